@@ -1,0 +1,19 @@
+#pragma once
+/// \file
+/// fusion_cli subcommands. Each lives in its own cmd_*.cpp and registers itself on the app;
+/// main() maps io::CsvError and UsageError to exit status 2 with one line on stderr.
+
+#include <CLI/CLI.hpp>
+#include <stdexcept>
+
+namespace telltale::cli {
+
+/// Bad input that is not a CSV error (an unknown filter name, an inconsistent option).
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+void register_attitude(CLI::App& app);
+
+}  // namespace telltale::cli
