@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# The demo: a shore server, four simulated boats on a private DDS domain (loopback only) and the
+# dashboard. Prints the dashboard link with its token; Ctrl-C stops everything cleanly.
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+"$root/deploy/build.sh"
+bin="$root/build/bin"
+export TELLTALE_DOMAIN=${TELLTALE_DOMAIN:-$((10 + $$ % 90))}
+port=${TELLTALE_HTTP_PORT:-8080}
+token=${TELLTALE_COACH_TOKEN:-$(head -c 12 /dev/urandom | base64 | tr '+/' '-_')}
+db=${TELLTALE_DB:-$root/build/demo.db}
+log=$(mktemp -d)
+pids=()
+stop() {
+  trap - INT TERM EXIT
+  [ ${#pids[@]} -gt 0 ] && kill -INT "${pids[@]}" 2>/dev/null || true
+  wait 2>/dev/null || true
+  rm -rf "$log"
+  echo "demo stopped (recording kept in $db)"
+}
+trap stop INT TERM EXIT
+"$bin/shore_server" --http-port "$port" --db "$db" --coach-token "$token" >"$log/shore" 2>&1 &
+pids+=($!)
+for _ in $(seq 100); do grep -q "ready" "$log/shore" && break; sleep 0.1; done
+grep -q "ready" "$log/shore" || { cat "$log/shore"; exit 1; }
+for boat in ILCA-1 ILCA-2 ILCA-3 ILCA-4; do
+  "$bin/boat_node" --boat-id "$boat" >"$log/$boat" 2>&1 &
+  pids+=($!)
+done
+url=$(grep -o 'http://[^ ]*' "$log/shore")
+echo "Telltale demo on DDS domain $TELLTALE_DOMAIN: shore + 4 boats"
+echo "Dashboard: ${url}#token=${token}"
+echo "Coach token: ${token}   (curl -H 'Authorization: Bearer ${token}' ${url}api/v1/boats)"
+echo "Ctrl-C to stop."
+wait -n "${pids[@]}" || true
+echo "a demo process exited:" >&2
+tail -n 5 "$log"/* >&2

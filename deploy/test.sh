@@ -1,0 +1,7 @@
+#!/usr/bin/env bash
+# Builds everything and runs every test (unit, integration over real DDS and HTTP).
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+"$root/deploy/build.sh"
+cd "$root/build"
+ctest --output-on-failure -j"$(nproc)" --timeout 600

@@ -1,0 +1,104 @@
+#include "dds_participant.hpp"
+
+#include <cstdlib>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastrtps/types/TypesBase.h>
+#include <filesystem>
+#include <mutex>
+
+namespace telltale::dds {
+
+using eprosima::fastdds::dds::DomainParticipantFactory;
+using eprosima::fastrtps::types::ReturnCode_t;
+namespace fdds = eprosima::fastdds::dds;
+
+int resolve_domain(const std::optional<int>& flag) {
+  int domain = 0;
+  if (flag) {
+    domain = *flag;
+  } else if (const char* env = std::getenv("TELLTALE_DOMAIN"); env && *env) {
+    char* end = nullptr;
+    const long v = std::strtol(env, &end, 10);
+    if (*end != '\0') throw DdsError(std::string("TELLTALE_DOMAIN is not a number: ") + env);
+    domain = static_cast<int>(v);
+  } else {
+    throw DdsError("no DDS domain: pass --domain N or set TELLTALE_DOMAIN");
+  }
+  if (domain < 0 || domain > 232) throw DdsError("DDS domain must be 0..232");
+  return domain;
+}
+
+std::string resolve_profiles_file(const std::string& flag) {
+  std::string path = flag;
+  if (path.empty()) {
+    if (const char* env = std::getenv("TELLTALE_DDS_PROFILES"); env && *env) path = env;
+  }
+  if (path.empty()) path = TELLTALE_DEFAULT_DDS_PROFILES;
+  if (!std::filesystem::exists(path)) throw DdsError("DDS profiles file not found: " + path);
+  return path;
+}
+
+Participant::Participant(const DdsOptions& options, const std::string& name)
+    : domain_(resolve_domain(options.domain)) {
+  auto* factory = DomainParticipantFactory::get_instance();
+  const std::string profiles = resolve_profiles_file(options.profiles_file);
+  // The factory is process-wide; load each file once.
+  static std::mutex load_mutex;
+  static std::string loaded;
+  {
+    std::lock_guard lock(load_mutex);
+    if (loaded != profiles) {
+      if (factory->load_XML_profiles_file(profiles) != ReturnCode_t::RETCODE_OK)
+        throw DdsError("cannot load DDS profiles " + profiles);
+      loaded = profiles;
+    }
+  }
+  fdds::DomainParticipantQos qos;
+  if (factory->get_participant_qos_from_profile(options.participant_profile, qos) !=
+      ReturnCode_t::RETCODE_OK)
+    throw DdsError("no participant profile '" + options.participant_profile + "' in " + profiles);
+  qos.name(name);
+  participant_ = factory->create_participant(static_cast<fdds::DomainId_t>(domain_), qos);
+  if (!participant_) throw DdsError("cannot create DDS participant on domain " +
+                                    std::to_string(domain_));
+  publisher_ = participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
+  subscriber_ = participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
+  if (!publisher_ || !subscriber_) {
+    participant_->delete_contained_entities();
+    factory->delete_participant(participant_);
+    throw DdsError("cannot create DDS publisher/subscriber");
+  }
+}
+
+Participant::~Participant() {
+  if (!participant_) return;
+  participant_->delete_contained_entities();
+  DomainParticipantFactory::get_instance()->delete_participant(participant_);
+}
+
+fdds::Topic* Participant::topic(const std::string& topic_name, fdds::TypeSupport type) {
+  if (auto it = topics_.find(topic_name); it != topics_.end()) return it->second;
+  if (type.register_type(participant_) != ReturnCode_t::RETCODE_OK)
+    throw DdsError("cannot register type " + type.get_type_name());
+  auto* t = participant_->create_topic(topic_name, type.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
+  if (!t) throw DdsError("cannot create topic " + topic_name);
+  topics_[topic_name] = t;
+  return t;
+}
+
+fdds::DataWriter* Participant::writer(fdds::Topic* t, const std::string& profile,
+                                      fdds::DataWriterListener* listener) {
+  auto* w = publisher_->create_datawriter_with_profile(t, profile, listener);
+  if (!w) throw DdsError("cannot create writer on " + t->get_name() + " with profile " + profile);
+  return w;
+}
+
+fdds::DataReader* Participant::reader(fdds::Topic* t, const std::string& profile,
+                                      fdds::DataReaderListener* listener) {
+  auto* r = subscriber_->create_datareader_with_profile(t, profile, listener,
+                                                        fdds::StatusMask::all());
+  if (!r) throw DdsError("cannot create reader on " + t->get_name() + " with profile " + profile);
+  return r;
+}
+
+}  // namespace telltale::dds

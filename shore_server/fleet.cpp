@@ -1,0 +1,61 @@
+#include "fleet.hpp"
+
+namespace telltale::shore {
+
+BoatView FleetModel::update(const AttitudeSample& sample, SteadyTime arrival,
+                        std::uint64_t arrival_utc_ns) {
+  std::lock_guard lock(mutex_);
+  auto it = boats_.try_emplace(sample.boat_id).first;
+  BoatView& b = it->second;
+  b.last = sample;
+  b.last_arrival = arrival;
+  b.arrival_utc_ns = arrival_utc_ns;
+  b.stale = false;
+  ++b.samples_received;
+  return b;
+}
+
+void FleetModel::update_status(const std::string& node_id, const NodeStatusInfo& status) {
+  std::lock_guard lock(mutex_);
+  auto it = boats_.find(node_id);
+  if (it == boats_.end()) return;  // status before any sample: kept once the boat publishes
+  it->second.status = status;
+}
+
+std::vector<BoatView> FleetModel::sweep(SteadyTime now) {
+  std::vector<BoatView> went_stale;
+  std::lock_guard lock(mutex_);
+  for (auto& entry : boats_) {
+    BoatView& b = entry.second;
+    if (!b.stale && now - b.last_arrival > stale_after_) {
+      b.stale = true;
+      went_stale.push_back(b);
+    }
+  }
+  return went_stale;
+}
+
+std::optional<BoatView> FleetModel::mark_stale(const std::string& boat_id) {
+  std::lock_guard lock(mutex_);
+  auto it = boats_.find(boat_id);
+  if (it == boats_.end() || it->second.stale) return std::nullopt;
+  it->second.stale = true;
+  return it->second;
+}
+
+std::vector<BoatView> FleetModel::boats() const {
+  std::lock_guard lock(mutex_);
+  std::vector<BoatView> out;
+  out.reserve(boats_.size());
+  for (const auto& [id, b] : boats_) out.push_back(b);
+  return out;
+}
+
+std::optional<BoatView> FleetModel::boat(const std::string& boat_id) const {
+  std::lock_guard lock(mutex_);
+  auto it = boats_.find(boat_id);
+  if (it == boats_.end()) return std::nullopt;
+  return it->second;
+}
+
+}  // namespace telltale::shore

@@ -1,0 +1,77 @@
+#pragma once
+/// \file
+/// The fleet model: the latest state of every boat and wearable seen on the domain, thread-safe.
+/// The DDS listener writes it, REST handlers and the live stream read it.
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace telltale::shore {
+
+using SteadyTime = std::chrono::steady_clock::time_point;
+
+/// One boat's latest attitude, in wire units.
+struct AttitudeSample {
+  std::string boat_id;
+  std::uint64_t seq = 0;
+  std::uint64_t t_utc_ns = 0;
+  double heel_deg = 0.0;
+  double pitch_deg = 0.0;
+  double heading_deg = 0.0;  ///< NaN when the boat has no heading source
+  double heel_rate_deg_s = 0.0;
+  double pitch_rate_deg_s = 0.0;
+  double yaw_rate_deg_s = 0.0;
+  float accel_weight = 0.0f;
+  float quality = 0.0f;
+  std::uint8_t leds[4] = {0, 0, 0, 0};  ///< left, right, up, down
+  std::uint8_t led_count = 0;
+};
+
+struct NodeStatusInfo {
+  std::string kind;  ///< "boat", "wearable", "shore"
+  std::string software_version;
+  double uptime_s = 0.0;
+  std::uint32_t sensor_health = 0;
+  std::string health_text;
+  std::uint64_t samples_published = 0;
+};
+
+struct BoatView {
+  AttitudeSample last;
+  SteadyTime last_arrival{};
+  std::uint64_t arrival_utc_ns = 0;
+  bool stale = false;
+  std::string alarm_state = "normal";
+  std::optional<NodeStatusInfo> status;
+  std::uint64_t samples_received = 0;
+};
+
+class FleetModel {
+ public:
+  /// `stale_after`: a boat with no sample for this long is stale.
+  explicit FleetModel(std::chrono::milliseconds stale_after) : stale_after_(stale_after) {}
+
+  /// Records a sample and returns the boat's view after it.
+  BoatView update(const AttitudeSample& sample, SteadyTime arrival, std::uint64_t arrival_utc_ns);
+  void update_status(const std::string& node_id, const NodeStatusInfo& status);
+  /// Marks boats silent for longer than stale_after as stale; returns those that just went stale.
+  std::vector<BoatView> sweep(SteadyTime now);
+  /// Forces a boat stale now (DDS deadline missed); its view if it just went stale.
+  std::optional<BoatView> mark_stale(const std::string& boat_id);
+
+  [[nodiscard]] std::vector<BoatView> boats() const;
+  [[nodiscard]] std::optional<BoatView> boat(const std::string& boat_id) const;
+
+ private:
+  std::chrono::milliseconds stale_after_;
+  mutable std::mutex mutex_;
+  std::map<std::string, BoatView> boats_;
+};
+
+}  // namespace telltale::shore

@@ -1,0 +1,109 @@
+#include "fleet_subscriber.hpp"
+
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+
+#include "telltalePubSubTypes.h"
+
+namespace telltale::shore {
+
+namespace fdds = eprosima::fastdds::dds;
+
+namespace {
+
+AttitudeSample from_wire(const msg::BoatAttitude& m) {
+  AttitudeSample s;
+  s.boat_id = m.boat_id().to_string();
+  s.seq = m.seq();
+  s.t_utc_ns = m.t_utc_ns();
+  s.heel_deg = m.heel_deg();
+  s.pitch_deg = m.pitch_deg();
+  s.heading_deg = m.heading_deg();
+  s.heel_rate_deg_s = m.heel_rate_deg_s();
+  s.pitch_rate_deg_s = m.pitch_rate_deg_s();
+  s.yaw_rate_deg_s = m.yaw_rate_deg_s();
+  s.accel_weight = m.accel_weight();
+  s.quality = m.quality();
+  s.leds[0] = m.leds().left_leds();
+  s.leds[1] = m.leds().right_leds();
+  s.leds[2] = m.leds().up_leds();
+  s.leds[3] = m.leds().down_leds();
+  s.led_count = m.leds().led_count();
+  return s;
+}
+
+const char* kind_name(msg::NodeKind kind) {
+  switch (kind) {
+    case msg::NODE_KIND_BOAT:
+      return "boat";
+    case msg::NODE_KIND_WEARABLE:
+      return "wearable";
+    case msg::NODE_KIND_SHORE:
+      return "shore";
+  }
+  return "unknown";
+}
+
+}  // namespace
+
+class FleetSubscriber::Listener : public fdds::DataReaderListener {
+ public:
+  explicit Listener(const FleetCallbacks& cb) : cb_(cb) {}
+
+  // Readers are told apart by topic name: a callback may arrive before the constructor below has
+  // stored the reader pointers.
+  void on_data_available(fdds::DataReader* reader) override {
+    fdds::SampleInfo info;
+    const std::string& topic = reader->get_topicdescription()->get_name();
+    if (topic == dds::kTopicBoatAttitude) {
+      msg::BoatAttitude m;
+      while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
+        if (info.valid_data && cb_.on_attitude) cb_.on_attitude(from_wire(m));
+      }
+    } else if (topic == dds::kTopicNodeStatus) {
+      msg::NodeStatus m;
+      while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
+        if (!info.valid_data || !cb_.on_status) continue;
+        NodeStatusInfo s;
+        s.kind = kind_name(m.kind());
+        s.software_version = m.software_version().to_string();
+        s.uptime_s = m.uptime_s();
+        s.sensor_health = m.sensor_health();
+        s.health_text = m.health_text().to_string();
+        s.samples_published = m.samples_published();
+        cb_.on_status(m.node_id().to_string(), s);
+      }
+    }
+  }
+
+  void on_requested_deadline_missed(fdds::DataReader* reader,
+                                    const fdds::RequestedDeadlineMissedStatus& status) override {
+    if (reader->get_topicdescription()->get_name() != dds::kTopicBoatAttitude ||
+        !cb_.on_deadline_missed)
+      return;
+    msg::BoatAttitude key_holder;
+    if (reader->get_key_value(&key_holder, status.last_instance_handle) ==
+        ReturnCode_t::RETCODE_OK)
+      cb_.on_deadline_missed(key_holder.boat_id().to_string());
+  }
+
+ private:
+  using ReturnCode_t = eprosima::fastrtps::types::ReturnCode_t;
+  const FleetCallbacks& cb_;
+};
+
+FleetSubscriber::FleetSubscriber(const dds::DdsOptions& options, FleetCallbacks callbacks)
+    : callbacks_(std::move(callbacks)), listener_(std::make_unique<Listener>(callbacks_)) {
+  participant_ = std::make_unique<dds::Participant>(options, "shore_server");
+  participant_->reader(
+      participant_->topic(dds::kTopicBoatAttitude,
+                          fdds::TypeSupport(new msg::BoatAttitudePubSubType())),
+      "attitude_reader", listener_.get());
+  participant_->reader(
+      participant_->topic(dds::kTopicNodeStatus, fdds::TypeSupport(new msg::NodeStatusPubSubType())),
+      "status_reader", listener_.get());
+}
+
+// The participant (and its readers) go first, so no callback runs on a dead listener.
+FleetSubscriber::~FleetSubscriber() { participant_.reset(); }
+
+}  // namespace telltale::shore

@@ -1,0 +1,118 @@
+// shore_server: subscribes to the fleet over DDS, records it, serves the REST API, the live
+// stream and the dashboard.
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <thread>
+
+#include "auth.hpp"
+#include "fleet.hpp"
+#include "fleet_subscriber.hpp"
+#include "http_api.hpp"
+#include "live_hub.hpp"
+#include "shutdown.hpp"
+#include "store.hpp"
+
+namespace {
+
+using namespace telltale::shore;
+
+struct Options {
+  telltale::dds::DdsOptions dds;
+  HttpConfig http;
+  std::string db_path = "telltale.db";
+  std::string coach_token;
+  int stale_ms = 2000;
+  int commit_ms = 250;
+};
+
+void run(Options o, telltale::ShutdownSignal& shutdown) {
+  TokenStore tokens;
+  if (o.coach_token.empty()) {
+    if (const char* env = std::getenv("TELLTALE_COACH_TOKEN"); env && *env) o.coach_token = env;
+  }
+  if (o.coach_token.empty()) {
+    o.coach_token = random_token();
+    std::printf("shore_server coach token (generated): %s\n", o.coach_token.c_str());
+  }
+  tokens.add(o.coach_token, {Role::kCoach, ""});
+
+  SampleStore store(o.db_path, std::chrono::milliseconds(o.commit_ms));
+  FleetModel fleet(std::chrono::milliseconds(o.stale_ms));
+  LiveHub hub(o.http.max_stream_clients, 256);
+
+  FleetCallbacks callbacks;
+  callbacks.on_attitude = [&](const AttitudeSample& s) {
+    const BoatView view =
+        fleet.update(s, std::chrono::steady_clock::now(), telltale::utc_now_ns());
+    store.enqueue(s);
+    hub.publish_sample(s.boat_id, boat_json(view));
+  };
+  callbacks.on_status = [&](const std::string& id, const NodeStatusInfo& st) {
+    fleet.update_status(id, st);
+  };
+  callbacks.on_deadline_missed = [&](const std::string& id) {
+    if (auto v = fleet.mark_stale(id)) hub.publish_sample(id, boat_json(*v));
+  };
+  FleetSubscriber subscriber(o.dds, callbacks);
+
+  HttpApi api(o.http, fleet, hub, tokens, store);
+  const int port = api.bind();
+  std::thread http_thread([&] { api.serve(); });
+  std::printf("shore_server ready: http://%s:%d/ domain=%d db=%s\n", o.http.bind_address.c_str(),
+              port, telltale::dds::resolve_domain(o.dds.domain), o.db_path.c_str());
+  std::fflush(stdout);
+
+  // Stale sweep: a boat silent for stale_ms is marked stale even if DDS never says so.
+  while (!shutdown.wait_for(std::chrono::milliseconds(200))) {
+    for (const auto& v : fleet.sweep(std::chrono::steady_clock::now()))
+      hub.publish_sample(v.last.boat_id, boat_json(v));
+  }
+  hub.close();
+  api.stop();
+  http_thread.join();
+  std::printf("shore_server stopped: %llu samples committed\n",
+              static_cast<unsigned long long>(store.committed()));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  telltale::ShutdownSignal shutdown;  // first: every later thread inherits the blocked signals
+  Options o;
+  int domain = -1;
+  CLI::App app{"Telltale shore server: fleet over DDS -> SQLite, REST API, live stream, dashboard"};
+  app.add_option("--domain", domain, "DDS domain id (default: $TELLTALE_DOMAIN)");
+  app.add_option("--http-port", o.http.port, "HTTP port; 0 picks a free one and prints it")
+      ->capture_default_str();
+  app.add_option("--bind", o.http.bind_address, "HTTP listen address (localhost by default)")
+      ->capture_default_str();
+  app.add_option("--db", o.db_path, "SQLite database file (created if missing)")
+      ->capture_default_str();
+  app.add_option("--coach-token", o.coach_token,
+                 "coach token (default: $TELLTALE_COACH_TOKEN, else a generated one, printed)");
+  app.add_option("--web-dir", o.http.web_dir, "dashboard files")->capture_default_str();
+  app.add_option("--max-streams", o.http.max_stream_clients, "live-stream clients at most")
+      ->capture_default_str();
+  app.add_option("--rest-threads", o.http.rest_threads, "HTTP workers besides the streams")
+      ->capture_default_str();
+  app.add_option("--stale-ms", o.stale_ms, "a boat silent this long is stale")
+      ->capture_default_str();
+  app.add_option("--commit-ms", o.commit_ms, "store commit interval (the durability window)")
+      ->capture_default_str();
+  app.add_option("--dds-profiles", o.dds.profiles_file,
+                 "Fast DDS profiles XML (default: $TELLTALE_DDS_PROFILES or deploy/dds/)");
+  app.add_option("--dds-participant", o.dds.participant_profile, "participant profile")
+      ->capture_default_str();
+  o.http.web_dir = TELLTALE_DEFAULT_WEB_DIR;
+  CLI11_PARSE(app, argc, argv);
+  if (domain >= 0) o.dds.domain = domain;
+  try {
+    run(o, shutdown);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "shore_server: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,233 @@
+// Walking skeleton over real processes: a shore_server and two boat_nodes on a private DDS domain;
+// the fleet seen over HTTP, live over SSE, and recorded in SQLite.
+#include <gtest/gtest.h>
+#include <httplib.h>
+#include <signal.h>
+#include <sqlite3.h>
+
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <thread>
+
+#include "process.hpp"
+
+namespace telltale::testing {
+namespace {
+
+using nlohmann::json;
+using namespace std::chrono_literals;
+
+constexpr const char* kToken = "integration-coach-token";
+
+class FleetTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = make_temp_dir();
+    domain_ = unique_domain();
+    shore_ = std::make_unique<Process>(std::vector<std::string>{
+        bin_dir() + "/shore_server", "--domain", std::to_string(domain_), "--http-port", "0",
+        "--db", dir_ + "/fleet.db", "--coach-token", kToken});
+    const auto ready = shore_->wait_for_line("shore_server ready: ", 20s);
+    ASSERT_TRUE(ready) << "shore did not start: " << shore_->output();
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(*ready, m, std::regex(R"(http://127\.0\.0\.1:(\d+)/)")));
+    port_ = std::stoi(m[1]);
+  }
+  void TearDown() override {
+    boats_.clear();
+    shore_.reset();
+    std::filesystem::remove_all(dir_);
+  }
+
+  Process& start_boat(const std::string& id) {
+    boats_.push_back(std::make_unique<Process>(std::vector<std::string>{
+        bin_dir() + "/boat_node", "--domain", std::to_string(domain_), "--boat-id", id}));
+    EXPECT_TRUE(boats_.back()->wait_for_line("boat_node ready: ", 20s))
+        << boats_.back()->output();
+    return *boats_.back();
+  }
+
+  httplib::Client client() const {
+    httplib::Client c("127.0.0.1", port_);
+    c.set_connection_timeout(2);
+    c.set_read_timeout(5);
+    return c;
+  }
+
+  std::map<std::string, json> boats_by_id() const {
+    auto c = client();
+    auto res = c.Get("/api/v1/boats", {{"Authorization", std::string("Bearer ") + kToken}});
+    std::map<std::string, json> out;
+    if (!res || res->status != 200) return out;
+    for (const auto& b : json::parse(res->body)) out[b["id"].get<std::string>()] = b;
+    return out;
+  }
+
+  std::string dir_;
+  int domain_ = 0;
+  int port_ = 0;
+  std::unique_ptr<Process> shore_;
+  std::vector<std::unique_ptr<Process>> boats_;
+};
+
+// Given a shore and two boats on a private domain, when a few seconds pass, then both boats are
+// listed over HTTP with finite heel and pitch that change between two reads.
+TEST_F(FleetTest, TwoBoatsAppearWithLiveChangingAttitude) {
+  start_boat("alpha");
+  start_boat("bravo-2");
+
+  std::map<std::string, json> first;
+  const auto deadline = std::chrono::steady_clock::now() + 15s;
+  while (std::chrono::steady_clock::now() < deadline) {
+    first = boats_by_id();
+    if (first.size() == 2) break;
+    std::this_thread::sleep_for(200ms);
+  }
+  ASSERT_EQ(first.size(), 2u) << "shore output: " << shore_->output();
+  std::this_thread::sleep_for(1s);
+  const auto second = boats_by_id();
+  for (const char* id : {"alpha", "bravo-2"}) {
+    SCOPED_TRACE(id);
+    ASSERT_TRUE(second.count(id));
+    const json& a = first.at(id);
+    const json& b = second.at(id);
+    ASSERT_TRUE(b["heel_deg"].is_number());
+    ASSERT_TRUE(b["pitch_deg"].is_number());
+    EXPECT_TRUE(std::isfinite(b["heel_deg"].get<double>()));
+    EXPECT_TRUE(std::isfinite(b["pitch_deg"].get<double>()));
+    EXPECT_LT(std::abs(b["heel_deg"].get<double>()), 90.0);
+    EXPECT_LT(std::abs(b["pitch_deg"].get<double>()), 90.0);
+    EXPECT_GT(b["seq"].get<std::uint64_t>(), a["seq"].get<std::uint64_t>());
+    EXPECT_NE(b["heel_deg"].get<double>(), a["heel_deg"].get<double>());
+    EXPECT_NE(b["pitch_deg"].get<double>(), a["pitch_deg"].get<double>());
+    EXPECT_FALSE(b["stale"].get<bool>());
+    // 25 Hz for one second: the sequence advanced by about 25 (best effort on loopback).
+    EXPECT_GE(b["seq"].get<std::uint64_t>() - a["seq"].get<std::uint64_t>(), 20u);
+  }
+}
+
+// The live stream pushes samples of every boat; a boat that stops goes stale within 2.5 s.
+TEST_F(FleetTest, StreamDeliversSamplesAndMarksSilentBoatStale) {
+  start_boat("charlie");
+  Process& delta = start_boat("delta");
+
+  std::map<std::string, int> samples;
+  bool delta_stale = false;
+  bool stopped_delta = false;
+  auto started = std::chrono::steady_clock::now();
+  std::chrono::steady_clock::time_point stop_time;
+  auto c = client();
+  c.set_read_timeout(20);
+  std::string buffer;
+  auto res = c.Get(
+      "/api/v1/stream", {{"Authorization", std::string("Bearer ") + kToken}},
+      [&](const char* data, std::size_t len) {
+        buffer.append(data, len);
+        std::size_t end;
+        while ((end = buffer.find("\n\n")) != std::string::npos) {
+          const std::string frame = buffer.substr(0, end);
+          buffer.erase(0, end + 2);
+          const auto pos = frame.find("data: ");
+          if (frame.rfind("event: sample", 0) != 0 || pos == std::string::npos) continue;
+          const json b = json::parse(frame.substr(pos + 6));
+          const std::string id = b["id"];
+          ++samples[id];
+          if (stopped_delta && id == "delta" && b["stale"].get<bool>()) delta_stale = true;
+        }
+        const auto now = std::chrono::steady_clock::now();
+        if (!stopped_delta && samples["charlie"] > 25 && samples["delta"] > 25) {
+          EXPECT_EQ(delta.stop(SIGKILL), 128 + SIGKILL);
+          stopped_delta = true;
+          stop_time = now;
+        }
+        if (delta_stale) return false;
+        return now - started < 30s;
+      });
+  ASSERT_TRUE(stopped_delta) << "samples: charlie " << samples["charlie"] << " delta "
+                             << samples["delta"];
+  EXPECT_TRUE(delta_stale) << "delta never went stale";
+  EXPECT_LT(std::chrono::steady_clock::now() - stop_time, 3500ms);
+}
+
+TEST_F(FleetTest, AuthAndOpenEndpoints) {
+  auto c = client();
+  auto health = c.Get("/healthz");
+  ASSERT_TRUE(health);
+  EXPECT_EQ(health->status, 200);
+  EXPECT_EQ(json::parse(health->body)["status"], "ok");
+
+  auto spec = c.Get("/api/v1/openapi.json");
+  ASSERT_TRUE(spec);
+  ASSERT_EQ(spec->status, 200);
+  const json doc = json::parse(spec->body);
+  for (const char* path : {"/healthz", "/api/v1/boats", "/api/v1/stream", "/api/v1/login"})
+    EXPECT_TRUE(doc["paths"].contains(path)) << path;
+
+  for (const auto& headers :
+       {httplib::Headers{}, httplib::Headers{{"Authorization", "Bearer wrong"}},
+        httplib::Headers{{"Authorization", "Basic abc"}}}) {
+    auto res = c.Get("/api/v1/boats", headers);
+    ASSERT_TRUE(res);
+    EXPECT_EQ(res->status, 401);
+    EXPECT_TRUE(json::parse(res->body).contains("error"));
+  }
+  auto missing = c.Get("/api/v1/nothing-here", {{"Authorization", std::string("Bearer ") + kToken}});
+  ASSERT_TRUE(missing);
+  EXPECT_EQ(missing->status, 404);
+  EXPECT_TRUE(json::parse(missing->body).contains("error"));
+
+  // Login exchanges the bearer token for an HttpOnly cookie that then authorises requests.
+  auto login = c.Post("/api/v1/login", {{"Authorization", std::string("Bearer ") + kToken}}, "",
+                      "text/plain");
+  ASSERT_TRUE(login);
+  EXPECT_EQ(login->status, 200);
+  const std::string cookie = login->get_header_value("Set-Cookie");
+  EXPECT_NE(cookie.find("HttpOnly"), std::string::npos);
+  auto with_cookie = c.Get("/api/v1/boats", {{"Cookie", cookie.substr(0, cookie.find(';'))}});
+  ASSERT_TRUE(with_cookie);
+  EXPECT_EQ(with_cookie->status, 200);
+
+  auto page = c.Get("/");
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 200);
+  EXPECT_NE(page->body.find("Telltale"), std::string::npos);
+}
+
+// SIGINT stops every process cleanly (exit 0) and the shore has recorded both boats' samples.
+TEST_F(FleetTest, CleanShutdownKeepsTheRecording) {
+  Process& echo = start_boat("echo");
+  std::this_thread::sleep_for(3s);
+  EXPECT_EQ(echo.stop(SIGINT), 0);
+  const auto stopped = echo.wait_for_line("boat_node stopped: ", 1s);
+  ASSERT_TRUE(stopped) << echo.output();
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(*stopped, m, std::regex(R"(published=(\d+))")));
+  const long published = std::stol(m[1]);
+  EXPECT_GT(published, 50);
+  std::this_thread::sleep_for(500ms);
+  EXPECT_EQ(shore_->stop(SIGTERM), 0) << shore_->output();
+  // A clean close checkpoints the WAL and removes it: no stale state left behind.
+  EXPECT_FALSE(std::filesystem::exists(dir_ + "/fleet.db-wal"));
+  EXPECT_FALSE(std::filesystem::exists(dir_ + "/fleet.db-shm"));
+
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open_v2((dir_ + "/fleet.db").c_str(), &db, SQLITE_OPEN_READONLY, nullptr),
+            SQLITE_OK);
+  sqlite3_stmt* st = nullptr;
+  sqlite3_prepare_v2(db, "SELECT COUNT(*), MAX(seq) FROM attitude WHERE boat_id = 'echo'", -1, &st,
+                     nullptr);
+  ASSERT_EQ(sqlite3_step(st), SQLITE_ROW);
+  const long stored = sqlite3_column_int64(st, 0);
+  const long max_seq = sqlite3_column_int64(st, 1);
+  sqlite3_finalize(st);
+  sqlite3_close(db);
+  // Everything the shore received after discovery is stored; the last one published is there.
+  EXPECT_EQ(max_seq, published);
+  EXPECT_GT(stored, published / 2);
+}
+
+}  // namespace
+}  // namespace telltale::testing

@@ -1,0 +1,120 @@
+#include "process.hpp"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <stdexcept>
+#include <thread>
+
+namespace telltale::testing {
+
+Process::Process(std::vector<std::string> argv, std::vector<std::string> env) {
+  // Everything the child needs is built before fork: after it, only async-signal-safe calls.
+  std::vector<char*> args;
+  for (auto& a : argv) args.push_back(a.data());
+  args.push_back(nullptr);
+  std::vector<char*> envp;
+  for (char** e = environ; *e; ++e) envp.push_back(*e);
+  for (auto& e : env) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  int fds[2];
+  if (pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
+  const pid_t parent = getpid();
+  pid_ = fork();
+  if (pid_ < 0) throw std::runtime_error("fork failed");
+  if (pid_ == 0) {
+    // Child: die with the test, even if the test crashes.
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (getppid() != parent) _exit(127);
+    // Signals the test runner blocked must not stay blocked in the child.
+    sigset_t none;
+    sigemptyset(&none);
+    sigprocmask(SIG_SETMASK, &none, nullptr);
+    dup2(fds[1], STDOUT_FILENO);
+    execve(args[0], args.data(), envp.data());
+    _exit(127);
+  }
+  close(fds[1]);
+  stdout_fd_ = fds[0];
+}
+
+Process::~Process() {
+  if (running()) stop(SIGTERM, std::chrono::seconds(5));
+  if (stdout_fd_ >= 0) close(stdout_fd_);
+}
+
+bool Process::read_some(std::chrono::milliseconds timeout) {
+  pollfd p{stdout_fd_, POLLIN, 0};
+  if (poll(&p, 1, static_cast<int>(timeout.count())) <= 0) return false;
+  char buf[4096];
+  const ssize_t n = read(stdout_fd_, buf, sizeof buf);
+  if (n <= 0) return false;
+  output_.append(buf, static_cast<std::size_t>(n));
+  return true;
+}
+
+std::optional<std::string> Process::wait_for_line(const std::string& prefix,
+                                                  std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    std::size_t eol;
+    while ((eol = output_.find('\n', scanned_)) != std::string::npos) {
+      std::string line = output_.substr(scanned_, eol - scanned_);
+      scanned_ = eol + 1;
+      if (line.rfind(prefix, 0) == 0) return line;
+    }
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0) return std::nullopt;
+    if (!read_some(std::min(left, std::chrono::milliseconds(100))) && !running())
+      return std::nullopt;
+  }
+}
+
+bool Process::running() {
+  if (exited_) return false;
+  int status = 0;
+  const pid_t r = waitpid(pid_, &status, WNOHANG);
+  if (r == pid_) {
+    exited_ = true;
+    status_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    return false;
+  }
+  return true;
+}
+
+int Process::stop(int signo, std::chrono::milliseconds timeout) {
+  if (!running()) return status_;
+  kill(pid_, signo);
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < deadline) {
+    read_some(std::chrono::milliseconds(20));  // keep the pipe drained so the child never blocks
+    if (!running()) return status_;
+  }
+  kill(pid_, SIGKILL);
+  waitpid(pid_, nullptr, 0);
+  exited_ = true;
+  status_ = -1;
+  return -1;
+}
+
+int unique_domain() {
+  // Spread over 100..229 by process id: tests run in parallel by ctest get different domains.
+  return 100 + static_cast<int>(getpid() % 130);
+}
+
+std::string make_temp_dir() {
+  std::string tmpl = (std::filesystem::temp_directory_path() / "telltale_test_XXXXXX").string();
+  if (!mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
+  return tmpl;
+}
+
+std::string bin_dir() { return TELLTALE_BIN_DIR; }
+
+}  // namespace telltale::testing
