@@ -22,6 +22,7 @@ constexpr double kRadToDeg = 180.0 / M_PI;
 struct Options {
   telltale::dds::DdsOptions dds;
   std::string boat_id;
+  std::string group;
   std::string source = "sim";
   double rate_hz = 25.0;
   double imu_rate_hz = 100.0;
@@ -32,6 +33,8 @@ void validate(const Options& o) {
   static const std::regex kId("[A-Za-z0-9_-]{1,32}");
   if (!std::regex_match(o.boat_id, kId))
     throw std::invalid_argument("boat id must be 1-32 of [A-Za-z0-9_-], got '" + o.boat_id + "'");
+  if (!o.group.empty() && !std::regex_match(o.group, kId))
+    throw std::invalid_argument("group must be 1-32 of [A-Za-z0-9_-], got '" + o.group + "'");
   if (o.source != "sim") throw std::invalid_argument("unknown source '" + o.source + "'");
   if (!(o.imu_rate_hz > 0.0 && o.imu_rate_hz <= 1000.0))
     throw std::invalid_argument("--imu-rate-hz must be in (0, 1000]");
@@ -52,6 +55,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   telltale::dds::assign_bounded<32>(status.node_id(), o.boat_id, "boat id");
   status.kind(telltale::msg::NODE_KIND_BOAT);
   status.software_version(TELLTALE_VERSION);
+  status.group(o.group);
 
   std::printf("boat_node ready: boat=%s domain=%d source=%s rate=%gHz\n", o.boat_id.c_str(),
               telltale::dds::resolve_domain(o.dds.domain), o.source.c_str(), o.rate_hz);
@@ -129,6 +133,7 @@ int main(int argc, char** argv) {
   app.add_option("--domain", domain, "DDS domain id (default: $TELLTALE_DOMAIN)");
   app.add_option("--boat-id", o.boat_id, "fleet-unique boat id, 1-32 of [A-Za-z0-9_-]")
       ->required();
+  app.add_option("--group", o.group, "fleet group or class (alarm rules can target it)");
   app.add_option("--source", o.source, "sensor source: sim")->capture_default_str();
   app.add_option("--rate-hz", o.rate_hz, "publish rate, Hz")->capture_default_str();
   app.add_option("--imu-rate-hz", o.imu_rate_hz, "IMU sample rate of the sim source, Hz")

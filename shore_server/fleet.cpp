@@ -43,6 +43,20 @@ std::optional<BoatView> FleetModel::mark_stale(const std::string& boat_id) {
   return it->second;
 }
 
+std::optional<BoatView> FleetModel::set_alarm_state(const std::string& boat_id,
+                                                    const std::string& state) {
+  std::lock_guard lock(mutex_);
+  auto it = boats_.find(boat_id);
+  if (it == boats_.end()) {
+    // Known from a stored alarm before the boat's first sample after a restart.
+    it = boats_.try_emplace(boat_id).first;
+    it->second.last.boat_id = boat_id;
+    it->second.stale = true;
+  }
+  it->second.alarm_state = state;
+  return it->second;
+}
+
 std::vector<BoatView> FleetModel::boats() const {
   std::lock_guard lock(mutex_);
   std::vector<BoatView> out;

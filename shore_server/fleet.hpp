@@ -40,6 +40,7 @@ struct NodeStatusInfo {
   std::uint32_t sensor_health = 0;
   std::string health_text;
   std::uint64_t samples_published = 0;
+  std::string group;
 };
 
 struct BoatView {
@@ -64,6 +65,9 @@ class FleetModel {
   std::vector<BoatView> sweep(SteadyTime now);
   /// Forces a boat stale now (DDS deadline missed); its view if it just went stale.
   std::optional<BoatView> mark_stale(const std::string& boat_id);
+
+  /// Sets a boat's alarm state ("normal", "warn", "alarm"); its view if the boat is known.
+  std::optional<BoatView> set_alarm_state(const std::string& boat_id, const std::string& state);
 
   [[nodiscard]] std::vector<BoatView> boats() const;
   [[nodiscard]] std::optional<BoatView> boat(const std::string& boat_id) const;

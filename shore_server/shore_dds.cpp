@@ -1,6 +1,7 @@
-#include "fleet_subscriber.hpp"
+#include "shore_dds.hpp"
 
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <algorithm>
 
 #include "telltalePubSubTypes.h"
 
@@ -45,7 +46,7 @@ const char* kind_name(msg::NodeKind kind) {
 
 }  // namespace
 
-class FleetSubscriber::Listener : public fdds::DataReaderListener {
+class ShoreDds::Listener : public fdds::DataReaderListener {
  public:
   explicit Listener(const FleetCallbacks& cb) : cb_(cb) {}
 
@@ -70,6 +71,7 @@ class FleetSubscriber::Listener : public fdds::DataReaderListener {
         s.sensor_health = m.sensor_health();
         s.health_text = m.health_text().to_string();
         s.samples_published = m.samples_published();
+        s.group = m.group().to_string();
         cb_.on_status(m.node_id().to_string(), s);
       }
     }
@@ -91,7 +93,7 @@ class FleetSubscriber::Listener : public fdds::DataReaderListener {
   const FleetCallbacks& cb_;
 };
 
-FleetSubscriber::FleetSubscriber(const dds::DdsOptions& options, FleetCallbacks callbacks)
+ShoreDds::ShoreDds(const dds::DdsOptions& options, FleetCallbacks callbacks)
     : callbacks_(std::move(callbacks)), listener_(std::make_unique<Listener>(callbacks_)) {
   participant_ = std::make_unique<dds::Participant>(options, "shore_server");
   participant_->reader(
@@ -101,9 +103,77 @@ FleetSubscriber::FleetSubscriber(const dds::DdsOptions& options, FleetCallbacks 
   participant_->reader(
       participant_->topic(dds::kTopicNodeStatus, fdds::TypeSupport(new msg::NodeStatusPubSubType())),
       "status_reader", listener_.get());
+  rule_writer_ = participant_->writer(
+      participant_->topic(dds::kTopicAlarmRules, fdds::TypeSupport(new msg::AlarmRulePubSubType())),
+      "alarm_writer");
+  event_writer_ = participant_->writer(
+      participant_->topic(dds::kTopicAlarmEvents,
+                          fdds::TypeSupport(new msg::AlarmEventPubSubType())),
+      "alarm_writer");
 }
 
 // The participant (and its readers) go first, so no callback runs on a dead listener.
-FleetSubscriber::~FleetSubscriber() { participant_.reset(); }
+ShoreDds::~ShoreDds() { participant_.reset(); }
+
+void ShoreDds::publish_rules(const std::vector<AlarmRule>& rules) {
+  std::lock_guard lock(write_mutex_);
+  ++rule_revision_;
+  std::vector<std::string> ids;
+  for (const auto& r : rules) {
+    msg::AlarmRule m;
+    m.rule_id(r.id);
+    m.scope(r.scope);
+    m.quantity(r.quantity == AlarmQuantity::kHeel ? msg::ALARM_QUANTITY_HEEL
+                                                  : msg::ALARM_QUANTITY_PITCH);
+    m.min_deg(r.min_deg);
+    m.max_deg(r.max_deg);
+    m.hold_s(r.hold_s);
+    m.hysteresis_deg(r.hysteresis_deg);
+    m.level(r.level == AlarmLevel::kAlarm ? msg::ALARM_LEVEL_ALARM : msg::ALARM_LEVEL_WARN);
+    m.enabled(r.enabled);
+    m.revision(rule_revision_);
+    rule_writer_->write(&m);
+    ids.push_back(r.id);
+  }
+  for (const auto& old : published_rule_ids_) {
+    if (std::find(ids.begin(), ids.end(), old) != ids.end()) continue;
+    msg::AlarmRule key;
+    key.rule_id(old);
+    rule_writer_->dispose(&key, rule_writer_->lookup_instance(&key));
+  }
+  published_rule_ids_ = std::move(ids);
+}
+
+void ShoreDds::publish_event(const AlarmEvent& e) {
+  msg::AlarmEvent m;
+  m.boat_id(e.boat_id);
+  m.rule_id(e.rule_id);
+  m.event_id(e.id);
+  m.level(e.level == AlarmLevel::kAlarm  ? msg::ALARM_LEVEL_ALARM
+          : e.level == AlarmLevel::kWarn ? msg::ALARM_LEVEL_WARN
+                                         : msg::ALARM_LEVEL_NORMAL);
+  switch (e.phase) {
+    case AlarmPhase::kRaised:
+      m.phase(msg::ALARM_PHASE_RAISED);
+      m.t_utc_ns(e.raised_ns);
+      break;
+    case AlarmPhase::kAcknowledged:
+      m.phase(msg::ALARM_PHASE_ACKNOWLEDGED);
+      m.t_utc_ns(e.acknowledged_ns);
+      break;
+    case AlarmPhase::kSilenced:
+      m.phase(msg::ALARM_PHASE_SILENCED);
+      m.t_utc_ns(e.silenced_ns);
+      break;
+    case AlarmPhase::kCleared:
+      m.phase(msg::ALARM_PHASE_CLEARED);
+      m.t_utc_ns(e.cleared_ns);
+      break;
+  }
+  m.value_deg(e.value_deg);
+  m.message(e.message.substr(0, 128));
+  std::lock_guard lock(write_mutex_);
+  event_writer_->write(&m);
+}
 
 }  // namespace telltale::shore
