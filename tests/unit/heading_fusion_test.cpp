@@ -1,6 +1,8 @@
 // Heading fusion (paper 002): the "Must show" items, analytic invariants, seeded sweeps
 // and Given/When/Then scenarios on the simulator.
 #define EIGEN_RUNTIME_NO_MALLOC
+#include "telltale/fusion/heading_fusion.hpp"
+
 #include <gtest/gtest.h>
 
 #include <array>
@@ -10,7 +12,6 @@
 #include <string>
 #include <vector>
 
-#include "telltale/fusion/heading_fusion.hpp"
 #include "telltale/fusion/sim/heading_eval.hpp"
 #include "telltale/fusion/sim/heading_sim.hpp"
 
@@ -93,7 +94,8 @@ TEST(HeadingClosedLoop, EqualsCentralizedStepByStepOnIdenticalSynchronousSensors
   // Then the resolved closed loop is the centralized filter (to rounding)
   EXPECT_LT(worst, 1e-9);
   // and its information shares are beta_i = 1/3 (eq. 35-36 at their fixed point)
-  for (int i = 0; i < 3; ++i) EXPECT_NEAR(cl.state().beta[static_cast<std::size_t>(i)], 1.0 / 3, 1e-12);
+  for (int i = 0; i < 3; ++i)
+    EXPECT_NEAR(cl.state().beta[static_cast<std::size_t>(i)], 1.0 / 3, 1e-12);
 }
 
 TEST(HeadingClosedLoop, UnequalSensorsStayWithinFivePercentOfCentralized) {
@@ -287,7 +289,8 @@ TEST(HeadingMonitor, StuckSensorIsIsolatedOnASlowTurn) {
   for (int k = 0; k < 200; ++k) {
     const double t = 0.1 * k;
     const double h = 50.0 + 0.3 * t + 0.05 * std::sin(7.0 * k);  // noise-like wiggle
-    y = {h, h + 0.02 * std::cos(5.0 * k), k < 30 ? h : 50.0 + 0.3 * 2.9 + 0.05 * std::sin(7.0 * 29)};
+    y = {h, h + 0.02 * std::cos(5.0 * k),
+         k < 30 ? h : 50.0 + 0.3 * 2.9 + 0.05 * std::sin(7.0 * 29)};
     f.update(t, y.data());
     frozen_seen = frozen_seen || f.diagnostics().status[2] == HeadingSensorStatus::kFrozen ||
                   f.diagnostics().status[2] == HeadingSensorStatus::kInconsistent;
@@ -337,7 +340,8 @@ TEST_P(WrapInvariance, RotatingEveryReadingRotatesTheOutput) {
       worst = std::max(worst, std::abs(wrap_180_deg(b.heading_deg() - a.heading_deg() - c)));
       ASSERT_GE(a.heading_deg(), 0.0);
       ASSERT_LT(a.heading_deg(), 360.0);
-      if (std::isfinite(last)) worst_step = std::max(worst_step, std::abs(wrap_180_deg(a.heading_deg() - last)));
+      if (std::isfinite(last))
+        worst_step = std::max(worst_step, std::abs(wrap_180_deg(a.heading_deg() - last)));
       last = a.heading_deg();
     }
     // Then the output turns by c (to rounding) and never jumps by a turn at north
@@ -369,8 +373,9 @@ TEST(HeadingEightSensors, OneBadOfEightIsIsolatedAndTheRestAverageDown) {
   for (std::size_t i = 0; i < 8; ++i) sc.fusion.noise_deg[i] = sc.sensors[i].noise_deg;
   const auto samples = sim::simulate_heading(sc, 11);
   const auto cl = run(sc, samples, HeadingMethod::kClosedLoop);
-  const auto three = run(scenario("dinghy-bias"), sim::simulate_heading(scenario("dinghy-bias"), 11),
-                         HeadingMethod::kClosedLoop);
+  const auto three =
+      run(scenario("dinghy-bias"), sim::simulate_heading(scenario("dinghy-bias"), 11),
+          HeadingMethod::kClosedLoop);
   EXPECT_LE(cl.faults.at(0).isolation_s, 2.0);
   EXPECT_LT(cl.rms_deg, three.rms_deg);
 }
@@ -398,8 +403,10 @@ TEST(HeadingNoHeap, UpdateNeverAllocatesForAnyMethodWithThreeOrEightSensors) {
         for (int i = 0; i < n; ++i) {
           // readings, gaps, a stuck and a spiking sensor: every branch of the monitor runs
           const double h = 350.0 + 20.0 * std::sin(0.05 * k) + 0.1 * std::sin(13.0 * (k + i));
-          y[static_cast<std::size_t>(i)] =
-              (i == 1 && k > 100) ? 7.0 : (i == 2 && k % 7 == 0) ? kNaN : (i == 0 && k % 50 == 0) ? h + 25.0 : h;
+          y[static_cast<std::size_t>(i)] = (i == 1 && k > 100)       ? 7.0
+                                           : (i == 2 && k % 7 == 0)  ? kNaN
+                                           : (i == 0 && k % 50 == 0) ? h + 25.0
+                                                                     : h;
         }
         f.update(0.1 * k, y.data());
       }
