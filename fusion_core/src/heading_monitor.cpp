@@ -166,18 +166,31 @@ HeadingGateDecision HeadingSensorMonitor::assess(double t_s, double dt_s, int n,
   const double p = std::max(pred_var_deg2, 0.0);
   double nu_ref = 0.0;
   double r_ref = 0.0;
-  if (n_cand >= 3) {
+  if (n_present >= 3) {
+    // Median over every sensor that reads now, isolated ones included: a sensor isolated by a
+    // false alarm must be able to come back, and the median of three or more ignores any one
+    // bad sensor whether or not it is isolated yet.
     std::array<double, kMaxHeadingSensors> v{};
     double r_sum = 0.0;
-    for (int k = 0; k < n_cand; ++k) {
-      const auto i = static_cast<std::size_t>(cand[static_cast<std::size_t>(k)]);
-      v[static_cast<std::size_t>(k)] = nu[i];
-      r_sum += r_deg2[i];
+    int m = 0;
+    for (int i = 0; i < n; ++i) {
+      const auto ui = static_cast<std::size_t>(i);
+      if (!present[ui]) continue;
+      v[static_cast<std::size_t>(m++)] = nu[ui];
+      r_sum += r_deg2[ui];
     }
-    std::sort(v.begin(), v.begin() + n_cand);
-    const auto h = static_cast<std::size_t>(n_cand / 2);
-    nu_ref = (n_cand % 2 == 1) ? v[h] : 0.5 * (v[h - 1] + v[h]);
-    r_ref = r_sum / n_cand;
+    for (int a = 1; a < m; ++a) {  // insertion sort: m <= 8 (std::sort trips -Warray-bounds)
+      const double key = v[static_cast<std::size_t>(a)];
+      int b = a - 1;
+      while (b >= 0 && v[static_cast<std::size_t>(b)] > key) {
+        v[static_cast<std::size_t>(b + 1)] = v[static_cast<std::size_t>(b)];
+        --b;
+      }
+      v[static_cast<std::size_t>(b + 1)] = key;
+    }
+    const auto h = static_cast<std::size_t>(m / 2);
+    nu_ref = (m % 2 == 1) ? v[h] : 0.5 * (v[h - 1] + v[h]);
+    r_ref = r_sum / m;
   } else if (n_cand == 2) {
     const auto a = static_cast<std::size_t>(cand[0]);
     const auto b = static_cast<std::size_t>(cand[1]);
@@ -223,7 +236,7 @@ HeadingGateDecision HeadingSensorMonitor::assess(double t_s, double dt_s, int n,
     const double dnu = nu[ui] - nu_ref;
     const double z = dnu * dnu / (r_deg2[ui] + r_ref);
     s.last_stat = z;
-    if (n_cand == 2 && !d.sensors_disagree && !d.no_candidate) {
+    if (n_present == 2 && n_cand == 2 && !d.sensors_disagree && !d.no_candidate) {
       // Two that agree within noise: the model's choice of reference is a coin toss, so the
       // window gets half of their chi-square(1) each instead of all of it for one of them.
       const auto a = static_cast<std::size_t>(cand[0]);

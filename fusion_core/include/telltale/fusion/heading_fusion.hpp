@@ -65,7 +65,10 @@ struct HeadingFusionParams {
   std::array<double, kMaxHeadingSensors> noise_deg{0.1, 0.1, 0.1, 0.1,
                                                    0.1, 0.1, 0.1, 0.1};  ///< sigma of v_i, deg
   std::array<double, kMaxHeadingSensors> latency_s{};  ///< age of a reading when it arrives, s
-  double accel_var_deg2_s4 = 400.0;         ///< Q: variance of yaw acceleration, (deg/s^2)^2
+  /// Q: variance of yaw acceleration, (deg/s^2)^2. 1000 = (31.6 deg/s^2)^2 covers a dinghy's
+  /// 90-degree tack in 4 s (peak 90 pi^2 / (2 * 4^2) = 27.8 deg/s^2); with 400 the rate lags in
+  /// tacks and latency-compensated sensors disagree with undelayed ones (false isolations).
+  double accel_var_deg2_s4 = 1000.0;
   double initial_rate_var_deg2_s2 = 100.0;  ///< P0 of the turn rate, (deg/s)^2
   double max_dt_s = 5.0;           ///< a longer gap re-initialises from the next readings, s
   HeadingMonitorParams monitor{};  ///< fault handling (monitor.enabled = false: fuse everything)

@@ -8,8 +8,9 @@
 ///
 /// What the monitor does (none of this is in the paper, which only defines M_i = I or 0):
 /// - innovation of every reading against the global prediction, nu_i = wrap(y_i - psi^-);
-/// - a robust reference: the median innovation of the non-excluded sensors (3 or more), the
-///   innovation that agrees best with the model (2), or the model itself (1);
+/// - a robust reference: the median innovation of all sensors reading now, isolated ones
+///   included (3 or more), else the innovation of the non-isolated sensor that agrees best with
+///   the model (2), or the model itself (1);
 /// - per reading, z_i = (nu_i - nu_ref)^2 / (r_i + r_ref): a chi-square(1) statistic of the
 ///   disagreement with the others. A reading with z_i > `sample_gate` is not fused (a spike);
 /// - per sensor, the sum of the last `window` values of min(z_i, `stat_cap`): chi-square(window).
