@@ -99,7 +99,8 @@ void run_heading(const HeadingOptions& o) {
   std::chrono::nanoseconds in_filter{0};
   std::uint64_t excluded_steps = 0;
   while (reader.next(row)) {
-    for (int i = 0; i < n; ++i) y[static_cast<std::size_t>(i)] = row[static_cast<std::size_t>(i + 1)];
+    for (int i = 0; i < n; ++i)
+      y[static_cast<std::size_t>(i)] = row[static_cast<std::size_t>(i + 1)];
     const auto t0 = std::chrono::steady_clock::now();
     f.update(row[0], y.data());
     in_filter += std::chrono::steady_clock::now() - t0;
@@ -141,7 +142,8 @@ fusion::sim::HeadingScenario scenario_or_throw(const std::string& name) {
   const auto sc = fusion::sim::heading_scenario(name);
   if (!sc) {
     std::string known;
-    for (auto s : fusion::sim::heading_scenario_names()) known += (known.empty() ? "" : ", ") + std::string(s);
+    for (auto s : fusion::sim::heading_scenario_names())
+      known += (known.empty() ? "" : ", ") + std::string(s);
     throw UsageError("unknown heading scenario '" + name + "' (known: " + known + ")");
   }
   return *sc;
@@ -166,7 +168,8 @@ void run_heading_sim(const SimOptions& o) {
     if (truth) {
       row = {s.t_s, s.truth_heading_deg, s.truth_rate_deg_s};
       for (std::size_t i = 0; i < n; ++i) {
-        row.push_back(fusion::sim::heading_fault_active(sc, static_cast<int>(i), s.t_s) ? 1.0 : 0.0);
+        row.push_back(fusion::sim::heading_fault_active(sc, static_cast<int>(i), s.t_s) ? 1.0
+                                                                                        : 0.0);
       }
       truth->row(row);
     }
@@ -236,8 +239,8 @@ void run_heading_eval(const EvalOptions& o) {
         for (const auto& f : r.faults) {
           if (f.isolation_s < 0) never_iso = true;
           iso = std::max(iso, f.isolation_s);
-          const bool recovers = sc.faults[static_cast<std::size_t>(&f - r.faults.data())].t_end_s <
-                                sc.duration_s;
+          const bool recovers =
+              sc.faults[static_cast<std::size_t>(&f - r.faults.data())].t_end_s < sc.duration_s;
           if (recovers && f.readmit_s < 0) never_back = true;
           if (recovers) readmit = std::max(readmit, f.readmit_s);
         }
@@ -259,13 +262,15 @@ void register_heading(CLI::App& app) {
   {
     auto o = std::make_shared<HeadingOptions>();
     auto* cmd = app.add_subcommand("heading", "Fuse N heading sensors: H.csv -> F.csv");
-    cmd->add_option("--in", o->in, "H.csv: t_s,h1_deg,...,hN_deg (N <= 8; empty or nan = no reading)")
+    cmd->add_option("--in", o->in,
+                    "H.csv: t_s,h1_deg,...,hN_deg (N <= 8; empty or nan = no reading)")
         ->required();
     cmd->add_option("--out", o->out,
                     "F.csv: t_s,heading_deg,rate_deg_s,heading_sd_deg,sensors_in_use,"
                     "sensors_excluded,model_mismatch (bit i = sensor i+1)")
         ->required();
-    cmd->add_option("--method", o->method, "fusion method: " + method_list())->capture_default_str();
+    cmd->add_option("--method", o->method, "fusion method: " + method_list())
+        ->capture_default_str();
     cmd->add_option("--noise-deg", o->noise_deg, "sensor noise sigma, deg (one, or one per sensor)")
         ->delimiter(',');
     cmd->add_option("--latency-s", o->latency_s, "sensor latency, s (one, or one per sensor)")
@@ -279,7 +284,8 @@ void register_heading(CLI::App& app) {
   {
     auto o = std::make_shared<SimOptions>();
     std::string names;
-    for (auto s : fusion::sim::heading_scenario_names()) names += (names.empty() ? "" : ", ") + std::string(s);
+    for (auto s : fusion::sim::heading_scenario_names())
+      names += (names.empty() ? "" : ", ") + std::string(s);
     auto* cmd = app.add_subcommand("heading-sim", "Simulate N heading sensors: H.csv and truth");
     cmd->add_option("scenario", o->scenario, "scenario: " + names)->required();
     cmd->add_option("--seed", o->seed, "random seed")->capture_default_str();

@@ -30,6 +30,7 @@
 // computed in different steps.
 #include "telltale/fusion/heading_fusion.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -143,7 +144,7 @@ void HeadingFusion::predict(double dt_s) {
   p_prior_ = symmetrised(f_ * state_.p * f_.transpose() + gqg_);  // eq. 17
 }
 
-void HeadingFusion::update(double t_s, const double* readings_deg) {
+void HeadingFusion::update(double t_s, const double* readings_deg, const double* age_s) {
   ++diag_.updates;
   std::array<double, kMaxHeadingSensors> y;
   y.fill(kNaN);
@@ -194,7 +195,9 @@ void HeadingFusion::update(double t_s, const double* readings_deg) {
   // uses the estimated rate, so its uncertainty adds latency^2 var(rate) to the reading's noise.
   for (int i = 0; i < n_; ++i) {
     const auto ui = static_cast<std::size_t>(i);
-    const double lat = params_.latency_s[ui];
+    const double age =
+        (age_s != nullptr && std::isfinite(age_s[i]) && age_s[i] > 0.0) ? age_s[i] : 0.0;
+    const double lat = params_.latency_s[ui] + age;
     if (std::isfinite(y[ui])) y[ui] += state_.x(1) * lat;
     r_eff_deg2_[ui] = r_deg2_[ui] + lat * lat * p_prior_(1, 1);
   }
@@ -437,6 +440,32 @@ void HeadingFusion::normalise_heading() {
   if (turns == 0.0 || !std::isfinite(turns)) return;
   state_.x(0) -= 360.0 * turns;
   for (int i = 0; i < n_; ++i) state_.local_x[static_cast<std::size_t>(i)](0) -= 360.0 * turns;
+}
+
+HeadingReadingBuffer::HeadingReadingBuffer(int sensor_count)
+    : n_(std::clamp(sensor_count, 1, kMaxHeadingSensors)) {
+  heading_deg_.fill(kNaN);
+  t_s_.fill(kNaN);
+}
+
+void HeadingReadingBuffer::push(int sensor, double t_s, double heading_deg) {
+  if (sensor < 0 || sensor >= n_ || !std::isfinite(heading_deg) || !std::isfinite(t_s)) {
+    ++ignored_;
+    return;
+  }
+  heading_deg_[static_cast<std::size_t>(sensor)] = heading_deg;
+  t_s_[static_cast<std::size_t>(sensor)] = t_s;
+}
+
+void HeadingReadingBuffer::flush_into(HeadingFusion& fusion, double t_s) {
+  std::array<double, kMaxHeadingSensors> age{};
+  for (int i = 0; i < n_; ++i) {
+    const auto ui = static_cast<std::size_t>(i);
+    age[ui] = std::isfinite(t_s_[ui]) ? std::max(0.0, t_s - t_s_[ui]) : 0.0;
+  }
+  fusion.update(t_s, heading_deg_.data(), age.data());
+  heading_deg_.fill(kNaN);
+  t_s_.fill(kNaN);
 }
 
 }  // namespace telltale::fusion

@@ -364,6 +364,42 @@ TEST(HeadingWrap, CircularMeanOfReadingsAcrossNorth) {
   EXPECT_LT(std::abs(wrap_180_deg(f.heading_deg() - 0.0)), 1e-9);
 }
 
+TEST(HeadingReadingBuffer, AsynchronousReadingsFlushedPerTickStillIsolateAndTrack) {
+  // Given the bias-step dinghy run, sentences received when produced, and a node that flushes at
+  // 10 Hz at its own phase, 0..90 ms after the sensors' tick (drifting), so every reading is aged
+  const HeadingScenario sc = scenario("dinghy-bias");
+  const auto samples = sim::simulate_heading(sc, 4);
+  HeadingFusion f(sc.fusion);
+  HeadingReadingBuffer buf(3);
+  double sq = 0.0;
+  int scored = 0;
+  bool isolated = false;
+  for (const auto& s : samples) {
+    for (int i = 0; i < 3; ++i) {
+      const double y = s.reading_deg[static_cast<std::size_t>(i)];
+      // the sentence describes the heading at s.t_s - latency; it is received a little later
+      if (std::isfinite(y)) buf.push(i, s.t_s, y);
+    }
+    const double phase_s = 0.01 + 0.08 * (0.5 + 0.5 * std::sin(0.05 * s.t_s));
+    buf.flush_into(f, s.t_s + phase_s);
+    if (s.t_s < sim::kHeadingSettleS) continue;
+    // truth at the flush time: first order in the rate
+    const double truth = s.truth_heading_deg + phase_s * s.truth_rate_deg_s;
+    const double e = wrap_180_deg(f.heading_deg() - truth);
+    sq += e * e;
+    ++scored;
+    if (s.t_s > 62.0 && s.t_s < 180.0)
+      isolated = isolated || ((f.diagnostics().sensors_excluded >> 1) & 1u);
+  }
+  // Then the fused heading stays accurate and the biased sensor is isolated
+  EXPECT_LT(std::sqrt(sq / scored), 0.3);
+  EXPECT_TRUE(isolated);
+  EXPECT_EQ(buf.ignored(), 0u);
+  buf.push(7, 1.0, 10.0);
+  buf.push(0, 1.0, kNaN);
+  EXPECT_EQ(buf.ignored(), 2u);
+}
+
 // ---------------------------------------------------------------- N = 8, registry, no heap
 
 TEST(HeadingEightSensors, OneBadOfEightIsIsolatedAndTheRestAverageDown) {
@@ -409,6 +445,11 @@ TEST(HeadingNoHeap, UpdateNeverAllocatesForAnyMethodWithThreeOrEightSensors) {
                                                                      : h;
         }
         f.update(0.1 * k, y.data());
+      }
+      HeadingReadingBuffer buf(n);
+      for (int k = 0; k < 50; ++k) {
+        buf.push(k % n, 40.0 + 0.1 * k, 123.0);
+        buf.flush_into(f, 40.0 + 0.1 * k + 0.01);
       }
       Eigen::internal::set_is_malloc_allowed(true);
       EXPECT_TRUE(std::isfinite(f.heading_deg())) << heading_method_name(m);

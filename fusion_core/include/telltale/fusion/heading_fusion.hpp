@@ -116,7 +116,9 @@ class HeadingFusion {
 
   /// One step at time t_s. `heading_deg` points to sensor_count readings, any range (wrapped
   /// here), NaN = no reading. Never throws, never allocates.
-  void update(double t_s, const double* heading_deg);
+  /// `age_s` (optional, sensor_count entries): how long before t_s each reading was received;
+  /// it adds to latency_s[i] in the compensation (for readings collected between two calls).
+  void update(double t_s, const double* heading_deg, const double* age_s = nullptr);
   void update(double t_s, std::span<const double> heading_deg) { update(t_s, heading_deg.data()); }
 
   /// Fused heading in [0, 360), deg.
@@ -153,6 +155,29 @@ class HeadingFusion {
   Mat2 p_prior_ = Mat2::Identity();  ///< P^-(k) of this step
   Mat2 gqg_ = Mat2::Zero();          ///< G Q G^T of this step
   Mat2 f_ = Mat2::Identity();        ///< F of this step
+};
+
+/// Collects asynchronous readings (one NMEA sentence at a time, from several threads via the
+/// caller's lock) and hands them to HeadingFusion once per tick, so that the monitor sees the
+/// sensors side by side. Latest reading per sensor wins; its age at the tick is compensated.
+///   buffer.push(i, t_received_s, heading_deg);   // any time, any order of sensors
+///   buffer.flush_into(fusion, t_tick_s);          // at the node's rate, e.g. 10-25 Hz
+class HeadingReadingBuffer {
+ public:
+  explicit HeadingReadingBuffer(int sensor_count);
+  /// Stores a reading of sensor i (0-based) received at t_s. Out-of-range i or a non-finite
+  /// value is ignored (counted in ignored()).
+  void push(int sensor, double t_s, double heading_deg);
+  /// Calls fusion.update(t_s, ...) with the readings pushed since the last flush (the others
+  /// NaN), each aged t_s - t_received (>= 0), and clears the buffer.
+  void flush_into(HeadingFusion& fusion, double t_s);
+  [[nodiscard]] std::uint64_t ignored() const { return ignored_; }
+
+ private:
+  int n_;
+  std::array<double, kMaxHeadingSensors> heading_deg_{};
+  std::array<double, kMaxHeadingSensors> t_s_{};
+  std::uint64_t ignored_ = 0;
 };
 
 }  // namespace telltale::fusion
