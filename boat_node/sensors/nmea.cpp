@@ -16,6 +16,8 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "telltale/fusion/heading_monitor.hpp"
+
 namespace telltale::sensors {
 namespace {
 
@@ -28,11 +30,7 @@ int hex_value(char c) {
   return -1;
 }
 
-double wrap_360(double a) {
-  double w = std::fmod(a, 360.0);
-  if (w < 0.0) w += 360.0;
-  return w >= 360.0 ? 0.0 : w;
-}
+using fusion::wrap_360_deg;
 
 /// Strict unsigned decimal: digits with at most one '.', nothing else ("nan", "1e3", "-2",
 /// " 5" are all rejected). from_chars alone would accept "nan" and "inf".
@@ -89,7 +87,7 @@ bool parse_signed(std::string_view value, std::string_view dir, double& out) {
 
 bool parse_heading_field(std::string_view f, double& out) {
   if (!parse_number(f, out) || out > 360.0) return false;
-  out = wrap_360(out);
+  out = wrap_360_deg(out);
   return true;
 }
 
@@ -188,8 +186,8 @@ NmeaParseResult parse_nmea_heading(std::string_view line, const NmeaParseOptions
     if (!parse_signed(f[3], f[4], h.variation_deg)) return res;
     h.sentence = NmeaSentence::kHdg;
     const double dev = std::isfinite(h.deviation_deg) ? h.deviation_deg : 0.0;
-    h.magnetic_deg = wrap_360(sensor + dev);
-    h.true_deg = std::isfinite(h.variation_deg) ? wrap_360(h.magnetic_deg + h.variation_deg) : kNaN;
+    h.magnetic_deg = wrap_360_deg(sensor + dev);
+    h.true_deg = std::isfinite(h.variation_deg) ? wrap_360_deg(h.magnetic_deg + h.variation_deg) : kNaN;
   }
   res.status = NmeaStatus::kOk;
   return res;
