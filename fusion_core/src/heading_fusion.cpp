@@ -10,9 +10,9 @@
 //    with it, so that eq. 4 gives p_i^-(k) = P^-(k) / beta_i. We do that ("closed-loop"). The
 //    printed form is kept as "closed-loop-eq27" and "closed-loop-paper".
 // 2. beta_i from tr(p_i), eq. 35-36: we read p_i as the local posterior p_i^+ of eq. 9 (eq. 18
-//    uses the same letter for a correction term, whose trace grows with the gain). With
-//    p_i^- = P^- / beta_i the update beta_i <- rho / tr(p_i^+) has the fixed point
-//    beta_i = (1/r_i) / sum_j (1/r_j); starting from tr = r_i it starts there.
+//    uses the same letter for a correction term, whose trace grows with the gain). With the
+//    resolutions below the result does not depend on beta at all (see the end of this note);
+//    it still sets the local covariances p_i = P / beta_i that lambda_i is built from.
 // 3. lambda_i, eq. 32-33. Printed: lambda_i = P^+^-1 M_i p_i^+, multiplying k_i y_i, while
 //    E (eq. 28) keeps k_i without lambda. Then X^+ = E X^+(k-1) + D sum lambda_i k_i y_i is not
 //    unbiased: for a constant heading psi its fixed point is not psi unless
@@ -24,10 +24,14 @@
 //    X^+ = X^- + D sum lambda_i k_i (y_i - h X^-).
 // 4. Eq. 21 is the covariance of the optimal gain only; we compute P^+ for the gain actually
 //    used with the Joseph form, so the covariance stays honest whatever the gain.
-// With 1-3, "closed-loop" equals "centralized" (the paper's own claim, last line of 2.3): all
-// k_i are the centralized gain and sum_i D lambda_i k_i y_i is the information-weighted mean.
-// The two differ only when the set of fused sensors changes and the betas carried over were
-// computed in different steps.
+// With 1-3, "closed-loop" IS the centralized filter (the paper's own claim, end of 2.3), for
+// any shares with sum beta_i = 1 over the fused set, whatever the r_i: in information form
+// p_i^+^-1 = beta_i P^-^-1 + h^T h / r_i and p_i^+^-1 k_i = h^T / r_i, so
+// sum_j p_j^+^-1 = P^-^-1 + sum_j h^T h / r_j = (P_c^+)^-1 and
+// sum_i D lambda_i k_i nu_i = P_c^+ sum_i h^T nu_i / r_i, the centralized update. Measured
+// difference on every simulated scenario: < 2e-13 deg. The local/global structure costs time
+// (see the benchmark) and buys nothing in a single process; it matters only where the local
+// filters run on separate computers, which a boat node does not do.
 #include "telltale/fusion/heading_fusion.hpp"
 
 #include <algorithm>
