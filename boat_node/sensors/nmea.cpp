@@ -187,7 +187,8 @@ NmeaParseResult parse_nmea_heading(std::string_view line, const NmeaParseOptions
     h.sentence = NmeaSentence::kHdg;
     const double dev = std::isfinite(h.deviation_deg) ? h.deviation_deg : 0.0;
     h.magnetic_deg = wrap_360_deg(sensor + dev);
-    h.true_deg = std::isfinite(h.variation_deg) ? wrap_360_deg(h.magnetic_deg + h.variation_deg) : kNaN;
+    h.true_deg =
+        std::isfinite(h.variation_deg) ? wrap_360_deg(h.magnetic_deg + h.variation_deg) : kNaN;
   }
   res.status = NmeaStatus::kOk;
   return res;
