@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "alarm_engine.hpp"
+#include "telltale/fusion/alarm_engine.hpp"
 #include "fleet.hpp"
 #include "live_hub.hpp"
 #include "store.hpp"

@@ -46,6 +46,8 @@ json boat_object(const BoatView& v) {
       {"alarm_state", v.alarm_state},
       {"stale", v.stale},
       {"samples_received", v.samples_received},
+      {"clock_offset_ms", finite_or_null(v.clock_offset_ms)},
+      {"clock_suspect", std::abs(v.clock_offset_ms) > kClockSuspectMs},
   };
   if (v.status) {
     j["status"] = {{"software_version", v.status->software_version},

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "alarm_engine.hpp"
+#include "telltale/fusion/alarm_engine.hpp"
 #include "fleet.hpp"
 #include "store.hpp"
 

@@ -72,6 +72,10 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
     alarms.on_sample(s, view.status ? view.status->group : std::string());
     hub.publish_sample(s.boat_id, boat_json(view));
   };
+  callbacks.on_backfill = [&](const AttitudeSample& s) {
+    // Old samples go to the recording only: the live view and the alarms are about now.
+    store.enqueue(s);
+  };
   callbacks.on_status = [&](const std::string& id, const NodeStatusInfo& st) {
     fleet.update_status(id, st);
   };
@@ -89,10 +93,14 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
               port, dds.domain(), o.store.path.c_str());
   std::fflush(stdout);
 
-  // Stale sweep: a boat silent for stale_ms is marked stale even if DDS never says so.
+  // Stale sweep: a boat silent for stale_ms is marked stale even if DDS never says so. Every
+  // second each boat gets its receipt (what is stored), from which it backfills what is missing.
+  int tick = 0;
   while (!shutdown.wait_for(std::chrono::milliseconds(200))) {
     for (const auto& v : fleet.sweep(std::chrono::steady_clock::now()))
       hub.publish_sample(v.last.boat_id, boat_json(v));
+    if (++tick % 5 == 0)
+      for (const auto& a : store.acks()) dds.publish_ack(a.boat_id, a.boot_id, a.acked_seq);
   }
   hub.close();
   api.stop();

@@ -3,6 +3,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <algorithm>
 
+#include "shutdown.hpp"
 #include "telltalePubSubTypes.h"
 
 namespace telltale::shore {
@@ -29,6 +30,7 @@ AttitudeSample from_wire(const msg::BoatAttitude& m) {
   s.leds[2] = m.leds().up_leds();
   s.leds[3] = m.leds().down_leds();
   s.led_count = m.leds().led_count();
+  s.boot_id = m.boot_id();
   return s;
 }
 
@@ -55,10 +57,11 @@ class ShoreDds::Listener : public fdds::DataReaderListener {
   void on_data_available(fdds::DataReader* reader) override {
     fdds::SampleInfo info;
     const std::string& topic = reader->get_topicdescription()->get_name();
-    if (topic == dds::kTopicBoatAttitude) {
+    if (topic == dds::kTopicBoatAttitude || topic == dds::kTopicBoatBackfill) {
+      const auto& sink = topic == dds::kTopicBoatAttitude ? cb_.on_attitude : cb_.on_backfill;
       msg::BoatAttitude m;
       while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
-        if (info.valid_data && cb_.on_attitude) cb_.on_attitude(from_wire(m));
+        if (info.valid_data && sink) sink(from_wire(m));
       }
     } else if (topic == dds::kTopicNodeStatus) {
       msg::NodeStatus m;
@@ -100,6 +103,9 @@ ShoreDds::ShoreDds(const dds::DdsOptions& options, FleetCallbacks callbacks)
       participant_->topic(dds::kTopicBoatAttitude,
                           fdds::TypeSupport(new msg::BoatAttitudePubSubType())),
       "attitude_reader", listener_.get());
+  participant_->reader(participant_->topic(dds::kTopicBoatBackfill,
+                                           fdds::TypeSupport(new msg::BoatAttitudePubSubType())),
+                       "backfill_reader", listener_.get());
   participant_->reader(
       participant_->topic(dds::kTopicNodeStatus, fdds::TypeSupport(new msg::NodeStatusPubSubType())),
       "status_reader", listener_.get());
@@ -110,6 +116,20 @@ ShoreDds::ShoreDds(const dds::DdsOptions& options, FleetCallbacks callbacks)
       participant_->topic(dds::kTopicAlarmEvents,
                           fdds::TypeSupport(new msg::AlarmEventPubSubType())),
       "alarm_writer");
+  ack_writer_ = participant_->writer(
+      participant_->topic(dds::kTopicShoreAck, fdds::TypeSupport(new msg::ShoreAckPubSubType())),
+      "ack_writer");
+}
+
+void ShoreDds::publish_ack(const std::string& boat_id, std::uint64_t boot_id,
+                           std::uint64_t acked_seq) {
+  msg::ShoreAck m;
+  m.boat_id(boat_id);
+  m.boot_id(boot_id);
+  m.acked_seq(acked_seq);
+  m.t_utc_ns(utc_now_ns());
+  std::lock_guard lock(write_mutex_);
+  ack_writer_->write(&m);
 }
 
 // The participant (and its readers) go first, so no callback runs on a dead listener.

@@ -22,6 +22,7 @@ CREATE TABLE IF NOT EXISTS attitude (
   yaw_rate_deg_s REAL,
   accel_weight REAL,
   quality REAL,
+  boot_id INTEGER NOT NULL DEFAULT 0,
   PRIMARY KEY (boat_id, t_utc_ns)
 ) WITHOUT ROWID;
 CREATE TABLE IF NOT EXISTS sessions (
@@ -191,7 +192,8 @@ Store::Store(StoreConfig config) : config_(std::move(config)) {
     if (sqlite3_prepare_v2(db_,
                            "INSERT OR IGNORE INTO attitude (boat_id, t_utc_ns, seq, heel_deg, "
                            "pitch_deg, heading_deg, heel_rate_deg_s, pitch_rate_deg_s, "
-                           "yaw_rate_deg_s, accel_weight, quality) VALUES (?,?,?,?,?,?,?,?,?,?,?)",
+                           "yaw_rate_deg_s, accel_weight, quality, boot_id) "
+                           "VALUES (?,?,?,?,?,?,?,?,?,?,?,?)",
                            -1, &insert_, nullptr) != SQLITE_OK)
       throw StoreError(sqlite3_errmsg(db_));
   } catch (const StoreError& e) {
@@ -280,6 +282,8 @@ bool Store::commit(std::vector<AttitudeSample>& batch) {
       sqlite3_bind_double(insert_, 9, s.yaw_rate_deg_s);
       sqlite3_bind_double(insert_, 10, static_cast<double>(s.accel_weight));
       sqlite3_bind_double(insert_, 11, static_cast<double>(s.quality));
+      // Boot ids are random 64-bit numbers: stored as their two's-complement int64.
+      sqlite3_bind_int64(insert_, 12, static_cast<sqlite3_int64>(s.boot_id));
       if (sqlite3_step(insert_) != SQLITE_DONE) throw StoreError(sqlite3_errmsg(db_));
       if (sqlite3_changes(db_) == 1) {  // a duplicate (re-sent sample) changes nothing
         ++inserted;
@@ -295,6 +299,8 @@ bool Store::commit(std::vector<AttitudeSample>& batch) {
     }
     dirty_sessions_.clear();
     exec(db_, "COMMIT");
+    // On disk now: these samples may be acknowledged to their boats.
+    for (const auto& s : batch) track_receipt(s);
     std::lock_guard lock(mutex_);
     committed_ += inserted;
     last_error_.clear();
@@ -350,6 +356,41 @@ void Store::extend_session(const std::string& boat_id, std::uint64_t t_ns) {
   ins.step();
   open_sessions_[boat_id] = {sqlite3_last_insert_rowid(db_), boat_id, t_ns, t_ns, 1};
   dirty_sessions_.insert(boat_id);
+}
+
+void Store::track_receipt(const AttitudeSample& s) {
+  if (s.seq == 0) return;
+  std::lock_guard lock(receipts_mutex_);
+  Receipt& r = receipts_[s.boat_id];
+  if (r.boot_id != s.boot_id || !r.known) {
+    // A run not seen since this shore started: what is already stored counts (restart).
+    r = Receipt{};
+    r.known = true;
+    r.boot_id = s.boot_id;
+    Stmt q(db_, "SELECT seq FROM attitude WHERE boat_id = ? AND boot_id = ? ORDER BY seq");
+    q.bind(1, s.boat_id).bind(2, static_cast<std::int64_t>(s.boot_id));
+    while (q.step()) {
+      const std::uint64_t seq = q.u64(0);
+      if (seq == r.acked + 1) {
+        r.acked = seq;
+      } else if (seq > r.acked + 1) {
+        r.ahead.insert(seq);
+      }
+    }
+  }
+  if (s.seq <= r.acked) return;
+  r.ahead.insert(s.seq);
+  while (!r.ahead.empty() && *r.ahead.begin() <= r.acked + 1) {
+    r.acked = std::max(r.acked, *r.ahead.begin());
+    r.ahead.erase(r.ahead.begin());
+  }
+}
+
+std::vector<Store::Ack> Store::acks() const {
+  std::lock_guard lock(receipts_mutex_);
+  std::vector<Ack> out;
+  for (const auto& [boat, r] : receipts_) out.push_back({boat, r.boot_id, r.acked});
+  return out;
 }
 
 void Store::apply_retention() {

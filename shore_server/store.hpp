@@ -30,7 +30,7 @@
 #include <thread>
 #include <vector>
 
-#include "alarm_engine.hpp"
+#include "telltale/fusion/alarm_engine.hpp"
 #include "fleet.hpp"
 
 namespace telltale::shore {
@@ -115,6 +115,14 @@ class Store {
   [[nodiscard]] std::optional<AlarmEvent> event(std::uint64_t id);
   [[nodiscard]] std::uint64_t max_event_id();
 
+  /// Per boat: its latest run and the highest seq of that run with every sample up to it stored.
+  struct Ack {
+    std::string boat_id;
+    std::uint64_t boot_id;
+    std::uint64_t acked_seq;
+  };
+  [[nodiscard]] std::vector<Ack> acks() const;
+
   [[nodiscard]] std::uint64_t committed() const;
   /// Last error of the writer thread, empty if none.
   [[nodiscard]] std::string last_error() const;
@@ -125,6 +133,16 @@ class Store {
   bool commit(std::vector<AttitudeSample>& batch);
   void extend_session(const std::string& boat_id, std::uint64_t t_ns);
   void apply_retention();
+  void track_receipt(const AttitudeSample& sample);
+
+  struct Receipt {
+    bool known = false;
+    std::uint64_t boot_id = 0;
+    std::uint64_t acked = 0;
+    std::set<std::uint64_t> ahead;  ///< stored seqs beyond a gap
+  };
+  mutable std::mutex receipts_mutex_;
+  std::map<std::string, Receipt> receipts_;
 
   StoreConfig config_;
   sqlite3* db_ = nullptr;       ///< writer connection (samples, sessions, alarms)

@@ -1,10 +1,10 @@
-#include "alarm_engine.hpp"
+#include "telltale/fusion/alarm_engine.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-namespace telltale::shore {
+namespace telltale::fusion {
 namespace {
 
 constexpr std::uint64_t kSecond = 1000000000ULL;
@@ -131,4 +131,4 @@ TEST(AlarmRule, Validation) {
 }
 
 }  // namespace
-}  // namespace telltale::shore
+}  // namespace telltale::fusion

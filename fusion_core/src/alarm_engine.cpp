@@ -1,9 +1,12 @@
-#include "alarm_engine.hpp"
+#include "telltale/fusion/alarm_engine.hpp"
+
+#include <algorithm>
+#include <cstdio>
 
 #include <cmath>
 #include <regex>
 
-namespace telltale::shore {
+namespace telltale::fusion {
 
 const char* to_string(AlarmLevel level) {
   switch (level) {
@@ -220,4 +223,4 @@ void AlarmEngine::restore(std::vector<AlarmRule> rules, std::vector<AlarmEvent> 
   for (const auto& [id, e] : active_) next_id_ = std::max(next_id_, id + 1);
 }
 
-}  // namespace telltale::shore
+}  // namespace telltale::fusion

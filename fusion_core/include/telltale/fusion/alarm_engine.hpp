@@ -2,8 +2,9 @@
 /// \file
 /// The alarm engine: rules per boat, per group and fleet-wide; states normal/warn/alarm; hold
 /// time and hysteresis; events with a lifecycle (raised -> acknowledged/silenced -> cleared).
-/// Pure logic, thread-safe; persistence and distribution are the caller's (the shore wiring
-/// stores every changed event and pushes it to the boats and dashboards).
+/// Pure logic, thread-safe; persistence and distribution are the caller's. The shore runs it for
+/// the fleet (and stores and pushes every changed event); a boat runs the same rules for its own
+/// LED panel and buzzer when no shore is there.
 ///
 /// A rule watches heel or pitch of every boat in its scope. The angle is in band when
 /// min_deg <= value <= max_deg. Outside the band continuously for hold_s (boat clock) raises an
@@ -17,7 +18,7 @@
 #include <string>
 #include <vector>
 
-namespace telltale::shore {
+namespace telltale::fusion {
 
 enum class AlarmLevel { kNormal = 0, kWarn = 1, kAlarm = 2 };
 enum class AlarmQuantity { kHeel, kPitch };
@@ -101,4 +102,4 @@ class AlarmEngine {
   std::uint64_t next_id_ = 1;
 };
 
-}  // namespace telltale::shore
+}  // namespace telltale::fusion
