@@ -9,6 +9,9 @@ int main(int argc, char** argv) {
   CLI::App app{"Telltale fusion core, offline: attitude, heading, steps, PDR, simulation, evaluation"};
   app.require_subcommand(1);
   telltale::cli::register_attitude(app);
+  telltale::cli::register_steps(app);
+  telltale::cli::register_gait_sim(app);
+  telltale::cli::register_steps_eval(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
