@@ -138,7 +138,8 @@ bool AdaptiveStepDetector::update(const ImuSample& s, StepEvent& event) {
   if (params_.require_stance) {
     const double quiet_a = std::max(params_.stance_fraction * th[0], params_.acc_floor_m_s2);
     const double quiet_w = std::max(params_.stance_fraction * th[2], params_.gyro_floor_rad_s);
-    const bool quiet = std::abs(mag - kG) < quiet_a && (!gyro_ok || std::abs(w) < quiet_w);
+    const bool quiet =
+        std::abs(mag - kG) < quiet_a && (!gyro_ok || s.gyro_body_rad_s.norm() < quiet_w);
     if (!quiet) {
       quiet_since_s_ = -1.0;
     } else if (quiet_since_s_ < 0.0) {

@@ -112,7 +112,7 @@ struct AdaptiveStepParams {
   double mean_tau_s = 4.0;              ///< time constant of the |f| mean the signal is taken about
   bool use_gyro = true;                 ///< false: acceleration conditions only
   bool require_stance = true;           ///< foot: a cycle closes with the foot at rest
-  double stance_s = 0.04;               ///< rest needed to close a foot cycle, s
+  double stance_s = 0.03;               ///< rest needed to close a foot cycle, s
   double stance_fraction = 0.25;        ///< rest = |f|-g and |w| below this x upper thresholds
 };
 class AdaptiveStepDetector final : public StepDetector {
