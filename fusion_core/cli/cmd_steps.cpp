@@ -56,6 +56,7 @@ void register_steps(CLI::App& app) {
   cmd->add_option("--mount", opts->mount, "foot (counts that foot's steps) | body | phone")
       ->capture_default_str();
   cmd->callback([opts] { run_steps(*opts); });
+  register_pdr(app);
 
 }
 

@@ -3,6 +3,7 @@
 /// IMU CSV reading and gait-simulator CSV writing shared by the steps, pdr, gait-sim and
 /// steps-eval subcommands (SPEC section 6 column names).
 
+#include <CLI/CLI.hpp>
 #include <limits>
 #include <string>
 #include <vector>
@@ -11,6 +12,8 @@
 #include "telltale/fusion/sim/gait_sim.hpp"
 
 namespace telltale::cli {
+
+void register_pdr(CLI::App& app);  // registered by register_steps (cmd_pdr.cpp)
 
 /// One row of an IMU CSV: gyro NaN when the file has no gyro columns, mag NaN without mag.
 struct ImuRecord {

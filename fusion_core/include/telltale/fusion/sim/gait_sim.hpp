@@ -37,14 +37,14 @@
 #include <vector>
 
 #include "telltale/fusion/imu_sample.hpp"
+#include "telltale/fusion/phone_pose.hpp"
 
 namespace telltale::fusion::sim {
 
 enum class Gait { kSlowWalk, kWalk, kFastWalk, kJog, kRun };
 inline constexpr int kGaitCount = 5;
-/// The four phone poses of seed 003, in the order of the classifier outputs.
-enum class PhonePose { kHandHeld = 0, kCall = 1, kPocket = 2, kArmSwing = 3 };
-inline constexpr int kPoseCount = 4;
+using fusion::kPoseCount;
+using fusion::PhonePose;
 enum class SensorSite { kFoot, kPhone };
 
 [[nodiscard]] std::string_view gait_name(Gait g);  ///< "slow-walk", "walk", "fast-walk", "jog", "run"
