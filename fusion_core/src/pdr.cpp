@@ -422,7 +422,8 @@ void Pdr::on_step(double t_s) {
         const double r = den > 1e-9 ? a.dot(b) / den : 0.0;
         const double tilt_deg =
             std::acos(std::clamp(tilt.dot(tilts_[slot]), -1.0, 1.0)) * 180.0 / M_PI;
-        const bool changed = r < params_.switch_correlation && tilt_deg > params_.switch_tilt_deg;
+        const bool changed = (r < params_.switch_correlation && tilt_deg > params_.switch_tilt_deg) ||
+                             tilt_deg > 2.0 * params_.switch_tilt_deg;
         if (!switching_ && changed) {
           switching_ = true;
           settling_ = false;

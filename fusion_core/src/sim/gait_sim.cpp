@@ -323,8 +323,8 @@ class Simulator {
   // --- phone ----------------------------------------------------------------------------------
   /// Orientation of the phone relative to the walking frame, and its extra acceleration
   /// (walking frame) in a pose, given the body state.
-  void phone_in_pose(PhonePose pose, double t, const Body& b, Eigen::Matrix3d& r_rel,
-                     Eigen::Vector3d& acc_w) const {
+  void phone_in_pose(PhonePose pose, double t, const Body& b, Eigen::Matrix3d& osc_out,
+                     Eigen::Matrix3d& mount, Eigen::Vector3d& acc_w) const {
     const auto ip = static_cast<std::size_t>(pose);
     const Eigen::Matrix3d mis =
         rot_z(p_.mount_yaw_deg[ip] * kDeg) * rot_y(p_.mount_tilt_deg[ip] * kDeg);
@@ -365,7 +365,8 @@ class Simulator {
       }
     }
     acc_w += gain.cwiseProduct(b.acc_w);
-    r_rel = osc * pose_matrix(pose) * mis;
+    osc_out = osc;
+    mount = pose_matrix(pose) * mis;
   }
 
   /// Phone orientation in the world at t and its acceleration (world), with pose switches.
@@ -377,9 +378,10 @@ class Simulator {
     const Eigen::Matrix3d r_wf = walk_frame(b.s, &heading, &curv);
     double seg_start = 0;
     const GaitSegment& seg = segment_at(t, &seg_start);
-    Eigen::Matrix3d r_rel;
+    Eigen::Matrix3d osc, mount;
     Eigen::Vector3d acc_w;
-    phone_in_pose(seg.pose, t, b, r_rel, acc_w);
+    phone_in_pose(seg.pose, t, b, osc, mount, acc_w);
+    Eigen::Matrix3d r_rel = osc * mount;
     pose = seg.pose;
     switching = false;
     // Previous segment's pose while the switch is in progress.
@@ -388,12 +390,16 @@ class Simulator {
       if (prev.pose != seg.pose) {
         const double u = (t - seg_start) / sc_.switch_s;
         const double w = minjerk(u);
-        Eigen::Matrix3d r_old;
+        Eigen::Matrix3d osc_old, mount_old;
         Eigen::Vector3d acc_old;
-        phone_in_pose(prev.pose, t, b, r_old, acc_old);
-        const Eigen::Quaterniond q =
-            Eigen::Quaterniond(r_old).slerp(w, Eigen::Quaterniond(r_rel));
-        r_rel = q.toRotationMatrix();
+        phone_in_pose(prev.pose, t, b, osc_old, mount_old, acc_old);
+        // The hand turns the phone from one fixed mounting to the other along one path (slerp of
+        // the constant mountings, so the path cannot flip even for a half turn) while the
+        // small motions of the two poses blend.
+        const Eigen::Quaterniond q_mount =
+            Eigen::Quaterniond(mount_old).slerp(w, Eigen::Quaterniond(mount));
+        const Eigen::Quaterniond q_osc = Eigen::Quaterniond(osc_old).slerp(w, Eigen::Quaterniond(osc));
+        r_rel = (q_osc * q_mount).toRotationMatrix();
         const Eigen::Vector3d d = pose_position(seg.pose) - pose_position(prev.pose);
         acc_w = (1.0 - w) * acc_old + w * acc_w +
                 d * minjerk_acc(u) / (sc_.switch_s * sc_.switch_s);
@@ -651,12 +657,10 @@ std::optional<GaitScenario> make_gait_scenario(std::string_view name, std::uint6
   } else {
     return std::nullopt;
   }
-  if (site == "phone") {
+  if (site == "phone" && rest != "switch") {
     const auto p = pose_from_name(take());
-    if (!p && rest.empty()) {
-      // "phone-switch": the four poses in turn while walking.
-    }
-    if (p) pose = *p;
+    if (!p) return std::nullopt;
+    pose = *p;
   }
   const std::string_view what = take();
   if (!rest.empty()) return std::nullopt;

@@ -202,6 +202,7 @@ struct PdrParams {
   double feature_window_s = 2.0;       ///< pose feature window, s
   double switch_correlation = 0.5;     ///< step waveforms correlating less = pose switch...
   double switch_tilt_deg = 15.0;       ///< ...if gravity also moved this much in the sensor frame
+                                       ///< (twice this much is a switch whatever the correlation)
   int switch_exit_steps = 2;           ///< correlated steps needed to leave a switch
   int pose_window_steps = 10;          ///< steps after a switch to confirm the new pose
   int pose_fallback_steps = 10;        ///< identical answers that change the pose without a switch
