@@ -13,6 +13,7 @@
 #include "commands.hpp"
 #include "gait_io.hpp"
 #include "telltale/fusion/sim/gait_sim.hpp"
+#include "telltale/fusion/sim/pose_dataset.hpp"
 #include "telltale/fusion/steps.hpp"
 
 namespace telltale::cli {
@@ -23,7 +24,8 @@ namespace sim = fusion::sim;
 struct EvalOptions {
   int people = 10;
   std::string oxford_dir;
-  std::string tables = "gait,oxford";
+  std::string tables = "gait,oxford,pose,pdr";
+  int loops = 40;
 };
 
 double count_accuracy(std::size_t counted, std::size_t truth) {
@@ -136,7 +138,60 @@ void oxford_table(const EvalOptions& o) {
   std::printf("\n");
 }
 
+void pose_table() {
+  const auto set = sim::simulate_pose_windows(1001, 10, 20);
+  const auto& net = fusion::builtin_pose_network();
+  int confusion[fusion::kPoseCount][fusion::kPoseCount] = {};
+  std::size_t ok = 0;
+  for (std::size_t i = 0; i < set.features.size(); ++i) {
+    const auto got = net.classify(set.features[i]);
+    const int want = static_cast<int>(set.labels[i]);
+    const int g = got ? static_cast<int>(*got) : 0;
+    ++confusion[want][g];
+    ok += (got && *got == set.labels[i]) ? 1u : 0u;
+  }
+  std::printf("\n## Pose classification (BP 3-8-4, shipped weights), 10 held-out simulated people, "
+              "%zu windows: accuracy %.2f %%\n\n| true \\ classified | hand-held | call | pocket "
+              "| arm-swing |\n|---|---|---|---|---|\n",
+              set.features.size(), 100.0 * static_cast<double>(ok) / static_cast<double>(set.features.size()));
+  for (int t = 0; t < fusion::kPoseCount; ++t) {
+    const auto name = sim::pose_name(static_cast<fusion::PhonePose>(t));
+    std::printf("| %.*s |", static_cast<int>(name.size()), name.data());
+    for (int c = 0; c < fusion::kPoseCount; ++c) std::printf(" %d |", confusion[t][c]);
+    std::printf("\n");
+  }
+}
+
+void pdr_table(int loops) {
+  std::printf("\n## PDR closed loops (%d walks, people held out of training): end-point error / "
+              "distance\n\n| variant | median %% | 90th pct %% | walks <= 2 %% | steps counted / true |"
+              "\n|---|---|---|---|---|\n", loops);
+  const std::pair<sim::LoopVariant, const char*> variants[] = {
+      {sim::LoopVariant::kAsSimulated, "pose switches, full sensor errors"},
+      {sim::LoopVariant::kSinglePose, "one pose, full sensor errors"},
+      {sim::LoopVariant::kIdealSensors, "pose switches, no biases/misalignment"}};
+  for (const auto& [variant, name] : variants) {
+    std::vector<double> err;
+    std::size_t counted = 0, truth = 0;
+    for (int i = 0; i < loops; ++i) {
+      progress("loops", i + 1, loops);
+      const auto r = sim::simulate_pdr_loop(static_cast<std::uint64_t>(2001 + i), variant);
+      err.push_back(100.0 * r.error_fraction);
+      counted += r.steps_counted;
+      truth += r.steps_true;
+    }
+    std::sort(err.begin(), err.end());
+    const auto within = std::count_if(err.begin(), err.end(), [](double e) { return e <= 2.0; });
+    std::printf("| %s | %.2f | %.2f | %ld / %d (%.0f %%) | %zu / %zu |\n", name,
+                err[err.size() / 2], err[(err.size() * 9) / 10 - 1], static_cast<long>(within), loops,
+                100.0 * static_cast<double>(within) / loops, counted, truth);
+    std::fflush(stdout);
+  }
+}
+
 void run_eval(const EvalOptions& o) {
+  if (o.tables.find("pose") != std::string::npos) pose_table();
+  if (o.tables.find("pdr") != std::string::npos) pdr_table(o.loops);
   if (o.tables.find("gait") != std::string::npos) gait_table(o);
   if (o.tables.find("oxford") != std::string::npos) oxford_table(o);
 }
@@ -151,6 +206,7 @@ void register_steps_eval(CLI::App& app) {
   cmd->add_option("--oxford", opts->oxford_dir,
                   "Oxford step traces (default: ../shared/data/oxford_steps, then "
                   "tests/data/oxford_steps)");
+  cmd->add_option("--loops", opts->loops, "simulated closed-loop PDR walks")->capture_default_str();
   cmd->add_option("--tables", opts->tables, "comma list: gait, oxford, pose, pdr")
       ->capture_default_str();
   cmd->callback([opts] { run_eval(*opts); });

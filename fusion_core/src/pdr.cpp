@@ -428,20 +428,23 @@ void Pdr::on_step(double t_s) {
           switching_ = true;
           settling_ = false;
           correlated_steps_ = 0;
+          switch_steps_ = 0;
           ++diag_.switches;
           // If the 3 steps before the switch were straight, their mean heading stands in for
           // the heading during the switch.
+          // The comparison spans two steps, so the switch may have begun during the latest
+          // step: the 3 steps before that one are the ones known to be clean.
           have_replacement_ = false;
-          if (recent_count_ >= 3) {
+          if (recent_count_ >= 4) {
             double s = 0, c = 0;
-            for (double h : recent_heading_rad_) {
-              s += std::sin(h);
-              c += std::cos(h);
+            for (std::size_t i = 0; i < 3; ++i) {
+              s += std::sin(recent_heading_rad_[i]);
+              c += std::cos(recent_heading_rad_[i]);
             }
             const double mean = std::atan2(s, c);
             bool straight = true;
-            for (double h : recent_heading_rad_)
-              straight = straight && std::abs(std::remainder(h - mean, kTwoPi)) <
+            for (std::size_t i = 0; i < 3; ++i)
+              straight = straight && std::abs(std::remainder(recent_heading_rad_[i] - mean, kTwoPi)) <
                                          params_.straight_deg * M_PI / 180.0;
             if (straight) {
               replacement_heading_rad_ = wrap_2pi(mean);
@@ -522,14 +525,15 @@ void Pdr::on_step(double t_s) {
   double heading = heading_.heading_rad();
   if (sum_sin_ != 0.0 || sum_cos_ != 0.0) heading = wrap_2pi(std::atan2(sum_sin_, sum_cos_));
   sum_sin_ = sum_cos_ = 0.0;
-  if (switching_ && have_replacement_) {
+  const bool replaced = switching_ && have_replacement_;
+  if (replaced) {
     heading = replacement_heading_rad_;
     ++diag_.replaced_headings;
   } else if (!switching_) {
-    recent_heading_rad_[0] = recent_heading_rad_[1];
-    recent_heading_rad_[1] = recent_heading_rad_[2];
-    recent_heading_rad_[2] = heading;
-    recent_count_ = std::min(recent_count_ + 1, 3);
+    for (std::size_t i = 0; i + 1 < recent_heading_rad_.size(); ++i)
+      recent_heading_rad_[i] = recent_heading_rad_[i + 1];
+    recent_heading_rad_.back() = heading;
+    recent_count_ = std::min(recent_count_ + 1, static_cast<int>(recent_heading_rad_.size()));
   }
   // Eq. (13) and eq. (11). The first step has no frequency yet: the person's usual walk.
   const double hz = out_.step_hz > 0.0 ? out_.step_hz : 1.8;
@@ -545,6 +549,24 @@ void Pdr::on_step(double t_s) {
   out_.x_m += (len + pending_m_) * std::sin(heading);
   out_.y_m += (len + pending_m_) * std::cos(heading);
   pending_m_ = 0.0;
+  if (replaced && switch_steps_ < static_cast<int>(switch_len_m_.size()))
+    switch_len_m_[static_cast<std::size_t>(switch_steps_++)] = len;
+  if (!switching_ && switch_steps_ > 0) {
+    // First step after a switch (our addition to seed 003): if the walker turned while the
+    // pre-switch heading stood in, the heading after the switch tells by how much; the switch
+    // steps are re-laid with headings interpolated from the old to the new one.
+    const double turn = std::remainder(heading - replacement_heading_rad_, kTwoPi);
+    if (std::abs(turn) > params_.straight_deg * M_PI / 180.0) {
+      const double n = static_cast<double>(switch_steps_);
+      for (int k = 0; k < switch_steps_; ++k) {
+        const double l = switch_len_m_[static_cast<std::size_t>(k)];
+        const double h = replacement_heading_rad_ + turn * (k + 0.5) / n;
+        out_.x_m += l * (std::sin(h) - std::sin(replacement_heading_rad_));
+        out_.y_m += l * (std::cos(h) - std::cos(replacement_heading_rad_));
+      }
+    }
+    switch_steps_ = 0;
+  }
   out_.heading_deg = heading * 180.0 / M_PI;
 }
 

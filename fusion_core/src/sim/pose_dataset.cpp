@@ -1,5 +1,7 @@
 #include "telltale/fusion/sim/pose_dataset.hpp"
 
+#include <cmath>
+
 namespace telltale::fusion::sim {
 
 PoseWindowSet simulate_pose_windows(std::uint64_t first, int people, int windows_per_pose) {
@@ -60,6 +62,37 @@ std::vector<CalibrationWalk> simulate_calibration_walks(std::uint64_t first, int
     }
   }
   return out;
+}
+
+}  // namespace telltale::fusion::sim
+
+namespace telltale::fusion::sim {
+
+LoopWalkResult simulate_pdr_loop(std::uint64_t seed, LoopVariant variant) {
+  auto sc = *make_gait_scenario("loop", seed);
+  Person person = random_person(seed);
+  if (variant == LoopVariant::kSinglePose)
+    for (auto& seg : sc.segments) seg.pose = sc.segments.front().pose;
+  if (variant == LoopVariant::kIdealSensors) {
+    sc.errors.acc_bias_m_s2 = sc.errors.gyro_bias_rad_s = sc.errors.mag_bias_uT = 0.0;
+    for (int p = 0; p < kPoseCount; ++p) person.mount_yaw_deg[p] = person.mount_tilt_deg[p] = 0.0;
+  }
+  const auto run = simulate_gait(sc, person, seed);
+  PdrParams params;
+  params.height_m = person.height_m;
+  Pdr pdr(params);
+  for (const auto& s : run.samples) (void)pdr.update(s.imu, s.mag_uT);
+  LoopWalkResult r;
+  const auto& last = run.samples.back();
+  r.distance_m = run.distance_m;
+  r.end_error_m = std::hypot(pdr.output().x_m - last.x_m, pdr.output().y_m - last.y_m);
+  r.error_fraction = r.end_error_m / r.distance_m;
+  r.steps_true = run.step_times_s.size();
+  r.steps_counted = pdr.output().steps;
+  for (std::size_t i = 1; i < run.samples.size(); ++i)
+    if (run.samples[i].pose != run.samples[i - 1].pose) ++r.switches_true;
+  r.switches_detected = pdr.diagnostics().switches;
+  return r;
 }
 
 }  // namespace telltale::fusion::sim

@@ -279,12 +279,14 @@ class Pdr {
   int settling_steps_ = 0;
   bool pose_known_ = false;
   double pending_m_ = 0.0;  ///< distance walked before the first heading
+  std::array<double, 32> switch_len_m_{};  ///< steps laid with the replacement heading
+  int switch_steps_ = 0;
   int wave_count_ = 0;
   double last_step_t_s_ = -1.0;
   double interval_ema_s_ = 0.0;
   // Heading over the current step (circular mean) and of the last three steps.
   double sum_sin_ = 0.0, sum_cos_ = 0.0;
-  std::array<double, 3> recent_heading_rad_{};
+  std::array<double, 4> recent_heading_rad_{};  ///< oldest first
   int recent_count_ = 0;
   bool switching_ = false;
   int correlated_steps_ = 0;

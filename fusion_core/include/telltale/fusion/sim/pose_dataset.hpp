@@ -31,3 +31,26 @@ struct PoseWindowSet {
                                                                       const PoseNetwork& net);
 
 }  // namespace telltale::fusion::sim
+
+namespace telltale::fusion::sim {
+
+/// One closed-loop PDR walk ("loop" scenario of the gait simulator) run through a Pdr.
+struct LoopWalkResult {
+  double distance_m = 0.0;       ///< true distance walked
+  double end_error_m = 0.0;      ///< |estimated end - true end|
+  double error_fraction = 0.0;   ///< end_error_m / distance_m
+  std::size_t steps_true = 0;
+  std::size_t steps_counted = 0;
+  unsigned switches_true = 0;    ///< pose changes in the schedule
+  unsigned switches_detected = 0;
+};
+enum class LoopVariant {
+  kAsSimulated,   ///< pose switches, full sensor error model
+  kSinglePose,    ///< the same walk in its first pose only (no switch)
+  kIdealSensors,  ///< pose switches, no biases, no hard iron, no misalignment (noise only)
+};
+/// Person and loop drawn from `seed` (people seeds 2001+ are not in the training range 1..23).
+[[nodiscard]] LoopWalkResult simulate_pdr_loop(std::uint64_t seed,
+                                               LoopVariant variant = LoopVariant::kAsSimulated);
+
+}  // namespace telltale::fusion::sim
