@@ -329,19 +329,20 @@ class Simulator {
     const Eigen::Matrix3d mis =
         rot_z(p_.mount_yaw_deg[ip] * kDeg) * rot_y(p_.mount_tilt_deg[ip] * kDeg);
     const Eigen::Vector3d& tr = b.trunk;
+    const double still = b.moving ? 1.0 : 0.2;  // a person standing holds the phone steadier
     Eigen::Matrix3d osc = Eigen::Matrix3d::Identity();
     Eigen::Vector3d gain(1, 1, 1);
     acc_w = Eigen::Vector3d::Zero();
     switch (pose) {
       case PhonePose::kHandHeld: {
         // Arm-damped trunk motion, tremor, phone tilted 25 deg up toward the face.
-        const Eigen::Vector3d w = wobble_.at(t, 1.5 * kDeg) + 0.5 * tr;
+        const Eigen::Vector3d w = wobble_.at(t, still * 1.5 * kDeg) + 0.5 * tr;
         osc = rot_z(w.z()) * rot_y(w.y() - 25.0 * kDeg) * rot_x(w.x());
         gain = {0.8, 0.6, 0.75};
         break;
       }
       case PhonePose::kCall: {
-        const Eigen::Vector3d w = wobble_.at(t, 0.6 * kDeg) + 0.25 * tr;
+        const Eigen::Vector3d w = wobble_.at(t, still * 0.6 * kDeg) + 0.25 * tr;
         osc = rot_z(w.z()) * rot_y(w.y()) * rot_x(w.x());
         gain = {0.9, 0.45, 0.85};
         break;
