@@ -23,9 +23,9 @@ std::int16_t i16(const std::uint8_t* p) {
   return static_cast<std::int16_t>(static_cast<std::uint16_t>(p[0] | (p[1] << 8)));
 }
 std::int32_t i32(const std::uint8_t* p) {
-  const std::uint32_t u = static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) |
-                          (static_cast<std::uint32_t>(p[2]) << 16) |
-                          (static_cast<std::uint32_t>(p[3]) << 24);
+  const std::uint32_t u =
+      static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) |
+      (static_cast<std::uint32_t>(p[2]) << 16) | (static_cast<std::uint32_t>(p[3]) << 24);
   return static_cast<std::int32_t>(u);
 }
 std::uint8_t checksum(const std::uint8_t* p) {
@@ -120,8 +120,7 @@ void WitMotionDecoder::packet(const std::uint8_t* p, double t_s) {
 
 void WitMotionDecoder::emit() {
   if (!pending_acc_) return;
-  if (!pending_.has_gyro)
-    pending_.imu.gyro_body_rad_s = Eigen::Vector3d::Constant(std::nan(""));
+  if (!pending_.has_gyro) pending_.imu.gyro_body_rad_s = Eigen::Vector3d::Constant(std::nan(""));
   ++stats_.samples;
   if (callback_) callback_(pending_);
   pending_ = WitSample();
@@ -157,7 +156,8 @@ std::vector<std::uint8_t> encode_wit_sample(const WitSample& s, const WitMotionP
   if (s.has_gyro) {
     const double kw = 32768.0 / (params.gyro_range_deg_s * kDegToRad);
     const auto& w = s.imu.gyro_body_rad_s;
-    add(encode_wit_packet(0x52, {to_i16(w.x() * kw), to_i16(w.y() * kw), to_i16(w.z() * kw), temp}));
+    add(encode_wit_packet(0x52,
+                          {to_i16(w.x() * kw), to_i16(w.y() * kw), to_i16(w.z() * kw), temp}));
   }
   if (s.has_angle) {
     const double k = 32768.0 / params.angle_range_deg;
@@ -172,10 +172,9 @@ std::vector<std::uint8_t> encode_wit_sample(const WitSample& s, const WitMotionP
   if (s.has_pressure) {
     const auto p = static_cast<std::uint32_t>(to_i32(s.pressure_pa));
     const auto h = static_cast<std::uint32_t>(to_i32(s.height_m * 100.0));
-    add(encode_wit_packet(0x56, {static_cast<std::int16_t>(p & 0xFFFFu),
-                                 static_cast<std::int16_t>(p >> 16),
-                                 static_cast<std::int16_t>(h & 0xFFFFu),
-                                 static_cast<std::int16_t>(h >> 16)}));
+    add(encode_wit_packet(
+        0x56, {static_cast<std::int16_t>(p & 0xFFFFu), static_cast<std::int16_t>(p >> 16),
+               static_cast<std::int16_t>(h & 0xFFFFu), static_cast<std::int16_t>(h >> 16)}));
   }
   return out;
 }
@@ -183,16 +182,26 @@ std::vector<std::uint8_t> encode_wit_sample(const WitSample& s, const WitMotionP
 namespace {
 speed_t baud_constant(int baud) {
   switch (baud) {
-    case 4800: return B4800;
-    case 9600: return B9600;
-    case 19200: return B19200;
-    case 38400: return B38400;
-    case 57600: return B57600;
-    case 115200: return B115200;
-    case 230400: return B230400;
-    case 460800: return B460800;
-    case 921600: return B921600;
-    default: throw std::invalid_argument("unsupported baud rate " + std::to_string(baud));
+    case 4800:
+      return B4800;
+    case 9600:
+      return B9600;
+    case 19200:
+      return B19200;
+    case 38400:
+      return B38400;
+    case 57600:
+      return B57600;
+    case 115200:
+      return B115200;
+    case 230400:
+      return B230400;
+    case 460800:
+      return B460800;
+    case 921600:
+      return B921600;
+    default:
+      throw std::invalid_argument("unsupported baud rate " + std::to_string(baud));
   }
 }
 }  // namespace
@@ -236,9 +245,8 @@ bool WitMotionSerial::poll_once(int timeout_ms) {
   const ssize_t n = ::read(fd_, buf.data(), buf.size());
   if (n < 0) return errno == EAGAIN || errno == EINTR;
   if (n == 0) return false;
-  const double t_s = std::chrono::duration<double>(
-                         std::chrono::steady_clock::now().time_since_epoch())
-                         .count();
+  const double t_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
   decoder_.feed(std::span<const std::uint8_t>(buf.data(), static_cast<std::size_t>(n)), t_s);
   return true;
 }

@@ -58,11 +58,11 @@ struct WitMotionParams {
 };
 
 struct WitMotionStats {
-  std::uint64_t frames = 0;          ///< packets with a good checksum
-  std::uint64_t bad_checksum = 0;    ///< 0x55-framed packets whose checksum failed
-  std::uint64_t skipped_bytes = 0;   ///< bytes discarded while looking for 0x55
-  std::uint64_t unknown_type = 0;    ///< good packets of a type we do not use
-  std::uint64_t samples = 0;         ///< samples handed to the callback
+  std::uint64_t frames = 0;         ///< packets with a good checksum
+  std::uint64_t bad_checksum = 0;   ///< 0x55-framed packets whose checksum failed
+  std::uint64_t skipped_bytes = 0;  ///< bytes discarded while looking for 0x55
+  std::uint64_t unknown_type = 0;   ///< good packets of a type we do not use
+  std::uint64_t samples = 0;        ///< samples handed to the callback
 };
 
 /// Byte-stream decoder. A sample is emitted once its cycle is complete: the decoder learns which
@@ -88,8 +88,8 @@ class WitMotionDecoder {
   std::size_t have_ = 0;
   WitSample pending_;
   bool pending_acc_ = false;
-  int last_type_ = -1;     ///< type of the previous good packet
-  int cycle_end_ = -1;     ///< learned type that ends a cycle
+  int last_type_ = -1;  ///< type of the previous good packet
+  int cycle_end_ = -1;  ///< learned type that ends a cycle
 };
 
 /// Encoder (tests, simulators): one packet, and a whole sample as the module would send it

@@ -39,7 +39,8 @@ void register_gait_sim(CLI::App& app) {
       "gait-sim",
       "Simulated walker with a foot-mounted IMU or a phone, with truth. SCENARIO: foot-GAIT, "
       "body-GAIT, phone-POSE-GAIT, *-mixed, phone-switch, loop; GAIT slow-walk|walk|fast-walk|"
-      "jog|run, POSE hand-held|call|pocket|arm-swing. e.g." + examples);
+      "jog|run, POSE hand-held|call|pocket|arm-swing. e.g." +
+          examples);
   cmd->add_option("scenario", opts->scenario, "scenario name")->required();
   cmd->add_option("--seed", opts->seed, "seed: the person, the noise, the loop geometry")
       ->capture_default_str();

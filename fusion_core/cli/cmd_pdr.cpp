@@ -53,9 +53,9 @@ void run_pdr(const PdrOptions& o) {
       "\"end_y_m\": %.3f, \"heading_deg\": %.2f, \"pose\": %d, \"cadence_spm\": %.1f, "
       "\"pose_switches\": %u, \"pose_changes\": %u, \"replaced_headings\": %u, \"gyro\": %s, "
       "\"mag\": %s, \"ns_per_sample\": %.1f}\n",
-      records.size(), f.steps, f.distance_m, f.x_m, f.y_m, f.heading_deg,
-      static_cast<int>(f.pose), f.cadence_spm, d.switches, d.pose_changes, d.replaced_headings,
-      has_gyro ? "true" : "false", has_mag ? "true" : "false",
+      records.size(), f.steps, f.distance_m, f.x_m, f.y_m, f.heading_deg, static_cast<int>(f.pose),
+      f.cadence_spm, d.switches, d.pose_changes, d.replaced_headings, has_gyro ? "true" : "false",
+      has_mag ? "true" : "false",
       static_cast<double>(spent.count()) / static_cast<double>(records.size()));
 }
 

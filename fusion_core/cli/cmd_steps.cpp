@@ -47,9 +47,11 @@ void run_steps(const StepsOptions& o) {
 void register_steps(CLI::App& app) {
   auto opts = std::make_shared<StepsOptions>();
   std::string names;
-  for (auto n : fusion::step_detector_names()) names += std::string(names.empty() ? "" : ", ") + std::string(n);
+  for (auto n : fusion::step_detector_names())
+    names += std::string(names.empty() ? "" : ", ") + std::string(n);
   auto* cmd = app.add_subcommand("steps", "Count steps in an IMU CSV (gyro columns optional)");
-  cmd->add_option("--in", opts->in, "IMU CSV: t_s,ax_m_s2,ay_m_s2,az_m_s2[,gx_rad_s,gy_rad_s,gz_rad_s]")
+  cmd->add_option("--in", opts->in,
+                  "IMU CSV: t_s,ax_m_s2,ay_m_s2,az_m_s2[,gx_rad_s,gy_rad_s,gz_rad_s]")
       ->required();
   cmd->add_option("--method", opts->method,
                   "detector: " + names + " (default: adaptive for foot, peak-valley otherwise)");
@@ -57,7 +59,6 @@ void register_steps(CLI::App& app) {
       ->capture_default_str();
   cmd->callback([opts] { run_steps(*opts); });
   register_pdr(app);
-
 }
 
 }  // namespace telltale::cli

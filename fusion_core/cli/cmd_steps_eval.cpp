@@ -51,15 +51,17 @@ void gait_table(const EvalOptions& o) {
   const auto names = fusion::step_detector_names();
   for (const std::string site : {"foot", "body"}) {
     const auto mount = site == "foot" ? fusion::StepMount::kFoot : fusion::StepMount::kBody;
-    std::printf("\n## Step count accuracy, %s-mounted sensor, %d simulated people "
-                "(mean / worst person, %%)\n\n| gait |",
-                site.c_str(), o.people);
+    std::printf(
+        "\n## Step count accuracy, %s-mounted sensor, %d simulated people "
+        "(mean / worst person, %%)\n\n| gait |",
+        site.c_str(), o.people);
     for (auto n : names) std::printf(" %.*s |", static_cast<int>(n.size()), n.data());
     std::printf("\n|---|");
     for (std::size_t i = 0; i < names.size(); ++i) std::printf("---|");
     std::printf("\n");
     std::vector<std::string> gaits;
-    for (int g = 0; g < sim::kGaitCount; ++g) gaits.emplace_back(sim::gait_name(static_cast<sim::Gait>(g)));
+    for (int g = 0; g < sim::kGaitCount; ++g)
+      gaits.emplace_back(sim::gait_name(static_cast<sim::Gait>(g)));
     gaits.emplace_back("mixed");
     for (const auto& g : gaits) {
       std::vector<double> sum(names.size(), 0.0), worst(names.size(), 1.0);
@@ -89,8 +91,8 @@ void gait_table(const EvalOptions& o) {
 
 std::string find_oxford(const std::string& given) {
   if (!given.empty()) return given;
-  for (const char* d : {"../shared/data/oxford_steps", "/work/shared/data/oxford_steps",
-                        "tests/data/oxford_steps"})
+  for (const char* d :
+       {"../shared/data/oxford_steps", "/work/shared/data/oxford_steps", "tests/data/oxford_steps"})
     if (std::filesystem::exists(std::string(d) + "/counts.csv")) return d;
   throw UsageError("no Oxford traces found: give --oxford DIR");
 }
@@ -150,10 +152,12 @@ void pose_table() {
     ++confusion[want][g];
     ok += (got && *got == set.labels[i]) ? 1u : 0u;
   }
-  std::printf("\n## Pose classification (BP 3-8-4, shipped weights), 10 held-out simulated people, "
-              "%zu windows: accuracy %.2f %%\n\n| true \\ classified | hand-held | call | pocket "
-              "| arm-swing |\n|---|---|---|---|---|\n",
-              set.features.size(), 100.0 * static_cast<double>(ok) / static_cast<double>(set.features.size()));
+  std::printf(
+      "\n## Pose classification (BP 3-8-4, shipped weights), 10 held-out simulated people, "
+      "%zu windows: accuracy %.2f %%\n\n| true \\ classified | hand-held | call | pocket "
+      "| arm-swing |\n|---|---|---|---|---|\n",
+      set.features.size(),
+      100.0 * static_cast<double>(ok) / static_cast<double>(set.features.size()));
   for (int t = 0; t < fusion::kPoseCount; ++t) {
     const auto name = sim::pose_name(static_cast<fusion::PhonePose>(t));
     std::printf("| %.*s |", static_cast<int>(name.size()), name.data());
@@ -163,9 +167,11 @@ void pose_table() {
 }
 
 void pdr_table(int loops) {
-  std::printf("\n## PDR closed loops (%d walks, people held out of training): end-point error / "
-              "distance\n\n| variant | median %% | 90th pct %% | walks <= 2 %% | steps counted / true |"
-              "\n|---|---|---|---|---|\n", loops);
+  std::printf(
+      "\n## PDR closed loops (%d walks, people held out of training): end-point error / "
+      "distance\n\n| variant | median %% | 90th pct %% | walks <= 2 %% | steps counted / true |"
+      "\n|---|---|---|---|---|\n",
+      loops);
   const std::pair<sim::LoopVariant, const char*> variants[] = {
       {sim::LoopVariant::kAsSimulated, "pose switches, full sensor errors"},
       {sim::LoopVariant::kSinglePose, "one pose, full sensor errors"},
@@ -183,8 +189,8 @@ void pdr_table(int loops) {
     std::sort(err.begin(), err.end());
     const auto within = std::count_if(err.begin(), err.end(), [](double e) { return e <= 2.0; });
     std::printf("| %s | %.2f | %.2f | %ld / %d (%.0f %%) | %zu / %zu |\n", name,
-                err[err.size() / 2], err[(err.size() * 9) / 10 - 1], static_cast<long>(within), loops,
-                100.0 * static_cast<double>(within) / loops, counted, truth);
+                err[err.size() / 2], err[(err.size() * 9) / 10 - 1], static_cast<long>(within),
+                loops, 100.0 * static_cast<double>(within) / loops, counted, truth);
     std::fflush(stdout);
   }
 }
@@ -200,8 +206,9 @@ void run_eval(const EvalOptions& o) {
 
 void register_steps_eval(CLI::App& app) {
   auto opts = std::make_shared<EvalOptions>();
-  auto* cmd = app.add_subcommand("steps-eval", "Accuracy tables: gaits x step methods, Oxford "
-                                               "traces, pose classifier, PDR closed loops");
+  auto* cmd = app.add_subcommand("steps-eval",
+                                 "Accuracy tables: gaits x step methods, Oxford "
+                                 "traces, pose classifier, PDR closed loops");
   cmd->add_option("--people", opts->people, "simulated people per gait")->capture_default_str();
   cmd->add_option("--oxford", opts->oxford_dir,
                   "Oxford step traces (default: ../shared/data/oxford_steps, then "

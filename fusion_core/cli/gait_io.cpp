@@ -30,8 +30,8 @@ std::vector<ImuRecord> read_imu_csv(const std::string& path, bool require_gyro, 
     ImuRecord r;
     r.imu.t_s = row[0];
     r.imu.acc_body_m_s2 = {row[1], row[2], row[3]};
-    r.imu.gyro_body_rad_s = gyro ? Eigen::Vector3d(row[4], row[5], row[6])
-                                 : Eigen::Vector3d::Constant(std::nan(""));
+    r.imu.gyro_body_rad_s =
+        gyro ? Eigen::Vector3d(row[4], row[5], row[6]) : Eigen::Vector3d::Constant(std::nan(""));
     if (mag) r.mag_uT = {row[7], row[8], row[9]};
     out.push_back(r);
   }
@@ -51,14 +51,12 @@ void write_gait_run(const fusion::sim::GaitRun& run, const std::string& imu_path
   }
   imu.close();
   if (truth_path.empty()) return;
-  io::CsvWriter truth(truth_path, {"t_s", "x_m", "y_m", "heading_deg", "distance_m", "gait",
-                                   "pose", "switching", "steps", "foot_steps", "step_hz",
-                                   "step_length_m"});
+  io::CsvWriter truth(truth_path, {"t_s", "x_m", "y_m", "heading_deg", "distance_m", "gait", "pose",
+                                   "switching", "steps", "foot_steps", "step_hz", "step_length_m"});
   for (const auto& s : run.samples)
-    truth.row({s.imu.t_s, s.x_m, s.y_m, s.heading_deg, s.distance_m,
-               static_cast<double>(s.gait), static_cast<double>(s.pose), s.switching ? 1.0 : 0.0,
-               static_cast<double>(s.steps), static_cast<double>(s.foot_steps), s.step_hz,
-               s.step_length_m});
+    truth.row({s.imu.t_s, s.x_m, s.y_m, s.heading_deg, s.distance_m, static_cast<double>(s.gait),
+               static_cast<double>(s.pose), s.switching ? 1.0 : 0.0, static_cast<double>(s.steps),
+               static_cast<double>(s.foot_steps), s.step_hz, s.step_length_m});
   truth.close();
 }
 

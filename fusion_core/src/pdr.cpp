@@ -147,8 +147,9 @@ PoseNetwork train_pose_network(const std::vector<PoseFeatures>& features,
       e[static_cast<Eigen::Index>(labels[i])] += 1.0;
       // Steps 5-6 (eqs. (7)-(10)): weights and thresholds along the error gradient.
       const Eigen::Matrix<double, PoseNetwork::kHidden, 1> back =
-          (net.w_ho.transpose() * e).cwiseProduct(h.cwiseProduct(
-              Eigen::Matrix<double, PoseNetwork::kHidden, 1>::Ones() - h));
+          (net.w_ho.transpose() * e)
+              .cwiseProduct(
+                  h.cwiseProduct(Eigen::Matrix<double, PoseNetwork::kHidden, 1>::Ones() - h));
       net.w_ho += params.eta * e * h.transpose();
       net.b_o += params.eta * e;
       net.w_ih += params.eta * back * x[i].transpose();
@@ -207,7 +208,8 @@ std::string format_pdr_model(const PoseNetwork& net, const StepLengthModel& len)
   put("w_ho", net.w_ho);
   put("b_o", net.b_o);
   Eigen::Matrix<double, kPoseCount, 3> abc;
-  for (int p = 0; p < kPoseCount; ++p) abc.row(p) = len.abc[static_cast<std::size_t>(p)].transpose();
+  for (int p = 0; p < kPoseCount; ++p)
+    abc.row(p) = len.abc[static_cast<std::size_t>(p)].transpose();
   put("step_length_abc", abc);
   return o.str();
 }
@@ -233,19 +235,27 @@ bool parse_pdr_model(std::string_view text, PoseNetwork& net_out, StepLengthMode
       return true;
     };
     bool ok = false;
-    if (name == "in_mean") ok = read(net.in_mean);
-    else if (name == "in_scale") ok = read(net.in_scale);
-    else if (name == "w_ih") ok = read(net.w_ih);
-    else if (name == "b_h") ok = read(net.b_h);
-    else if (name == "w_ho") ok = read(net.w_ho);
-    else if (name == "b_o") ok = read(net.b_o);
-    else if (name == "step_length_abc") ok = read(abc);
+    if (name == "in_mean")
+      ok = read(net.in_mean);
+    else if (name == "in_scale")
+      ok = read(net.in_scale);
+    else if (name == "w_ih")
+      ok = read(net.w_ih);
+    else if (name == "b_h")
+      ok = read(net.b_h);
+    else if (name == "w_ho")
+      ok = read(net.w_ho);
+    else if (name == "b_o")
+      ok = read(net.b_o);
+    else if (name == "step_length_abc")
+      ok = read(abc);
     if (!ok) return false;
   }
   if (found != 7) return false;
   net.trained = true;
   net_out = net;
-  for (int p = 0; p < kPoseCount; ++p) len_out.abc[static_cast<std::size_t>(p)] = abc.row(p).transpose();
+  for (int p = 0; p < kPoseCount; ++p)
+    len_out.abc[static_cast<std::size_t>(p)] = abc.row(p).transpose();
   return true;
 }
 
@@ -266,8 +276,8 @@ const StepLengthModel& builtin_step_length_model() { return builtin().len; }
 
 Eigen::Matrix3d pose_rotation(PhonePose pose) {
   Eigen::Matrix3d m = Eigen::Matrix3d::Identity();
-  if (pose == PhonePose::kCall) m << 0, 0, -1, 0, -1, 0, -1, 0, 0;    // eq. (14)
-  if (pose == PhonePose::kPocket) m << 0, 0, -1, 0, 1, 0, 1, 0, 0;    // eq. (15)
+  if (pose == PhonePose::kCall) m << 0, 0, -1, 0, -1, 0, -1, 0, 0;  // eq. (14)
+  if (pose == PhonePose::kPocket) m << 0, 0, -1, 0, 1, 0, 1, 0, 0;  // eq. (15)
   return m;
 }
 
@@ -370,8 +380,7 @@ Pdr::Pdr(Params params, const PoseNetwork& net, const StepLengthModel& lengths)
       heading_(params.heading) {}
 
 const StepDiagnostics& Pdr::step_diagnostics() const {
-  return params_.mount == StepMount::kFoot ? foot_steps_.diagnostics()
-                                           : phone_steps_.diagnostics();
+  return params_.mount == StepMount::kFoot ? foot_steps_.diagnostics() : phone_steps_.diagnostics();
 }
 
 Pdr::Wave Pdr::step_wave(double t0, double t1) const {
@@ -422,8 +431,9 @@ void Pdr::on_step(double t_s) {
         const double r = den > 1e-9 ? a.dot(b) / den : 0.0;
         const double tilt_deg =
             std::acos(std::clamp(tilt.dot(tilts_[slot]), -1.0, 1.0)) * 180.0 / M_PI;
-        const bool changed = (r < params_.switch_correlation && tilt_deg > params_.switch_tilt_deg) ||
-                             tilt_deg > 2.0 * params_.switch_tilt_deg;
+        const bool changed =
+            (r < params_.switch_correlation && tilt_deg > params_.switch_tilt_deg) ||
+            tilt_deg > 2.0 * params_.switch_tilt_deg;
         if (!switching_ && changed) {
           switching_ = true;
           settling_ = false;
@@ -444,8 +454,9 @@ void Pdr::on_step(double t_s) {
             const double mean = std::atan2(s, c);
             bool straight = true;
             for (std::size_t i = 0; i < 3; ++i)
-              straight = straight && std::abs(std::remainder(recent_heading_rad_[i] - mean, kTwoPi)) <
-                                         params_.straight_deg * M_PI / 180.0;
+              straight =
+                  straight && std::abs(std::remainder(recent_heading_rad_[i] - mean, kTwoPi)) <
+                                  params_.straight_deg * M_PI / 180.0;
             if (straight) {
               replacement_heading_rad_ = wrap_2pi(mean);
               have_replacement_ = true;
@@ -596,9 +607,9 @@ const PdrOutput& Pdr::update(const ImuSample& s, const Eigen::Vector3d& mag_uT) 
   if (heading_.initialised()) {
     sum_sin_ += std::sin(heading_.heading_rad());
     sum_cos_ += std::cos(heading_.heading_rad());
-    if (!out_.step) out_.heading_deg = switching_ && have_replacement_
-                                           ? replacement_heading_rad_ * 180.0 / M_PI
-                                           : heading_.heading_rad() * 180.0 / M_PI;
+    if (!out_.step)
+      out_.heading_deg = switching_ && have_replacement_ ? replacement_heading_rad_ * 180.0 / M_PI
+                                                         : heading_.heading_rad() * 180.0 / M_PI;
   }
   StepEvent ev;
   const bool step = foot ? foot_steps_.update(s, ev) : phone_steps_.update(s, ev);

@@ -17,7 +17,8 @@ TEST(GaitSim, PeopleSpanTheHeightRangeAndGaitsOrderByCadenceAndLength) {
     lo = std::min(lo, p.height_m);
     hi = std::max(hi, p.height_m);
     for (int g = 1; g < kGaitCount; ++g) {
-      EXPECT_GT(nominal_step_hz(static_cast<Gait>(g), p), nominal_step_hz(static_cast<Gait>(g - 1), p));
+      EXPECT_GT(nominal_step_hz(static_cast<Gait>(g), p),
+                nominal_step_hz(static_cast<Gait>(g - 1), p));
       EXPECT_GT(nominal_step_length_m(static_cast<Gait>(g), p),
                 nominal_step_length_m(static_cast<Gait>(g - 1), p));
     }
@@ -57,7 +58,8 @@ TEST(GaitSim, TruthBookkeepingAddsUp) {
     const auto run = simulate_gait(*make_gait_scenario(name, 7), random_person(7), 7);
     EXPECT_EQ(run.foot_step_times_s.size() * 2, run.step_times_s.size()) << name;
     EXPECT_EQ(static_cast<std::size_t>(run.samples.back().steps), run.step_times_s.size());
-    EXPECT_EQ(static_cast<std::size_t>(run.samples.back().foot_steps), run.foot_step_times_s.size());
+    EXPECT_EQ(static_cast<std::size_t>(run.samples.back().foot_steps),
+              run.foot_step_times_s.size());
     EXPECT_NEAR(run.samples.back().distance_m, run.distance_m, 1e-9);
     double mean_mag = 0;
     for (const auto& s : run.samples) mean_mag += s.imu.acc_body_m_s2.norm();

@@ -23,9 +23,12 @@ TEST(PoseRotation, PaperMatricesAreProperRotations) {
     EXPECT_TRUE((m * m.transpose()).isIdentity(1e-15));
     EXPECT_NEAR(m.determinant(), 1.0, 1e-15);
   }
-  // Eqs. (14)-(15) as printed: call [[0,0,-1],[0,-1,0],[-1,0,0]], pocket [[0,0,-1],[0,1,0],[1,0,0]].
-  EXPECT_EQ(pose_rotation(PhonePose::kCall) * Eigen::Vector3d(1, 2, 3), Eigen::Vector3d(-3, -2, -1));
-  EXPECT_EQ(pose_rotation(PhonePose::kPocket) * Eigen::Vector3d(1, 2, 3), Eigen::Vector3d(-3, 2, 1));
+  // Eqs. (14)-(15) as printed: call [[0,0,-1],[0,-1,0],[-1,0,0]], pocket
+  // [[0,0,-1],[0,1,0],[1,0,0]].
+  EXPECT_EQ(pose_rotation(PhonePose::kCall) * Eigen::Vector3d(1, 2, 3),
+            Eigen::Vector3d(-3, -2, -1));
+  EXPECT_EQ(pose_rotation(PhonePose::kPocket) * Eigen::Vector3d(1, 2, 3),
+            Eigen::Vector3d(-3, 2, 1));
 }
 
 // Walking frame x forward, y left, z up; earth field ENU (0, 20, -44) uT. For a heading psi the
@@ -40,8 +43,8 @@ TEST(HeadingFilter, MagneticHeadingInvertsTheFieldGeometryUnderTilt) {
         const Eigen::Matrix3d r = (Eigen::AngleAxisd(pitch * kDeg, Eigen::Vector3d::UnitY()) *
                                    Eigen::AngleAxisd(roll * kDeg, Eigen::Vector3d::UnitX()))
                                       .toRotationMatrix();
-        const double h = HeadingFilter::magnetic_heading_rad(r.transpose() * m_level,
-                                                             r.transpose() * Eigen::Vector3d::UnitZ());
+        const double h = HeadingFilter::magnetic_heading_rad(
+            r.transpose() * m_level, r.transpose() * Eigen::Vector3d::UnitZ());
         EXPECT_NEAR(std::remainder(h / kDeg - psi, 360.0), 0.0, 1e-9) << psi << roll << pitch;
       }
   }
@@ -175,7 +178,8 @@ TEST(Pdr, DetectsPoseSwitchesAndEndsInTheTruePose) {
 // line at what is measured so a regression shows.
 TEST(Pdr, ClosedLoopsWithPoseSwitchesMeasuredFigures) {
   std::vector<double> err;
-  for (int i = 0; i < 20; ++i) err.push_back(sim::simulate_pdr_loop(static_cast<std::uint64_t>(2001 + i)).error_fraction);
+  for (int i = 0; i < 20; ++i)
+    err.push_back(sim::simulate_pdr_loop(static_cast<std::uint64_t>(2001 + i)).error_fraction);
   std::sort(err.begin(), err.end());
   const auto within = std::count_if(err.begin(), err.end(), [](double e) { return e <= 0.02; });
   RecordProperty("within_2_percent", std::to_string(within));
@@ -188,7 +192,9 @@ TEST(Pdr, ClosedLoopsWithPoseSwitchesMeasuredFigures) {
 TEST(Pdr, ClosedLoopsWithIdealSensorsInOnePose) {
   std::vector<double> err;
   for (int i = 0; i < 10; ++i)
-    err.push_back(sim::simulate_pdr_loop(static_cast<std::uint64_t>(2001 + i), sim::LoopVariant::kIdealSensors).error_fraction);
+    err.push_back(sim::simulate_pdr_loop(static_cast<std::uint64_t>(2001 + i),
+                                         sim::LoopVariant::kIdealSensors)
+                      .error_fraction);
   std::sort(err.begin(), err.end());
   EXPECT_LE(err[5], 0.03);
 }

@@ -1,7 +1,8 @@
 // No heap in the update loops: Eigen's malloc guard around the step detectors and the PDR.
 #define EIGEN_RUNTIME_NO_MALLOC
-#include <Eigen/Core>
 #include <gtest/gtest.h>
+
+#include <Eigen/Core>
 
 #include "telltale/fusion/pdr.hpp"
 #include "telltale/fusion/sim/gait_sim.hpp"
@@ -11,10 +12,11 @@ namespace telltale::fusion {
 namespace {
 
 TEST(NoHeap, StepDetectorsAndPdrUpdateWithoutEigenAllocation) {
-  const auto run = sim::simulate_gait(*sim::make_gait_scenario("phone-switch", 4),
-                                      sim::random_person(4), 4);
+  const auto run =
+      sim::simulate_gait(*sim::make_gait_scenario("phone-switch", 4), sim::random_person(4), 4);
   std::vector<std::unique_ptr<StepDetector>> detectors;
-  for (auto name : step_detector_names()) detectors.push_back(make_step_detector(name, StepMount::kBody));
+  for (auto name : step_detector_names())
+    detectors.push_back(make_step_detector(name, StepMount::kBody));
   auto pdr = std::make_unique<Pdr>();
   StepEvent ev;
   std::size_t steps = 0;

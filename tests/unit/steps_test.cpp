@@ -141,23 +141,21 @@ TEST_P(GaitAccuracy, AdaptiveDetectorAtLeast99PercentAndBaselinesBeside) {
       if (name == "adaptive") worst_adaptive = std::min(worst_adaptive, acc);
     }
   }
-  for (const auto& [name, acc] : mean)
-    RecordProperty(name, std::to_string(100.0 * acc));
+  for (const auto& [name, acc] : mean) RecordProperty(name, std::to_string(100.0 * acc));
   EXPECT_GE(mean["adaptive"], 0.99);
   EXPECT_GE(worst_adaptive, 0.97);
   EXPECT_GE(mean["adaptive"] + 1e-12, mean["peak"]);
   EXPECT_GE(mean["adaptive"] + 1e-12, mean["fixed-threshold"]);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    EveryGait, GaitAccuracy,
-    testing::Values(GaitCase{"foot", "slow-walk"}, GaitCase{"foot", "walk"},
-                    GaitCase{"foot", "fast-walk"}, GaitCase{"foot", "jog"},
-                    GaitCase{"foot", "run"}, GaitCase{"foot", "mixed"},
-                    GaitCase{"body", "slow-walk"}, GaitCase{"body", "walk"},
-                    GaitCase{"body", "fast-walk"}, GaitCase{"body", "jog"},
-                    GaitCase{"body", "run"}, GaitCase{"body", "mixed"}),
-    case_name);
+INSTANTIATE_TEST_SUITE_P(EveryGait, GaitAccuracy,
+                         testing::Values(GaitCase{"foot", "slow-walk"}, GaitCase{"foot", "walk"},
+                                         GaitCase{"foot", "fast-walk"}, GaitCase{"foot", "jog"},
+                                         GaitCase{"foot", "run"}, GaitCase{"foot", "mixed"},
+                                         GaitCase{"body", "slow-walk"}, GaitCase{"body", "walk"},
+                                         GaitCase{"body", "fast-walk"}, GaitCase{"body", "jog"},
+                                         GaitCase{"body", "run"}, GaitCase{"body", "mixed"}),
+                         case_name);
 
 // The paper's claim about the baselines, as far as it holds here: fixed thresholds tuned for a
 // normal walk miss a body-worn slow walk entirely and lose steps when gaits change.
@@ -177,8 +175,8 @@ TEST(Baselines, FailOnNonNormalGaitsOfABodyWornSensor) {
 TEST(AdaptiveStepDetector, AccelerometerOnlyFootStillCounts) {
   for (int p = 1; p <= 3; ++p) {
     const auto seed = static_cast<std::uint64_t>(p);
-    const auto run =
-        sim::simulate_gait(*sim::make_gait_scenario("foot-mixed", seed), sim::random_person(seed), seed);
+    const auto run = sim::simulate_gait(*sim::make_gait_scenario("foot-mixed", seed),
+                                        sim::random_person(seed), seed);
     AdaptiveStepDetector d;
     EXPECT_GE(accuracy(count(d, run.samples, true), run.foot_step_times_s.size()), 0.99);
     EXPECT_FALSE(d.diagnostics().gyro_used);
@@ -223,7 +221,8 @@ TEST(OxfordTraces, PeakValleyMeanCountAccuracyAtLeast97Percent) {
     std::size_t n = 0;
     const double nan = std::numeric_limits<double>::quiet_NaN();
     for (std::size_t i = 0; i < table.rows(); ++i) {
-      const ImuSample s{table.columns[0][i], {nan, nan, nan},
+      const ImuSample s{table.columns[0][i],
+                        {nan, nan, nan},
                         {table.columns[1][i], table.columns[2][i], table.columns[3][i]}};
       n += d.update(s, ev) ? 1u : 0u;
     }

@@ -133,12 +133,14 @@ TEST(WitMotionDecoder, ResynchronisesAfterGarbageAndCountsBadFrames) {
     }
     stream.insert(stream.end(), enc.begin(), enc.end());
     const int junk = byte(rng) % 7;
-    for (int j = 0; j < junk; ++j) stream.push_back(j == 0 ? 0x55 : static_cast<std::uint8_t>(byte(rng)));
+    for (int j = 0; j < junk; ++j)
+      stream.push_back(j == 0 ? 0x55 : static_cast<std::uint8_t>(byte(rng)));
   }
   // Feed in irregular chunks, as a serial port delivers them.
   std::size_t i = 0;
   while (i < stream.size()) {
-    const std::size_t n = std::min<std::size_t>(1 + static_cast<std::size_t>(byte(rng)) % 40, stream.size() - i);
+    const std::size_t n =
+        std::min<std::size_t>(1 + static_cast<std::size_t>(byte(rng)) % 40, stream.size() - i);
     dec.feed(std::span<const std::uint8_t>(stream.data() + i, n), 0.0);
     i += n;
   }

@@ -59,10 +59,14 @@ Eigen::Matrix3d pose_matrix(PhonePose p) {
 /// this far during a switch.
 Eigen::Vector3d pose_position(PhonePose p) {
   switch (p) {
-    case PhonePose::kHandHeld: return {0.35, -0.10, -0.15};
-    case PhonePose::kCall: return {0.0, 0.12, 0.35};
-    case PhonePose::kPocket: return {0.10, 0.08, 0.0};
-    case PhonePose::kArmSwing: return {0.0, -0.25, -0.55};
+    case PhonePose::kHandHeld:
+      return {0.35, -0.10, -0.15};
+    case PhonePose::kCall:
+      return {0.0, 0.12, 0.35};
+    case PhonePose::kPocket:
+      return {0.10, 0.08, 0.0};
+    case PhonePose::kArmSwing:
+      return {0.0, -0.25, -0.55};
   }
   return Eigen::Vector3d::Zero();
 }
@@ -85,7 +89,8 @@ class Path {
     };
     for (const auto& leg : legs) {
       add(leg.length_m, 0.0);
-      if (leg.turn_deg != 0.0) add(radius * std::abs(leg.turn_deg) * kDeg, (leg.turn_deg > 0 ? -1.0 : 1.0) / radius);
+      if (leg.turn_deg != 0.0)
+        add(radius * std::abs(leg.turn_deg) * kDeg, (leg.turn_deg > 0 ? -1.0 : 1.0) / radius);
     }
     total_ = s;
     end_x_ = x;
@@ -298,8 +303,8 @@ class Simulator {
     const double a_lat = -sway * (M_PI * f) * (M_PI * f) * std::sin(kTwoPi * b.stride_phase);
     b.acc_w = {a_fwd, a_lat, a_up};
     const double yaw_amp = (row.running ? 5.0 : 3.0) * kDeg;
-    b.trunk = {2.0 * kDeg * std::cos(kTwoPi * b.stride_phase),
-               1.5 * kDeg * std::cos(kTwoPi * ph), yaw_amp * std::sin(kTwoPi * b.stride_phase)};
+    b.trunk = {2.0 * kDeg * std::cos(kTwoPi * b.stride_phase), 1.5 * kDeg * std::cos(kTwoPi * ph),
+               yaw_amp * std::sin(kTwoPi * b.stride_phase)};
     return b;
   }
 
@@ -353,7 +358,8 @@ class Simulator {
       case PhonePose::kArmSwing: {
         // Pendulum from the shoulder at stride frequency: hand forward when the opposite foot
         // strikes. alpha > 0 = hand forward and up; the phone pitches up with the arm.
-        const double a0 = p_.arm_swing_deg * kDeg * (b.moving ? std::min(1.0, b.step_len / 0.7) : 0.0);
+        const double a0 =
+            p_.arm_swing_deg * kDeg * (b.moving ? std::min(1.0, b.step_len / 0.7) : 0.0);
         const double r = 0.38 * p_.height_m;
         const double w_s = kTwoPi * b.step_hz / 2.0;
         const double alpha = a0 * std::sin(kTwoPi * b.stride_phase);
@@ -399,11 +405,12 @@ class Simulator {
         // small motions of the two poses blend.
         const Eigen::Quaterniond q_mount =
             Eigen::Quaterniond(mount_old).slerp(w, Eigen::Quaterniond(mount));
-        const Eigen::Quaterniond q_osc = Eigen::Quaterniond(osc_old).slerp(w, Eigen::Quaterniond(osc));
+        const Eigen::Quaterniond q_osc =
+            Eigen::Quaterniond(osc_old).slerp(w, Eigen::Quaterniond(osc));
         r_rel = (q_osc * q_mount).toRotationMatrix();
         const Eigen::Vector3d d = pose_position(seg.pose) - pose_position(prev.pose);
-        acc_w = (1.0 - w) * acc_old + w * acc_w +
-                d * minjerk_acc(u) / (sc_.switch_s * sc_.switch_s);
+        acc_w =
+            (1.0 - w) * acc_old + w * acc_w + d * minjerk_acc(u) / (sc_.switch_s * sc_.switch_s);
         switching = true;
         if (w < 0.5) pose = prev.pose;
       }
@@ -416,7 +423,8 @@ class Simulator {
 
   // --- foot -----------------------------------------------------------------------------------
   /// Toe position (world ENU) and foot orientation of the left (instrumented) foot at t.
-  void foot(double t, Eigen::Vector3d& pos, Eigen::Matrix3d& r_ws, Eigen::Vector3d& impact_w) const {
+  void foot(double t, Eigen::Vector3d& pos, Eigen::Matrix3d& r_ws,
+            Eigen::Vector3d& impact_w) const {
     impact_w.setZero();
     auto k = step_index(t);
     double s_toe = 0, height = 0, pitch = 0;
@@ -512,10 +520,10 @@ class Simulator {
     Eigen::Vector3d m = r_ws.transpose() * Eigen::Vector3d(0.0, 20.0, -44.0);
     for (std::size_t a = 0; a < 3; ++a) {
       const auto ai = static_cast<Eigen::Index>(a);
-      f[ai] = std::clamp(f[ai] + acc_bias_[a] + e.acc_noise_m_s2 * rng_.normal(),
-                        -e.acc_range_m_s2, e.acc_range_m_s2);
+      f[ai] = std::clamp(f[ai] + acc_bias_[a] + e.acc_noise_m_s2 * rng_.normal(), -e.acc_range_m_s2,
+                         e.acc_range_m_s2);
       w[ai] = std::clamp(w[ai] + gyro_bias_[a] + e.gyro_noise_rad_s * rng_.normal(),
-                        -e.gyro_range_rad_s, e.gyro_range_rad_s);
+                         -e.gyro_range_rad_s, e.gyro_range_rad_s);
       m[ai] += mag_bias_[a] + e.mag_noise_uT * rng_.normal();
     }
     out.imu.t_s = t;
@@ -530,7 +538,9 @@ class Simulator {
     out.step_hz = b.step_hz;
     out.step_length_m = b.step_len;
     const auto k = step_index(t);
-    out.steps = k < 0 ? 0 : static_cast<int>(std::min<std::ptrdiff_t>(k + 1, static_cast<std::ptrdiff_t>(steps_.size())));
+    out.steps = k < 0 ? 0
+                      : static_cast<int>(std::min<std::ptrdiff_t>(
+                            k + 1, static_cast<std::ptrdiff_t>(steps_.size())));
     int foot = 0;
     for (std::size_t i = 2; i < steps_.size(); i += 2)
       if (steps_[i].t0 <= t) ++foot;
@@ -682,7 +692,7 @@ std::optional<GaitScenario> make_gait_scenario(std::string_view name, std::uint6
 }
 
 std::vector<std::string> gait_scenario_examples() {
-  return {"foot-walk", "foot-run", "foot-mixed", "body-jog", "phone-arm-swing-walk",
+  return {"foot-walk",        "foot-run",     "foot-mixed", "body-jog", "phone-arm-swing-walk",
           "phone-call-mixed", "phone-switch", "loop"};
 }
 

@@ -14,8 +14,8 @@ PoseWindowSet simulate_pose_windows(std::uint64_t first, int people, int windows
       sc.site = SensorSite::kPhone;
       sc.rate_hz = 50.0;
       const auto pose = static_cast<PhonePose>(p);
-      sc.segments = {{Gait::kSlowWalk, pose, 20.0}, {Gait::kWalk, pose, 20.0},
-                     {Gait::kFastWalk, pose, 20.0}};
+      sc.segments = {
+          {Gait::kSlowWalk, pose, 20.0}, {Gait::kWalk, pose, 20.0}, {Gait::kFastWalk, pose, 20.0}};
       const auto run = simulate_gait(sc, person, seed * 16 + static_cast<std::uint64_t>(p));
       PoseFeatureWindow window(2.0);
       // Windows end between 3 s after the walk starts and its end, evenly spaced.
@@ -24,8 +24,7 @@ PoseWindowSet simulate_pose_windows(std::uint64_t first, int people, int windows
       int next = 0;
       for (const auto& s : run.samples) {
         window.push(s.imu);
-        const double t_next =
-            t0 + (t1 - t0) * next / std::max(1, windows_per_pose - 1);
+        const double t_next = t0 + (t1 - t0) * next / std::max(1, windows_per_pose - 1);
         if (next < windows_per_pose && s.imu.t_s >= t_next) {
           out.features.push_back(window.features());
           out.labels.push_back(pose);
@@ -57,7 +56,8 @@ std::vector<CalibrationWalk> simulate_calibration_walks(std::uint64_t first, int
       walk.height_m = person.height_m;
       walk.distance_m = run.distance_m;
       for (const auto& s : run.samples)
-        if (pdr.update(s.imu, s.mag_uT).step) walk.step_hz.push_back(pdr.output().step_hz > 0.0 ? pdr.output().step_hz : 1.8);
+        if (pdr.update(s.imu, s.mag_uT).step)
+          walk.step_hz.push_back(pdr.output().step_hz > 0.0 ? pdr.output().step_hz : 1.8);
       out.push_back(walk);
     }
   }

@@ -142,12 +142,12 @@ struct CalibrationWalk {
 /// by integrating the gyro and pulling toward the accelerometer (`up_tau_s`), so a swinging arm
 /// does not tilt it. Magnetic north (no declination).
 struct HeadingFilterParams {
-  double gyro_noise_rad_s = 0.02;    ///< heading-rate noise density, rad/s/sqrt(Hz)
-  double bias_walk_rad_s2 = 2e-4;    ///< bias random walk, rad/s^2/sqrt(Hz)
-  double mag_noise_deg = 6.0;        ///< magnetic heading noise per sample, deg
-  double gate_deg = 40.0;            ///< larger innovations are rejected...
-  double reset_after_s = 3.0;        ///< ...unless they persist this long (then reset)
-  double up_tau_s = 1.5;             ///< time constant of the pull toward the accelerometer
+  double gyro_noise_rad_s = 0.02;  ///< heading-rate noise density, rad/s/sqrt(Hz)
+  double bias_walk_rad_s2 = 2e-4;  ///< bias random walk, rad/s^2/sqrt(Hz)
+  double mag_noise_deg = 6.0;      ///< magnetic heading noise per sample, deg
+  double gate_deg = 40.0;          ///< larger innovations are rejected...
+  double reset_after_s = 3.0;      ///< ...unless they persist this long (then reset)
+  double up_tau_s = 1.5;           ///< time constant of the pull toward the accelerometer
 };
 class HeadingFilter {
  public:
@@ -216,18 +216,18 @@ struct PdrParams {
 /// Everything a node publishes after a sample.
 struct PdrOutput {
   double t_s = 0.0;
-  std::size_t steps = 0;          ///< steps of both feet
-  double cadence_spm = 0.0;       ///< steps per minute (0 until two steps)
-  double step_hz = 0.0;           ///< step frequency used for the step length
+  std::size_t steps = 0;     ///< steps of both feet
+  double cadence_spm = 0.0;  ///< steps per minute (0 until two steps)
+  double step_hz = 0.0;      ///< step frequency used for the step length
   double last_step_length_m = 0.0;
   double distance_m = 0.0;
-  double x_m = 0.0;               ///< east of the start, m
-  double y_m = 0.0;               ///< north of the start, m
-  double heading_deg = 0.0;       ///< walking direction, clockwise from north
+  double x_m = 0.0;          ///< east of the start, m
+  double y_m = 0.0;          ///< north of the start, m
+  double heading_deg = 0.0;  ///< walking direction, clockwise from north
   PhonePose pose = PhonePose::kHandHeld;
-  bool switching = false;         ///< a pose switch is in progress (heading held)
-  int gait = 1;                   ///< coarse gait from cadence: 0 slow walk .. 4 run
-  bool step = false;              ///< a step completed at this sample
+  bool switching = false;  ///< a pose switch is in progress (heading held)
+  int gait = 1;            ///< coarse gait from cadence: 0 slow walk .. 4 run
+  bool step = false;       ///< a step completed at this sample
 };
 
 class Pdr {
@@ -235,9 +235,9 @@ class Pdr {
   using Params = PdrParams;
   struct Diagnostics {
     unsigned rejected_non_finite = 0;
-    unsigned switches = 0;          ///< pose switches detected by cross-correlation
-    unsigned pose_changes = 0;      ///< classified pose changes applied
-    unsigned replaced_headings = 0; ///< steps that used the pre-switch heading
+    unsigned switches = 0;           ///< pose switches detected by cross-correlation
+    unsigned pose_changes = 0;       ///< classified pose changes applied
+    unsigned replaced_headings = 0;  ///< steps that used the pre-switch heading
   };
   /// `net` and `lengths` default to the built-in model; they are copied.
   explicit Pdr(Params params = {}, const PoseNetwork& net = builtin_pose_network(),
@@ -273,12 +273,12 @@ class Pdr {
   std::array<double, kRaw> raw_t_{};
   std::array<Eigen::Vector3d, kRaw> raw_f_{};
   std::size_t raw_head_ = 0, raw_size_ = 0;
-  std::array<Wave, 2> waves_{};  ///< the last two step waveforms
+  std::array<Wave, 2> waves_{};             ///< the last two step waveforms
   std::array<Eigen::Vector3d, 2> tilts_{};  ///< their mean gravity directions (sensor frame)
   bool settling_ = false;  ///< switch over, waiting for the new pose to be confirmed
   int settling_steps_ = 0;
   bool pose_known_ = false;
-  double pending_m_ = 0.0;  ///< distance walked before the first heading
+  double pending_m_ = 0.0;                 ///< distance walked before the first heading
   std::array<double, 32> switch_len_m_{};  ///< steps laid with the replacement heading
   int switch_steps_ = 0;
   int wave_count_ = 0;

@@ -100,20 +100,20 @@ class StepDetector {
 /// `min_interval_fraction` x recent interval and >= `min_interval_s`). Without a gyro the two
 /// acceleration conditions, the closing and the time thresholds remain.
 struct AdaptiveStepParams {
-  double window_s = 2.0;                ///< sliding window of the adaptive thresholds, s
-  double acc_cutoff_hz = 12.0;          ///< low-pass on |f| before thresholding, Hz
-  double gyro_cutoff_hz = 12.0;         ///< low-pass on the gyro axis, Hz
-  double acc_floor_m_s2 = 1.0;          ///< thresholds never come closer to 0 than this, m/s^2
-  double gyro_floor_rad_s = 0.5;        ///< same for the angular rate, rad/s
-  double min_interval_s = 0.36;         ///< absolute time threshold, s (foot: 2.8 cycles/s max)
-  double max_interval_s = 3.0;          ///< beyond this the cadence memory is reset, s
-  double min_interval_fraction = 0.5;   ///< time threshold relative to the recent interval
-  double initial_interval_s = 1.0;      ///< cadence memory at start, s
-  double mean_tau_s = 4.0;              ///< time constant of the |f| mean the signal is taken about
-  bool use_gyro = true;                 ///< false: acceleration conditions only
-  bool require_stance = true;           ///< foot: a cycle closes with the foot at rest
-  double stance_s = 0.03;               ///< rest needed to close a foot cycle, s
-  double stance_fraction = 0.25;        ///< rest = |f|-g and |w| below this x upper thresholds
+  double window_s = 2.0;               ///< sliding window of the adaptive thresholds, s
+  double acc_cutoff_hz = 12.0;         ///< low-pass on |f| before thresholding, Hz
+  double gyro_cutoff_hz = 12.0;        ///< low-pass on the gyro axis, Hz
+  double acc_floor_m_s2 = 1.0;         ///< thresholds never come closer to 0 than this, m/s^2
+  double gyro_floor_rad_s = 0.5;       ///< same for the angular rate, rad/s
+  double min_interval_s = 0.36;        ///< absolute time threshold, s (foot: 2.8 cycles/s max)
+  double max_interval_s = 3.0;         ///< beyond this the cadence memory is reset, s
+  double min_interval_fraction = 0.5;  ///< time threshold relative to the recent interval
+  double initial_interval_s = 1.0;     ///< cadence memory at start, s
+  double mean_tau_s = 4.0;             ///< time constant of the |f| mean the signal is taken about
+  bool use_gyro = true;                ///< false: acceleration conditions only
+  bool require_stance = true;          ///< foot: a cycle closes with the foot at rest
+  double stance_s = 0.03;              ///< rest needed to close a foot cycle, s
+  double stance_fraction = 0.25;       ///< rest = |f|-g and |w| below this x upper thresholds
 };
 class AdaptiveStepDetector final : public StepDetector {
  public:
@@ -147,9 +147,9 @@ class AdaptiveStepDetector final : public StepDetector {
 /// Baseline: peaks of the low-passed |f| above a fixed height, at least a fixed time apart
 /// (the "peak detection" column of seed 004, Table 2). Parameters suit a normal walk.
 struct PeakStepParams {
-  double cutoff_hz = 5.0;           ///< low-pass on |f|, Hz
-  double min_height_m_s2 = 11.5;    ///< a peak must exceed this |f|, m/s^2
-  double min_distance_s = 0.3;      ///< peaks closer than this are merged, s
+  double cutoff_hz = 5.0;         ///< low-pass on |f|, Hz
+  double min_height_m_s2 = 11.5;  ///< a peak must exceed this |f|, m/s^2
+  double min_distance_s = 0.3;    ///< peaks closer than this are merged, s
 };
 class PeakStepDetector final : public StepDetector {
  public:
@@ -172,10 +172,10 @@ class PeakStepDetector final : public StepDetector {
 
 /// Baseline: rising crossings of a fixed |f| threshold with a refractory time ("fixed threshold").
 struct FixedThresholdStepParams {
-  double cutoff_hz = 5.0;           ///< low-pass on |f|, Hz
-  double threshold_m_s2 = 11.5;     ///< rising crossing of this |f| counts, m/s^2
-  double hysteresis_m_s2 = 1.0;     ///< must fall below threshold - hysteresis to re-arm, m/s^2
-  double refractory_s = 0.3;        ///< minimum time between steps, s
+  double cutoff_hz = 5.0;        ///< low-pass on |f|, Hz
+  double threshold_m_s2 = 11.5;  ///< rising crossing of this |f| counts, m/s^2
+  double hysteresis_m_s2 = 1.0;  ///< must fall below threshold - hysteresis to re-arm, m/s^2
+  double refractory_s = 0.3;     ///< minimum time between steps, s
 };
 class FixedThresholdStepDetector final : public StepDetector {
  public:
@@ -228,7 +228,7 @@ class PeakValleyStepDetector final : public StepDetector {
   enum class Phase { kSeekPeak, kSeekValley } phase_ = Phase::kSeekPeak;
   bool have_t_ = false;
   double last_t_s_ = 0.0;
-  double mean_m_s2_ = 9.80665;   ///< slow running mean of the filtered |f|
+  double mean_m_s2_ = 9.80665;  ///< slow running mean of the filtered |f|
   double prev_peak_ = 0.0, prev_valley_ = 0.0;
   bool have_prev_ = false;
   double cand_peak_ = 0.0, cand_peak_t_s_ = 0.0;

@@ -47,9 +47,11 @@ using fusion::kPoseCount;
 using fusion::PhonePose;
 enum class SensorSite { kFoot, kPhone };
 
-[[nodiscard]] std::string_view gait_name(Gait g);  ///< "slow-walk", "walk", "fast-walk", "jog", "run"
+[[nodiscard]] std::string_view gait_name(
+    Gait g);  ///< "slow-walk", "walk", "fast-walk", "jog", "run"
 [[nodiscard]] std::optional<Gait> gait_from_name(std::string_view name);
-[[nodiscard]] std::string_view pose_name(PhonePose p);  ///< "hand-held", "call", "pocket", "arm-swing"
+[[nodiscard]] std::string_view pose_name(
+    PhonePose p);  ///< "hand-held", "call", "pocket", "arm-swing"
 [[nodiscard]] std::optional<PhonePose> pose_from_name(std::string_view name);
 
 /// Portable deterministic random numbers.
@@ -129,10 +131,10 @@ struct GaitScenario {
 struct GaitSample {
   ImuSample imu;
   Eigen::Vector3d mag_uT = Eigen::Vector3d::Zero();  ///< magnetometer, sensor frame, uT
-  double x_m = 0.0;            ///< truth position east, m
-  double y_m = 0.0;            ///< truth position north, m
-  double heading_deg = 0.0;    ///< truth walking direction, clockwise from north
-  double distance_m = 0.0;     ///< truth distance walked
+  double x_m = 0.0;                                  ///< truth position east, m
+  double y_m = 0.0;                                  ///< truth position north, m
+  double heading_deg = 0.0;  ///< truth walking direction, clockwise from north
+  double distance_m = 0.0;   ///< truth distance walked
   Gait gait = Gait::kWalk;
   PhonePose pose = PhonePose::kHandHeld;
   bool switching = false;      ///< a pose switch is in progress

@@ -36,12 +36,12 @@ namespace telltale::fusion::sim {
 
 /// One closed-loop PDR walk ("loop" scenario of the gait simulator) run through a Pdr.
 struct LoopWalkResult {
-  double distance_m = 0.0;       ///< true distance walked
-  double end_error_m = 0.0;      ///< |estimated end - true end|
-  double error_fraction = 0.0;   ///< end_error_m / distance_m
+  double distance_m = 0.0;      ///< true distance walked
+  double end_error_m = 0.0;     ///< |estimated end - true end|
+  double error_fraction = 0.0;  ///< end_error_m / distance_m
   std::size_t steps_true = 0;
   std::size_t steps_counted = 0;
-  unsigned switches_true = 0;    ///< pose changes in the schedule
+  unsigned switches_true = 0;  ///< pose changes in the schedule
   unsigned switches_detected = 0;
 };
 enum class LoopVariant {
