@@ -196,10 +196,10 @@ void pdr_table(int loops) {
 }
 
 void run_eval(const EvalOptions& o) {
-  if (o.tables.find("pose") != std::string::npos) pose_table();
-  if (o.tables.find("pdr") != std::string::npos) pdr_table(o.loops);
   if (o.tables.find("gait") != std::string::npos) gait_table(o);
   if (o.tables.find("oxford") != std::string::npos) oxford_table(o);
+  if (o.tables.find("pose") != std::string::npos) pose_table();
+  if (o.tables.find("pdr") != std::string::npos) pdr_table(o.loops);
 }
 
 }  // namespace
