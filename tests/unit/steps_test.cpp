@@ -9,6 +9,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -109,6 +110,7 @@ struct GaitCase {
   std::string site;  // foot | body
   std::string gait;  // slow-walk ... run | mixed
 };
+void PrintTo(const GaitCase& c, std::ostream* os) { *os << c.site << "-" << c.gait; }
 std::string case_name(const testing::TestParamInfo<GaitCase>& info) {
   std::string n = info.param.site + "_" + info.param.gait;
   for (auto& c : n)
