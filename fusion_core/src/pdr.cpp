@@ -529,6 +529,10 @@ void Pdr::on_step(double t_s) {
         applied_pose_ = candidate_pose_;
         pose_known_ = true;
       }
+    } else if (!pose_known_ && out_.steps >= static_cast<std::size_t>(params_.pose_confirm_steps)) {
+      // No classification possible (no gyroscope, or no model): keep the hand-held frame
+      // (M = I) rather than holding the track back for ever.
+      pose_known_ = true;
     }
   }
 

@@ -153,6 +153,28 @@ TEST(Pdr, StraightWalkHandHeld) {
   EXPECT_GT(out.cadence_spm, 80.0);
 }
 
+// Given a phone without gyroscope (accelerometer + magnetometer), when walking straight, then
+// the PDR still counts, keeps the hand-held frame and lays the track along the magnetic heading.
+TEST(Pdr, AccelerometerAndMagnetometerOnly) {
+  auto sc = *sim::make_gait_scenario("phone-hand-held-walk", 12);
+  sc.path = {{500.0, 0.0}};
+  sc.start_heading_deg = 200.0;
+  const auto person = sim::random_person(12);
+  const auto run = sim::simulate_gait(sc, person, 12);
+  PdrParams p;
+  p.height_m = person.height_m;
+  Pdr pdr(p);
+  for (auto s : run.samples) {
+    s.imu.gyro_body_rad_s.setConstant(std::nan(""));
+    (void)pdr.update(s.imu, s.mag_uT);
+  }
+  EXPECT_NEAR(static_cast<double>(pdr.output().steps), static_cast<double>(run.step_times_s.size()),
+              1.0);
+  EXPECT_GT(std::hypot(pdr.output().x_m, pdr.output().y_m), 0.9 * run.distance_m);
+  EXPECT_NEAR(std::remainder(std::atan2(pdr.output().x_m, pdr.output().y_m) / kDeg - 200.0, 360.0),
+              0.0, 8.0);
+}
+
 // Given the four poses in turn on a straight walk, then the switches are detected by
 // cross-correlation and the final pose is the true one.
 TEST(Pdr, DetectsPoseSwitchesAndEndsInTheTruePose) {
