@@ -1,16 +1,11 @@
 // wearable_node: an athlete's phone or foot IMU on land -> step detection and dead reckoning
 // (fusion_core PDR) -> WearableMotion over the same DDS as the boats.
 #include <CLI/CLI.hpp>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
 #include <cstdio>
-#include <deque>
 #include <limits>
-#include <mutex>
 #include <regex>
-#include <thread>
 
 #include "csv.hpp"
 #include "dds_participant.hpp"
@@ -18,7 +13,7 @@
 #include "telltale/fusion/pdr.hpp"
 #include "telltale/fusion/sim/gait_sim.hpp"
 #include "telltalePubSubTypes.h"
-#include "witmotion.hpp"
+#include "witmotion_feed.hpp"
 
 namespace {
 
@@ -107,45 +102,21 @@ class ReplayWearable : public WearableSource {
   bool fast_;
 };
 
-/// A WitMotion/JY901 module on a serial port, read on a thread of its own.
+/// A WitMotion/JY901 module on a serial port (the module of paper 004).
 class WitMotionWearable : public WearableSource {
  public:
-  WitMotionWearable(const std::string& device, int baud)
-      : port_(device, baud, [this](const telltale::sensors::WitSample& w) {
-          if (!w.has_gyro) return;
-          std::lock_guard lock(mutex_);
-          queue_.push_back({w.imu, w.has_mag ? w.mag_uT : nan3()});
-          if (queue_.size() > 1000) queue_.pop_front();
-          cv_.notify_one();
-        }) {
-    thread_ = std::thread([this] { port_.run(stop_); });
-  }
-  ~WitMotionWearable() override {
-    stop_ = true;
-    thread_.join();
-  }
+  explicit WitMotionWearable(const std::string& device_and_baud) : feed_(device_and_baud) {}
   std::optional<Sample> next(telltale::ShutdownSignal& shutdown) override {
-    std::unique_lock lock(mutex_);
-    while (queue_.empty()) {
-      if (shutdown.stop_requested()) return std::nullopt;
-      cv_.wait_for(lock, std::chrono::milliseconds(100));
-    }
-    Sample s = queue_.front();
-    queue_.pop_front();
-    return s;
+    const auto w = feed_.next([&] { return shutdown.stop_requested(); });
+    if (!w) return std::nullopt;
+    return Sample{w->imu, w->has_mag ? w->mag_uT
+                                     : Eigen::Vector3d::Constant(
+                                           std::numeric_limits<double>::quiet_NaN())};
   }
   bool real_time() const override { return false; }  // the device paces itself
 
  private:
-  static Eigen::Vector3d nan3() {
-    return Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
-  }
-  telltale::sensors::WitMotionSerial port_;
-  std::atomic<bool> stop_{false};
-  std::mutex mutex_;
-  std::condition_variable cv_;
-  std::deque<Sample> queue_;
-  std::thread thread_;
+  telltale::boat::WitMotionFeed feed_;
 };
 
 std::unique_ptr<WearableSource> make_source(const Options& o) {
@@ -153,15 +124,8 @@ std::unique_ptr<WearableSource> make_source(const Options& o) {
   if (o.source.rfind("sim:", 0) == 0) return std::make_unique<SimWearable>(o.source.substr(4), o.seed);
   if (o.source.rfind("replay:", 0) == 0)
     return std::make_unique<ReplayWearable>(o.source.substr(7), o.replay_fast);
-  if (o.source.rfind("witmotion:", 0) == 0) {
-    std::string dev = o.source.substr(10);
-    int baud = 9600;
-    if (const auto at = dev.find('@'); at != std::string::npos) {
-      baud = std::stoi(dev.substr(at + 1));
-      dev = dev.substr(0, at);
-    }
-    return std::make_unique<WitMotionWearable>(dev, baud);
-  }
+  if (o.source.rfind("witmotion:", 0) == 0)
+    return std::make_unique<WitMotionWearable>(o.source.substr(10));
   throw std::invalid_argument("unknown --source '" + o.source +
                               "' (sim, sim:SCENARIO, replay:FILE.csv, witmotion:DEVICE[@BAUD])");
 }
