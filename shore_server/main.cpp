@@ -123,6 +123,7 @@ int main(int argc, char** argv) {
   Options o;
   int domain = -1;
   CLI::App app{"Telltale shore server: fleet over DDS -> SQLite, REST API, live stream, dashboard"};
+  app.set_config("--config", "", "read options from this file (INI/TOML: key = value)");
   app.add_option("--domain", domain, "DDS domain id (default: $TELLTALE_DOMAIN)");
   app.add_option("--http-port", o.http.port, "HTTP port; 0 picks a free one and prints it")
       ->capture_default_str();
