@@ -4,7 +4,9 @@
 /// main() maps io::CsvError and UsageError to exit status 2 with one line on stderr.
 
 #include <CLI/CLI.hpp>
+#include <functional>
 #include <stdexcept>
+#include <vector>
 
 namespace telltale::cli {
 
@@ -15,5 +17,10 @@ class UsageError : public std::runtime_error {
 };
 
 void register_attitude(CLI::App& app);
+void register_simulate(CLI::App& app);
+/// `eval` is a group: each area (attitude, ...) adds a subcommand through register_eval_<area>
+/// and pushes a runner with its default options; `fusion_cli eval` alone runs them all.
+void register_eval(CLI::App& app);
+void register_eval_attitude(CLI::App& eval, std::vector<std::function<void()>>& run_all);
 
 }  // namespace telltale::cli

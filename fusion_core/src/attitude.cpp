@@ -1,0 +1,56 @@
+// Helpers shared by every attitude filter, and the registry by name.
+#include "telltale/fusion/attitude.hpp"
+
+#include <cmath>
+
+#include "telltale/fusion/attitude_baselines.hpp"
+#include "telltale/fusion/attitude_seed.hpp"
+#include "telltale/fusion/attitude_telltale.hpp"
+
+namespace telltale::fusion {
+
+void tilt_from_accel(const Eigen::Vector3d& f, double& heel_rad, double& pitch_rad) {
+  // At rest f = g (sin(pitch), cos(pitch) sin(heel), cos(pitch) cos(heel)).
+  heel_rad = std::atan2(f.y(), f.z());
+  pitch_rad = std::atan2(f.x(), std::sqrt(f.y() * f.y() + f.z() * f.z()));
+}
+
+void euler_rates_from_body(const Eigen::Vector3d& w, double heel_rad, double pitch_rad,
+                           double& heel_rate_rad_s, double& pitch_rate_rad_s) {
+  // SPEC section 1: pitch is bow-up positive; in FLU a positive rotation about +y (port) puts the
+  // bow down, so pitch = -theta of R = Rz(psi) Ry(theta) Rx(phi) and heel = phi. The standard
+  // Euler-rate relations dphi = p + (q sin(phi) + r cos(phi)) tan(theta),
+  // dtheta = q cos(phi) - r sin(phi) then read as below.
+  const double sh = std::sin(heel_rad);
+  const double ch = std::cos(heel_rad);
+  heel_rate_rad_s = w.x() - (w.y() * sh + w.z() * ch) * std::tan(pitch_rad);
+  pitch_rate_rad_s = -(w.y() * ch - w.z() * sh);
+}
+
+const std::vector<std::string>& attitude_filter_names() {
+  static const std::vector<std::string> names{"telltale", "seed",    "gyro",
+                                              "accel",    "average", "kalman-const"};
+  return names;
+}
+
+std::string attitude_filter_description(std::string_view name) {
+  if (name == "telltale") return "production: quaternion + inertial-frame low-pass + bias (default)";
+  if (name == "seed") return "the paper's time-varying weighted Kalman filter, as published";
+  if (name == "gyro") return "gyro-only Euler integration from the first tilt";
+  if (name == "accel") return "accelerometer-only tilt";
+  if (name == "average") return "fixed-weight average of gyro and accelerometer angles (tau 1 s)";
+  if (name == "kalman-const") return "constant-parameter Kalman filter (angle + bias per axis)";
+  return {};
+}
+
+std::unique_ptr<AttitudeFilter> make_attitude_filter(std::string_view name) {
+  if (name == "telltale") return std::make_unique<TelltaleAttitudeFilter>();
+  if (name == "seed") return std::make_unique<SeedAttitudeFilter>();
+  if (name == "gyro") return std::make_unique<GyroAttitudeFilter>();
+  if (name == "accel") return std::make_unique<AccelAttitudeFilter>();
+  if (name == "average") return std::make_unique<AverageAttitudeFilter>();
+  if (name == "kalman-const") return std::make_unique<ConstKalmanAttitudeFilter>();
+  return nullptr;
+}
+
+}  // namespace telltale::fusion

@@ -1,0 +1,92 @@
+// The paper's time-varying weighted Kalman filter (seed 000/001), as published.
+#include "telltale/fusion/attitude_seed.hpp"
+
+#include <cmath>
+
+namespace telltale::fusion {
+namespace {
+constexpr double kRadToDeg = 180.0 / M_PI;
+}
+
+SeedAttitudeFilter::SeedAttitudeFilter(Params params) : params_(params) {
+  state_.heel.r_deg2 = params_.r_a_deg2;
+  state_.pitch.r_deg2 = params_.r_a_deg2;
+}
+
+double SeedAttitudeFilter::weight_from_da(double da, const Params& p) {
+  // Eq 2. At da = 0.005 the curve gives 1/1.44 = 0.69, so it joins c_max = 0.7 almost smoothly.
+  if (da < p.da_low) return p.c_max;
+  if (da <= p.da_high) {
+    const double s = p.c_slope * da;
+    return 1.0 / (s * s);
+  }
+  return 0.0;
+}
+
+void SeedAttitudeFilter::step_axis(Axis& a, double increment_deg, double acc_deg) const {
+  const double c = state_.c;
+  // Open point 1: the gyro's prior is the last optimal estimate, its increment is measured.
+  a.x(0) = a.out_deg;
+  a.x(2) = increment_deg;
+  // Eq 1, prediction with A = [[1,0,1],[0,1,0],[0,0,1]].
+  Eigen::Matrix3d A;
+  A << 1, 0, 1, 0, 1, 0, 0, 0, 1;
+  const Eigen::Vector3d x_pred = A * a.x;
+  // Eq 3 with Q = diag(0, q_a, q_g) (table 1).
+  Eigen::Matrix3d p_pred = A * a.p * A.transpose();
+  p_pred(1, 1) += params_.q_a_deg2;
+  p_pred(2, 2) += params_.q_g_deg2;
+  // Eq 4: r_k.
+  a.r_deg2 = (c != 0.0) ? params_.r_a_deg2 : a.r_deg2 + params_.dr_deg2;
+  // Eq 1 observation: Y = (1-c) phi_g,meas + c phi_a,meas, H = (1-c, c, 0).
+  const Eigen::RowVector3d H(1.0 - c, c, 0.0);
+  const double y = (1.0 - c) * (a.out_deg + increment_deg) + c * acc_deg;
+  // Eq 3 gain, eq 5 update.
+  const double s = H * p_pred * H.transpose() + a.r_deg2;
+  const Eigen::Vector3d K = p_pred * H.transpose() / s;
+  a.x = x_pred + K * (y - H * x_pred);
+  a.p = (Eigen::Matrix3d::Identity() - K * H) * p_pred;
+  // The published angle: phi_o = (1-c) phi_g(k|k) + c phi_a(k|k).
+  a.out_deg = (1.0 - c) * a.x(0) + c * a.x(1);
+}
+
+void SeedAttitudeFilter::update(const ImuSample& s) {
+  if (!std::isfinite(s.t_s) || !s.gyro_body_rad_s.allFinite() || !s.acc_body_m_s2.allFinite()) {
+    ++diag_.rejected_non_finite;
+    return;
+  }
+  double dt = 0.0;  // the first sample has no increment (X0 = 0 stands for "no history")
+  if (state_.started) {
+    dt = s.t_s - state_.last_t_s;
+    if (!(dt > 0.0)) {
+      ++diag_.rejected_time;
+      return;
+    }
+  }
+  state_.started = true;
+  state_.last_t_s = s.t_s;
+  // Eq 2: da = | |a| - g_c | / g_c from the measured specific force.
+  const double da = std::abs(s.acc_body_m_s2.norm() - params_.g_c_m_s2) / params_.g_c_m_s2;
+  state_.c = weight_from_da(da, params_);
+  double heel_acc = 0.0;
+  double pitch_acc = 0.0;
+  tilt_from_accel(s.acc_body_m_s2, heel_acc, pitch_acc);
+  // Open point 2: body rates -> Euler rates at the last optimal angles.
+  euler_rates_from_body(s.gyro_body_rad_s, state_.heel.out_deg / kRadToDeg,
+                        state_.pitch.out_deg / kRadToDeg, state_.heel_rate_rad_s,
+                        state_.pitch_rate_rad_s);
+  step_axis(state_.heel, state_.heel_rate_rad_s * dt * kRadToDeg, heel_acc * kRadToDeg);
+  step_axis(state_.pitch, state_.pitch_rate_rad_s * dt * kRadToDeg, pitch_acc * kRadToDeg);
+}
+
+AttitudeOutput SeedAttitudeFilter::output() const {
+  return {state_.heel.out_deg / kRadToDeg,
+          state_.pitch.out_deg / kRadToDeg,
+          state_.heel_rate_rad_s,
+          state_.pitch_rate_rad_s,
+          state_.c,
+          state_.c / params_.c_max,
+          state_.started};
+}
+
+}  // namespace telltale::fusion
