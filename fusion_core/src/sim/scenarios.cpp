@@ -292,6 +292,20 @@ bool ImuScenario::next(ImuSample& imu, AttitudeTruth& truth) {
   } while (k_ > 1 && options_.drop_probability > 0.0 && u(timing_rng_) < options_.drop_probability);
   if (k_ == 1) t = 0.0;
   if (duration_s_ > 0.0 && t > duration_s_) return false;
+  // The sensors' decimation filters, modelled as the mean over the sample interval (BROAD's
+  // gyro behaves this way: integrating its samples as interval means beats treating them as
+  // instants). Gyro: the exact mean rate, from the attitude increment. Accelerometer: the mean of
+  // four sub-samples (midpoint rule).
+  Eigen::Vector3d acc_mean = Eigen::Vector3d::Zero();
+  const double dt = t - last_t_s_;
+  const bool first = k_ == 1;
+  if (!first) {
+    constexpr int kSub = 4;
+    for (int j = 0; j < kSub; ++j) {
+      const double tj = last_t_s_ + (j + 0.5) / kSub * dt;
+      acc_mean += specific_force_body(trajectory_->motion(tj), lever_arm_, options_.g_m_s2) / kSub;
+    }
+  }
   const RigidMotion m = trajectory_->motion(t);
   truth.t_s = t;
   heel_pitch_of(m.att, truth.heel_rad, truth.pitch_rad);
@@ -299,8 +313,15 @@ bool ImuScenario::next(ImuSample& imu, AttitudeTruth& truth) {
   truth.yaw_rad = std::atan2(x_world.y(), x_world.x());
   euler_rates_from_body(m.omega_body_rad_s, truth.heel_rad, truth.pitch_rad, truth.heel_rate_rad_s,
                         truth.pitch_rate_rad_s);
-  truth.gyro_true_rad_s = m.omega_body_rad_s;
-  truth.acc_true_m_s2 = specific_force_body(m, lever_arm_, options_.g_m_s2);
+  if (first) {
+    truth.gyro_true_rad_s = m.omega_body_rad_s;
+    truth.acc_true_m_s2 = specific_force_body(m, lever_arm_, options_.g_m_s2);
+  } else {
+    const Eigen::AngleAxisd inc(last_att_.conjugate() * m.att);
+    truth.gyro_true_rad_s = inc.angle() / dt * inc.axis();
+    truth.acc_true_m_s2 = acc_mean;
+  }
+  last_att_ = m.att;
   imu.t_s = t;
   errors_.apply(t - last_t_s_, rate_hz_, truth.gyro_true_rad_s, truth.acc_true_m_s2,
                 imu.gyro_body_rad_s, imu.acc_body_m_s2);

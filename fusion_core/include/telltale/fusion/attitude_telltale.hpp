@@ -4,7 +4,7 @@
 /// node. It keeps the paper's idea (trust the accelerometer only while the motion is inertial) and
 /// adds what is needed to hold +-1 deg on a boat:
 ///   - full 3-D kinematics: the gyro is integrated as a quaternion (no per-axis Euler integration),
-///     trapezoidal in the rate so 25 Hz sampling does not lag;
+///     each sample as the mean rate over the interval that ends at it (decimation filter);
 ///   - the accelerometer is rotated into a quasi-inertial frame (the gyro-integrated frame I) and
 ///     low-passed THERE (two first-order stages, tau_acc_s each): in an earth-fixed frame the
 ///     mean of any bounded motion's acceleration is dv/T -> 0, so waves, a pendulum's swing, a
@@ -46,7 +46,8 @@ struct TelltaleAttitudeParams {
   double rest_gyro_rad_s = 0.035;  ///< 2 deg/s
   double rest_acc_m_s2 = 0.4;
   double rest_min_s = 1.0;
-  double rest_bias_match_rad_s = 0.005;  ///< 0.3 deg/s: rest means the gyro reads the known bias
+  double rest_bias_match_rad_s = 0.0026;  ///< 0.15 deg/s: rest = the gyro reads the known bias
+  double rest_bias_tau_s = 5.0;  ///< bias refinement at rest after the first (which sets it)
   double rest_lp_tau_s = 0.5;      ///< low-pass of gyro/acc for the rest test and the bias
   /// Bias learning in motion: time constant of the integral of the accelerometer corrections.
   double bias_motion_tau_s = 60.0;
@@ -67,7 +68,6 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
     Eigen::Vector3d acc_lp1_i = Eigen::Vector3d::Zero();  ///< first low-pass stage, frame I
     Eigen::Vector3d acc_lp2_i = Eigen::Vector3d::Zero();  ///< second stage, frame I
     Eigen::Vector3d acc_fast_i = Eigen::Vector3d::Zero();  ///< 1 s low-pass for the gate, frame I
-    Eigen::Vector3d gyro_prev_rad_s = Eigen::Vector3d::Zero();
     Eigen::Vector3d gyro_rest_lp_rad_s = Eigen::Vector3d::Zero();
     Eigen::Vector3d acc_rest_lp_m_s2 = Eigen::Vector3d::Zero();
     double rest_time_s = 0.0;

@@ -42,8 +42,10 @@ struct AttitudeTruth {
   double yaw_rad = 0.0;  ///< counter-clockwise from world x (ENU), not a compass heading
   double heel_rate_rad_s = 0.0;
   double pitch_rate_rad_s = 0.0;
+  /// What an error-free sensor reads: the mean body rate and specific force (at the sensor) over
+  /// the sample interval (the sensors' decimation filter); instantaneous for the first sample.
   Eigen::Vector3d gyro_true_rad_s = Eigen::Vector3d::Zero();
-  Eigen::Vector3d acc_true_m_s2 = Eigen::Vector3d::Zero();  ///< specific force at the sensor
+  Eigen::Vector3d acc_true_m_s2 = Eigen::Vector3d::Zero();
 };
 
 /// Timing and sensor options of a run.
@@ -76,6 +78,7 @@ class ImuScenario {
   std::mt19937_64 timing_rng_;
   std::uint64_t k_ = 0;
   double last_t_s_ = 0.0;
+  Eigen::Quaterniond last_att_ = Eigen::Quaterniond::Identity();
 };
 
 [[nodiscard]] const std::vector<std::string>& scenario_names();
