@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "broad.hpp"
 #include "commands.hpp"
 #include "csv.hpp"
 #include "telltale/fusion/attitude_eval.hpp"
@@ -40,38 +41,6 @@ std::string find_broad_dir(const std::string& requested) {
     if (std::filesystem::is_directory(d)) return d;
   }
   return {};
-}
-
-/// Reads TRIAL.imu.csv + TRIAL.truth.csv (BROAD README: score rows with movement = 1 and truth).
-fusion::InclinationTrial load_broad_trial(const std::string& imu_path, const std::string& truth_path) {
-  constexpr double kDeg = M_PI / 180.0;
-  const io::CsvTable imu = io::read_csv(
-      imu_path,
-      {{"t_s"}, {"gx_rad_s"}, {"gy_rad_s"}, {"gz_rad_s"}, {"ax_m_s2"}, {"ay_m_s2"}, {"az_m_s2"}},
-      "t_s");
-  const io::CsvTable truth = io::read_csv(
-      truth_path,
-      {{"t_s"}, {"heel_deg", true, true}, {"pitch_deg", true, true}, {"movement"}}, "t_s");
-  if (truth.rows() != imu.rows()) {
-    throw io::CsvError(truth_path + ":1:1: " + std::to_string(truth.rows()) + " rows, the IMU file has " +
-                       std::to_string(imu.rows()));
-  }
-  fusion::InclinationTrial tr;
-  const std::size_t n = imu.rows();
-  tr.imu.resize(n);
-  tr.heel_true_rad.resize(n);
-  tr.pitch_true_rad.resize(n);
-  tr.scored.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    tr.imu[i].t_s = imu.columns[0][i];
-    tr.imu[i].gyro_body_rad_s = {imu.columns[1][i], imu.columns[2][i], imu.columns[3][i]};
-    tr.imu[i].acc_body_m_s2 = {imu.columns[4][i], imu.columns[5][i], imu.columns[6][i]};
-    tr.heel_true_rad[i] = truth.columns[1][i] * kDeg;
-    tr.pitch_true_rad[i] = truth.columns[2][i] * kDeg;
-    tr.scored[i] = truth.columns[3][i] == 1.0 && std::isfinite(tr.heel_true_rad[i]) &&
-                   std::isfinite(tr.pitch_true_rad[i]);
-  }
-  return tr;
 }
 
 void run_eval_attitude(const EvalAttitudeOptions& o) {
@@ -135,7 +104,7 @@ void run_eval_attitude(const EvalAttitudeOptions& o) {
   std::vector<double> sum(filters.size(), 0.0);
   for (const auto& trial : trials) {
     progress("eval attitude: BROAD " + trial);
-    const auto data = load_broad_trial(dir + "/" + trial + ".imu.csv", dir + "/" + trial + ".truth.csv");
+    const auto data = io::read_broad_trial(dir + "/" + trial + ".imu.csv", dir + "/" + trial + ".truth.csv");
     std::printf("| %s |", trial.c_str());
     for (std::size_t i = 0; i < filters.size(); ++i) {
       auto filter = fusion::make_attitude_filter(filters[i]);

@@ -25,8 +25,9 @@ double SeedAttitudeFilter::weight_from_da(double da, const Params& p) {
 
 void SeedAttitudeFilter::step_axis(Axis& a, double increment_deg, double acc_deg) const {
   const double c = state_.c;
-  // Open point 1: the gyro's prior is the last optimal estimate, its increment is measured.
-  a.x(0) = a.out_deg;
+  // Open point 1: the increment state is the measured one; the filter keeps its own phi_g (the
+  // prior of the optimal estimate enters through Y below). Overwriting phi_g(k-1|k-1) with phi_o
+  // too was tried: the state then no longer matches P and the filter diverges at 100 Hz.
   a.x(2) = increment_deg;
   // Eq 1, prediction with A = [[1,0,1],[0,1,0],[0,0,1]].
   Eigen::Matrix3d A;
@@ -38,7 +39,9 @@ void SeedAttitudeFilter::step_axis(Axis& a, double increment_deg, double acc_deg
   p_pred(2, 2) += params_.q_g_deg2;
   // Eq 4: r_k.
   a.r_deg2 = (c != 0.0) ? params_.r_a_deg2 : a.r_deg2 + params_.dr_deg2;
-  // Eq 1 observation: Y = (1-c) phi_g,meas + c phi_a,meas, H = (1-c, c, 0).
+  // Eq 1 observation: Y = (1-c) phi_g,meas + c phi_a,meas, H = (1-c, c, 0), where the gyro's
+  // measured angle uses the last optimal estimate as its prior ("the optimal estimate serves as
+  // the gyro's prior angle, correcting its drift in real time"): phi_g,meas = phi_o(k-1) + dphi.
   const Eigen::RowVector3d H(1.0 - c, c, 0.0);
   const double y = (1.0 - c) * (a.out_deg + increment_deg) + c * acc_deg;
   // Eq 3 gain, eq 5 update.

@@ -124,6 +124,24 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
       std::max(nonin, state_.nonin_hold_m_s2 * (1.0 - dt / (p.nonin_release_s + dt)));
   double w = 1.0 - (state_.nonin_hold_m_s2 - p.nonin_low_m_s2) /
                        (p.nonin_high_m_s2 - p.nonin_low_m_s2);
+  // A vehicle turning while it moves has a centripetal acceleration (a tack: 2.5 m/s * 0.5 rad/s
+  // = 1.25 m/s^2 for seconds) that the low-pass would absorb as a tilt. Signature: a horizontal
+  // acceleration across the heading, toward the side the vehicle turns to. A rotation in place
+  // (a turntable's axis, a hand turning the sensor) has no such correlation.
+  const Eigen::Quaterniond q_now = state_.q_corr * state_.q_gyro;
+  const Eigen::Vector3d w_e = q_now * (s.gyro_body_rad_s - state_.bias_rad_s);
+  const Eigen::Vector3d a_e = q_now * s.acc_body_m_s2;
+  const Eigen::Vector3d x_e = q_now * Eigen::Vector3d::UnitX();
+  const double xh = std::sqrt(x_e.x() * x_e.x() + x_e.y() * x_e.y());
+  double turn = 0.0;
+  if (xh > 0.3) {
+    const double a_lat = (-x_e.y() * a_e.x() + x_e.x() * a_e.y()) / xh;  // (z x x_h) . a_e
+    turn = a_lat * std::clamp(w_e.z() / p.turn_rate_rad_s, -1.0, 1.0);
+  }
+  state_.turn_m_s2 += (dt / (p.turn_tau_s + dt)) * (turn - state_.turn_m_s2);
+  state_.turn_hold_m_s2 = std::max(state_.turn_m_s2, state_.turn_hold_m_s2 * (1.0 - dt / (p.turn_release_s + dt)));
+  const double w_turn = 1.0 - clamp01((state_.turn_hold_m_s2 - p.turn_low_m_s2) / (p.turn_high_m_s2 - p.turn_low_m_s2));
+  w *= w_turn;
   w = std::max(p.w_min, clamp01(w));
   // At rest the motion is inertial by definition: the tilt error accumulated before the bias was
   // known (10 deg/s for a second) must not look like a linear acceleration and lock the gate.
@@ -134,7 +152,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // --- Low-pass in frame I. Fed with every sample: gating its input would bias the mean that
   // makes oscillations cancel (a shake with sharp stops and gentle starts would leave a residue).
   const double tau = at_rest ? p.tau_acc_rest_s : p.tau_acc_s;
-  const double a_lp = dt / (tau + dt);
+  const double a_lp = (at_rest ? 1.0 : std::max(p.lp_turn_min, w_turn)) * dt / (tau + dt);
   state_.acc_lp1_i += a_lp * (acc_i - state_.acc_lp1_i);
   state_.acc_lp2_i += a_lp * (state_.acc_lp1_i - state_.acc_lp2_i);
 

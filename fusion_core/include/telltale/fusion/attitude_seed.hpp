@@ -11,9 +11,10 @@
 ///
 /// Points the paper leaves open and how they are resolved (see attitude_seed.cpp for the why):
 ///  1. The gyro increment enters as the state dphi_g: before each prediction dphi_g(k-1|k-1) is
-///     replaced by the measured increment (heel or pitch rate) * dt, and phi_g(k-1|k-1) by the
-///     last optimal estimate phi_o (the paper: "the optimal estimate serves as the gyro's prior").
-///     The gyro "measurement" in Y(k) is therefore phi_o(k-1) + rate*dt.
+///     replaced by the measured increment (heel or pitch rate) * dt, so eq 1's prediction adds it
+///     to phi_g. The gyro's measured angle in Y(k) is phi_o(k-1) + rate*dt: the last optimal
+///     estimate is the gyro's prior (the paper: "the optimal estimate serves as the gyro's prior
+///     angle, correcting its drift in real time").
 ///  2. Body rates -> heel/pitch rates: full ZYX Euler kinematics (euler_rates_from_body) at the
 ///     last optimal heel and pitch, so the two per-axis filters are coupled only through it.
 ///  3. dr (eq 4) is a parameter; default 0.005 deg^2 per sample (see SeedAttitudeParams::dr).

@@ -11,7 +11,10 @@
 ///     turntable's centripetal acceleration (a vector that rotates with the yaw) average out while
 ///     gravity stays put (the idea of Laidig & Seel's VQF, 2023);
 ///   - a non-inertial test that sees horizontal accelerations (|a_I - lowpass(a_I)|, not |a| ~ g),
-///     with a peak hold: while it is high the low-pass is not fed (weight -> w_min);
+///     with a peak hold: while it is high the accelerometer's correction is scaled down
+///     (weight -> w_min) and the gyro carries the attitude;
+///   - a turn test (centripetal acceleration across the heading, toward the turn): during a tack
+///     the low-pass is not fed either, so the tack's acceleration is not remembered as a tilt;
 ///   - gyro bias estimated online: fast at rest (rest detection), slowly in motion from the
 ///     corrections the accelerometer has to make;
 ///   - non-uniform time steps, dropped samples (gaps up to max_gap_s are integrated, longer gaps
@@ -41,6 +44,16 @@ struct TelltaleAttitudeParams {
   double nonin_high_m_s2 = 2.0;
   double nonin_lp_tau_s = 1.0;   ///< the test compares a_I with its low-pass of this time constant
   double nonin_release_s = 1.0;  ///< decay time of the peak hold of the non-inertial measure
+  /// Turn test: a vehicle turning while it moves accelerates toward the inside of the turn.
+  /// Measure = low-pass(lateral horizontal acceleration * clamp(yaw rate / turn_rate_rad_s, +-1)),
+  /// with a peak hold; between turn_low and turn_high the low-pass input and the weight fade
+  /// to lp_turn_min and w_min.
+  double turn_rate_rad_s = 0.1;
+  double turn_tau_s = 0.5;
+  double turn_release_s = 2.0;
+  double turn_low_m_s2 = 0.4;
+  double turn_high_m_s2 = 1.5;
+  double lp_turn_min = 0.1;
   double w_min = 0.05;           ///< floor of the accelerometer weight (keeps long-run correction)
   /// Rest detection (gyro bias learning): deviations below these for rest_min_s.
   double rest_gyro_rad_s = 0.035;  ///< 2 deg/s
@@ -73,6 +86,8 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
     double rest_time_s = 0.0;
     bool bias_known = false;  ///< a rest has been seen
     double nonin_hold_m_s2 = 0.0;
+    double turn_m_s2 = 0.0;
+    double turn_hold_m_s2 = 0.0;
     double weight = 0.0;
     double tilt_var_rad2 = 0.0;  ///< rough tilt variance behind `quality`
     double last_t_s = 0.0;

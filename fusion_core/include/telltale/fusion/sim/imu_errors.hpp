@@ -22,8 +22,12 @@ struct ImuErrorParams {
   double gyro_bias_walk_rad_s_sqrt_s = 0.005 * M_PI / 180.0;  ///< assumed: 0.03 dps/degC drift
                                                              ///< (Table 4) over a few degC/hour
   double gyro_noise_density_rad_s_sqrt_hz = 0.03 * M_PI / 180.0;  ///< 0.03 dps/sqrt(Hz) (Table 4)
-  double gyro_scale_max = 0.02;  ///< sensitivity change +-2 % (Table 4, vs temperature), uniform
-  double gyro_misalign_max_rad = 0.01;  ///< assumed: 1 % cross-axis (not in the datasheet)
+  /// Scale and cross-axis after the instrument's one-off rate-table calibration (assumed
+  /// residual; the datasheet's +-2 % sensitivity change spans -40..85 degC, i.e. ~0.3 % over a
+  /// +-15 degC season). uncalibrated() has the raw +-2 % and 1 % cross-axis (typical MEMS; the
+  /// L3G4200D datasheet gives none).
+  double gyro_scale_max = 0.003;
+  double gyro_misalign_max_rad = 0.002;
   double gyro_lsb_rad_s = 8.75e-3 * M_PI / 180.0;  ///< 8.75 mdps/digit (Table 4)
   double gyro_full_scale_rad_s = 32767 * 8.75e-3 * M_PI / 180.0;  ///< 16-bit register, 286.7 dps
 
