@@ -17,14 +17,22 @@ void tilt_from_accel(const Eigen::Vector3d& f, double& heel_rad, double& pitch_r
 
 void euler_rates_from_body(const Eigen::Vector3d& w, double heel_rad, double pitch_rad,
                            double& heel_rate_rad_s, double& pitch_rate_rad_s) {
+  const double cp = std::cos(pitch_rad);
+  const Eigen::Vector3d up(std::sin(pitch_rad), cp * std::sin(heel_rad), cp * std::cos(heel_rad));
+  euler_rates_from_up(w, up, heel_rate_rad_s, pitch_rate_rad_s);
+}
+
+void euler_rates_from_up(const Eigen::Vector3d& w, const Eigen::Vector3d& u,
+                         double& heel_rate_rad_s, double& pitch_rate_rad_s) {
   // SPEC section 1: pitch is bow-up positive; in FLU a positive rotation about +y (port) puts the
   // bow down, so pitch = -theta of R = Rz(psi) Ry(theta) Rx(phi) and heel = phi. The standard
   // Euler-rate relations dphi = p + (q sin(phi) + r cos(phi)) tan(theta),
-  // dtheta = q cos(phi) - r sin(phi) then read as below.
-  const double sh = std::sin(heel_rad);
-  const double ch = std::cos(heel_rad);
-  heel_rate_rad_s = w.x() - (w.y() * sh + w.z() * ch) * std::tan(pitch_rad);
-  pitch_rate_rad_s = -(w.y() * ch - w.z() * sh);
+  // dtheta = q cos(phi) - r sin(phi) become, with sin(heel) = u_y / c, cos(heel) = u_z / c,
+  // tan(pitch) = u_x / c, c = cos(pitch) = hypot(u_y, u_z):
+  const double c2 = u.y() * u.y() + u.z() * u.z();
+  const double c = std::sqrt(c2);
+  heel_rate_rad_s = w.x() - u.x() * (w.y() * u.y() + w.z() * u.z()) / c2;
+  pitch_rate_rad_s = (w.z() * u.y() - w.y() * u.z()) / c;
 }
 
 const std::vector<std::string>& attitude_filter_names() {

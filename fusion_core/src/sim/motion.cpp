@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include "telltale/fusion/attitude.hpp"
+
 namespace telltale::fusion::sim {
 
 Eigen::Vector3d specific_force_body(const RigidMotion& m, const Eigen::Vector3d& r, double g) {
@@ -12,9 +14,7 @@ Eigen::Vector3d specific_force_body(const RigidMotion& m, const Eigen::Vector3d&
 }
 
 void heel_pitch_of(const Eigen::Quaterniond& att, double& heel_rad, double& pitch_rad) {
-  const Eigen::Vector3d u = att.conjugate() * Eigen::Vector3d::UnitZ();
-  heel_rad = std::atan2(u.y(), u.z());
-  pitch_rad = std::atan2(u.x(), std::hypot(u.y(), u.z()));
+  tilt_from_accel(att.conjugate() * Eigen::Vector3d::UnitZ(), heel_rad, pitch_rad);
 }
 
 Eigen::Quaterniond attitude_from_euler(double heel_rad, double pitch_rad, double yaw_rad) {

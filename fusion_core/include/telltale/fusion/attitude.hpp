@@ -55,6 +55,11 @@ void tilt_from_accel(const Eigen::Vector3d& acc_body_m_s2, double& heel_rad, dou
 void euler_rates_from_body(const Eigen::Vector3d& gyro_body_rad_s, double heel_rad,
                            double pitch_rad, double& heel_rate_rad_s, double& pitch_rate_rad_s);
 
+/// The same relation from the world's up vector seen in the body,
+/// up = (sin(pitch), cos(pitch) sin(heel), cos(pitch) cos(heel)), without trigonometry.
+void euler_rates_from_up(const Eigen::Vector3d& gyro_body_rad_s, const Eigen::Vector3d& up_body,
+                         double& heel_rate_rad_s, double& pitch_rate_rad_s);
+
 /// Names accepted by make_attitude_filter, the default first.
 [[nodiscard]] const std::vector<std::string>& attitude_filter_names();
 /// One-line description of a filter (for --help).

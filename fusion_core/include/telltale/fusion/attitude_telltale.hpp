@@ -36,7 +36,7 @@ namespace telltale::fusion {
 struct TelltaleAttitudeParams {
   double g_m_s2 = kStandardGravity_m_s2;
   /// Time constant of each of the two low-pass stages on the accelerometer in the inertial frame.
-  double tau_acc_s = 3.0;
+  double tau_acc_s = 3.5;
   /// Same, while the sensor is at rest (nothing to reject; converge fast).
   double tau_acc_rest_s = 0.2;
   /// Non-inertial test: |a_I - lowpass| (m/s^2) below low -> weight 1, above high -> w_min.
@@ -103,7 +103,7 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
     unsigned rest_samples = 0;    ///< samples spent learning the bias at rest
   };
 
-  explicit TelltaleAttitudeFilter(Params params = {}) : params_(params) {}
+  explicit TelltaleAttitudeFilter(Params params = {});
   void update(const ImuSample& sample) override;
   [[nodiscard]] AttitudeOutput output() const override { return state_.out; }
   [[nodiscard]] const State& state() const { return state_; }
@@ -113,7 +113,14 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
 
  private:
   void initialise(const ImuSample& s);
+  /// 1 / time constant (and 1 / threshold span) of every Params entry used per sample, so the
+  /// update multiplies instead of dividing.
+  struct Rates {
+    double rest_lp, rest_bias, nonin_lp, nonin_release, turn_lp, turn_release, acc, acc_rest,
+        bias_motion, nonin_range, turn_range, turn_rate;
+  };
   Params params_;
+  Rates rates_{};
   State state_;
   Diagnostics diag_;
 };
