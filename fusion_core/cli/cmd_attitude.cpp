@@ -20,11 +20,12 @@ struct AttitudeOptions {
 
 void run_attitude(const AttitudeOptions& o) {
   auto filter = fusion::make_attitude_filter(o.filter);
-  if (!filter) throw UsageError("unknown filter '" + o.filter + "' (see fusion_cli attitude --help)");
-  io::CsvReader reader(o.in,
-                       {{"t_s"}, {"gx_rad_s"}, {"gy_rad_s"}, {"gz_rad_s"}, {"ax_m_s2"},
-                        {"ay_m_s2"}, {"az_m_s2"}},
-                       "t_s");
+  if (!filter)
+    throw UsageError("unknown filter '" + o.filter + "' (see fusion_cli attitude --help)");
+  io::CsvReader reader(
+      o.in,
+      {{"t_s"}, {"gx_rad_s"}, {"gy_rad_s"}, {"gz_rad_s"}, {"ax_m_s2"}, {"ay_m_s2"}, {"az_m_s2"}},
+      "t_s");
   io::CsvWriter writer(o.out, {"t_s", "heel_deg", "pitch_deg", "heel_rate_deg_s",
                                "pitch_rate_deg_s", "acc_weight", "quality"});
   std::vector<double> row;
@@ -55,12 +56,14 @@ void run_attitude(const AttitudeOptions& o) {
 
 void register_attitude(CLI::App& app) {
   auto opts = std::make_shared<AttitudeOptions>();
-  std::string filters = "filter name (default " + std::string(fusion::kDefaultAttitudeFilter) + "):";
+  std::string filters =
+      "filter name (default " + std::string(fusion::kDefaultAttitudeFilter) + "):";
   for (const auto& n : fusion::attitude_filter_names()) {
     filters += "\n  " + n + ": " + fusion::attitude_filter_description(n);
   }
   auto* cmd = app.add_subcommand("attitude", "Heel and pitch from an IMU CSV");
-  cmd->add_option("--in", opts->in, "IMU CSV: t_s,gx_rad_s,gy_rad_s,gz_rad_s,ax_m_s2,ay_m_s2,az_m_s2")
+  cmd->add_option("--in", opts->in,
+                  "IMU CSV: t_s,gx_rad_s,gy_rad_s,gz_rad_s,ax_m_s2,ay_m_s2,az_m_s2")
       ->required();
   cmd->add_option("--out", opts->out,
                   "output CSV: t_s,heel_deg,pitch_deg,heel_rate_deg_s,pitch_rate_deg_s,"

@@ -37,7 +37,8 @@ void progress_done() {
 
 std::string find_broad_dir(const std::string& requested) {
   if (!requested.empty()) return requested;
-  for (const char* d : {"/work/shared/data/broad", "../shared/data/broad", "../../shared/data/broad"}) {
+  for (const char* d :
+       {"/work/shared/data/broad", "../shared/data/broad", "../../shared/data/broad"}) {
     if (std::filesystem::is_directory(d)) return d;
   }
   return {};
@@ -52,11 +53,14 @@ void run_eval_attitude(const EvalAttitudeOptions& o) {
     if (!fusion::make_attitude_filter(f)) throw UsageError("unknown filter '" + f + "'");
   }
   for (const auto& s : scenarios) {
-    if (!fusion::sim::make_scenario(s, 1, 25.0, 1.0)) throw UsageError("unknown scenario '" + s + "'");
+    if (!fusion::sim::make_scenario(s, 1, 25.0, 1.0))
+      throw UsageError("unknown scenario '" + s + "'");
   }
   for (const double rate : o.rates_hz) {
-    std::printf("\n## attitude: simulator, %d seeds, %.0f Hz: heel RMS, pitch RMS (heel max, pitch max), deg\n\n",
-                o.seeds, rate);
+    std::printf(
+        "\n## attitude: simulator, %d seeds, %.0f Hz: heel RMS, pitch RMS (heel max, pitch max), "
+        "deg\n\n",
+        o.seeds, rate);
     std::printf("| scenario |");
     for (const auto& f : filters) std::printf(" %s |", f.c_str());
     std::printf("\n|---|");
@@ -67,7 +71,8 @@ void run_eval_attitude(const EvalAttitudeOptions& o) {
       for (int seed = 1; seed <= o.seeds; ++seed) {
         progress("eval attitude: " + sc + " seed " + std::to_string(seed) + " at " +
                  std::to_string(static_cast<int>(rate)) + " Hz");
-        const auto st = fusion::evaluate_on_scenario(filters, sc, static_cast<std::uint64_t>(seed), rate);
+        const auto st =
+            fusion::evaluate_on_scenario(filters, sc, static_cast<std::uint64_t>(seed), rate);
         for (std::size_t i = 0; i < filters.size(); ++i) total[i].merge(st[i]);
       }
       progress_done();
@@ -104,7 +109,8 @@ void run_eval_attitude(const EvalAttitudeOptions& o) {
   std::vector<double> sum(filters.size(), 0.0);
   for (const auto& trial : trials) {
     progress("eval attitude: BROAD " + trial);
-    const auto data = io::read_broad_trial(dir + "/" + trial + ".imu.csv", dir + "/" + trial + ".truth.csv");
+    const auto data =
+        io::read_broad_trial(dir + "/" + trial + ".imu.csv", dir + "/" + trial + ".truth.csv");
     std::printf("| %s |", trial.c_str());
     for (std::size_t i = 0; i < filters.size(); ++i) {
       auto filter = fusion::make_attitude_filter(filters[i]);
@@ -117,7 +123,8 @@ void run_eval_attitude(const EvalAttitudeOptions& o) {
     std::fflush(stdout);
   }
   std::printf("| **mean** |");
-  for (const double s : sum) std::printf(" **%.2f** |", trials.empty() ? 0.0 : s / static_cast<double>(trials.size()));
+  for (const double s : sum)
+    std::printf(" **%.2f** |", trials.empty() ? 0.0 : s / static_cast<double>(trials.size()));
   std::printf("\n");
 }
 
@@ -125,7 +132,8 @@ void run_eval_attitude(const EvalAttitudeOptions& o) {
 
 void register_eval_attitude(CLI::App& eval, std::vector<std::function<void()>>& run_all) {
   auto opts = std::make_shared<EvalAttitudeOptions>();
-  auto* cmd = eval.add_subcommand("attitude", "heel/pitch: scenario x filter errors, BROAD inclination RMSE");
+  auto* cmd = eval.add_subcommand("attitude",
+                                  "heel/pitch: scenario x filter errors, BROAD inclination RMSE");
   cmd->add_option("--seeds", opts->seeds, "simulator seeds per scenario")->capture_default_str();
   cmd->add_option("--rate-hz", opts->rates_hz, "sample rates")->capture_default_str();
   cmd->add_option("--filters", opts->filters, "filters (default: all)");

@@ -23,8 +23,8 @@ void run_simulate(const SimulateOptions& o) {
       o.duration_s > 0.0 ? o.duration_s : fusion::sim::scenario_default_duration_s(o.scenario);
   auto sc = fusion::sim::make_scenario(o.scenario, o.seed, o.rate_hz, duration);
   if (!sc) throw UsageError("unknown scenario '" + o.scenario + "' or bad --rate-hz");
-  io::CsvWriter imu_out(o.out, {"t_s", "gx_rad_s", "gy_rad_s", "gz_rad_s", "ax_m_s2", "ay_m_s2",
-                                "az_m_s2"});
+  io::CsvWriter imu_out(
+      o.out, {"t_s", "gx_rad_s", "gy_rad_s", "gz_rad_s", "ax_m_s2", "ay_m_s2", "az_m_s2"});
   io::CsvWriter truth_out(o.truth, {"t_s", "heel_deg", "pitch_deg", "yaw_deg", "heel_rate_deg_s",
                                     "pitch_rate_deg_s", "scored"});
   constexpr double kDeg = 180.0 / M_PI;
@@ -47,7 +47,8 @@ void register_simulate(CLI::App& app) {
   auto opts = std::make_shared<SimulateOptions>();
   std::string names = "scenario:";
   for (const auto& n : fusion::sim::scenario_names()) names += " " + n;
-  auto* cmd = app.add_subcommand("simulate", "Simulated IMU CSV and its truth (scenarios of the tests)");
+  auto* cmd =
+      app.add_subcommand("simulate", "Simulated IMU CSV and its truth (scenarios of the tests)");
   cmd->add_option("scenario", opts->scenario, names)->required();
   cmd->add_option("--seed", opts->seed, "random seed")->capture_default_str();
   cmd->add_option("--out", opts->out, "IMU CSV: t_s,gx_rad_s,...,az_m_s2")->required();

@@ -14,9 +14,9 @@ fusion::InclinationTrial read_broad_trial(const std::string& imu_path,
       imu_path,
       {{"t_s"}, {"gx_rad_s"}, {"gy_rad_s"}, {"gz_rad_s"}, {"ax_m_s2"}, {"ay_m_s2"}, {"az_m_s2"}},
       "t_s");
-  const CsvTable truth = read_csv(
-      truth_path, {{"t_s"}, {"heel_deg", true, true}, {"pitch_deg", true, true}, {"movement"}},
-      "t_s");
+  const CsvTable truth =
+      read_csv(truth_path,
+               {{"t_s"}, {"heel_deg", true, true}, {"pitch_deg", true, true}, {"movement"}}, "t_s");
   if (truth.rows() != imu.rows()) {
     throw CsvError(truth_path + ":1:1: " + std::to_string(truth.rows()) +
                    " rows, but the IMU file has " + std::to_string(imu.rows()));

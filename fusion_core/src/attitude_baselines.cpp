@@ -8,36 +8,18 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
 
-bool finite_sample(const ImuSample& s) {
-  return std::isfinite(s.t_s) && s.gyro_body_rad_s.allFinite() && s.acc_body_m_s2.allFinite();
-}
-
-/// Shared gate of the integrating baselines: false (and counted) for a sample to drop; on the
-/// first sample initialises heel/pitch from the accelerometer and sets dt = 0.
+/// Shared gate of the integrating baselines; on the first sample initialises heel/pitch from the
+/// accelerometer (dt = 0).
 bool accept(const ImuSample& s, EulerTiltState& st, BaselineDiagnostics& d, double& dt) {
-  if (!finite_sample(s)) {
-    ++d.rejected_non_finite;
-    return false;
-  }
-  if (!st.initialised) {
-    tilt_from_accel(s.acc_body_m_s2, st.heel_rad, st.pitch_rad);
-    st.initialised = true;
-    st.last_t_s = s.t_s;
-    dt = 0.0;
-    return true;
-  }
-  dt = s.t_s - st.last_t_s;
-  if (!(dt > 0.0)) {
-    ++d.rejected_time;
-    return false;
-  }
-  st.last_t_s = s.t_s;
-  return true;
+  const SampleGate g =
+      gate_sample(s, st.initialised, st.last_t_s, dt, d.rejected_non_finite, d.rejected_time);
+  if (g == SampleGate::kFirst) tilt_from_accel(s.acc_body_m_s2, st.heel_rad, st.pitch_rad);
+  return g != SampleGate::kReject;
 }
 
 AttitudeOutput euler_output(const EulerTiltState& st, double acc_weight) {
-  return {st.heel_rad,   st.pitch_rad, st.heel_rate_rad_s, st.pitch_rate_rad_s,
-          acc_weight,    acc_weight,   st.initialised};
+  return {st.heel_rad, st.pitch_rad, st.heel_rate_rad_s, st.pitch_rate_rad_s,
+          acc_weight,  acc_weight,   st.initialised};
 }
 
 }  // namespace
@@ -105,26 +87,18 @@ void ConstKalmanAttitudeFilter::step_axis(Axis& a, double rate_deg_s, double acc
 }
 
 void ConstKalmanAttitudeFilter::update(const ImuSample& s) {
-  if (!finite_sample(s)) {
-    ++diag_.rejected_non_finite;
-    return;
-  }
+  double dt = 0.0;
+  const SampleGate g = gate_sample(s, state_.initialised, state_.last_t_s, dt,
+                                   diag_.rejected_non_finite, diag_.rejected_time);
+  if (g == SampleGate::kReject) return;
   double heel_acc = 0.0;
   double pitch_acc = 0.0;
   tilt_from_accel(s.acc_body_m_s2, heel_acc, pitch_acc);
-  if (!state_.initialised) {
+  if (g == SampleGate::kFirst) {
     state_.heel.angle_deg = heel_acc * kRadToDeg;
     state_.pitch.angle_deg = pitch_acc * kRadToDeg;
-    state_.last_t_s = s.t_s;
-    state_.initialised = true;
     return;
   }
-  const double dt = s.t_s - state_.last_t_s;
-  if (!(dt > 0.0)) {
-    ++diag_.rejected_time;
-    return;
-  }
-  state_.last_t_s = s.t_s;
   euler_rates_from_body(s.gyro_body_rad_s, state_.heel.angle_deg / kRadToDeg,
                         state_.pitch.angle_deg / kRadToDeg, state_.heel_rate_rad_s,
                         state_.pitch_rate_rad_s);

@@ -18,7 +18,8 @@ void TiltErrorStats::merge(const TiltErrorStats& o) {
   const double n = static_cast<double>(samples + o.samples);
   if (n == 0.0) return;
   const auto rms = [&](double a, double b) {
-    return std::sqrt((a * a * static_cast<double>(samples) + b * b * static_cast<double>(o.samples)) / n);
+    return std::sqrt(
+        (a * a * static_cast<double>(samples) + b * b * static_cast<double>(o.samples)) / n);
   };
   heel_rms_deg = rms(heel_rms_deg, o.heel_rms_deg);
   pitch_rms_deg = rms(pitch_rms_deg, o.pitch_rms_deg);
@@ -28,9 +29,8 @@ void TiltErrorStats::merge(const TiltErrorStats& o) {
 }
 
 std::vector<TiltErrorStats> evaluate_on_scenario(const std::vector<std::string>& filter_names,
-                                                 std::string_view scenario_name,
-                                                 std::uint64_t seed, double rate_hz,
-                                                 double duration_s) {
+                                                 std::string_view scenario_name, std::uint64_t seed,
+                                                 double rate_hz, double duration_s) {
   const std::size_t n = filter_names.size();
   std::vector<TiltErrorStats> st(n);
   std::vector<std::unique_ptr<AttitudeFilter>> filters;

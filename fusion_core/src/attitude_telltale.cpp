@@ -23,17 +23,22 @@ void renormalise(Eigen::Quaterniond& q) { q.coeffs() *= 1.5 - 0.5 * q.coeffs().s
 
 double clamp01(double x) { return std::min(1.0, std::max(0.0, x)); }
 
-
 }  // namespace
 
 TelltaleAttitudeFilter::TelltaleAttitudeFilter(Params params) : params_(params) {
   const Params& p = params_;
-  rates_ = {1.0 / p.rest_lp_tau_s,       1.0 / p.rest_bias_tau_s,
-            1.0 / p.nonin_lp_tau_s,      1.0 / p.nonin_release_s,
-            1.0 / p.turn_tau_s,          1.0 / p.turn_release_s,
-            1.0 / p.tau_acc_s,           1.0 / p.tau_acc_rest_s,
-            1.0 / p.bias_motion_tau_s,   1.0 / (p.nonin_high_m_s2 - p.nonin_low_m_s2),
-            1.0 / (p.turn_high_m_s2 - p.turn_low_m_s2), 1.0 / p.turn_rate_rad_s};
+  rates_ = {1.0 / p.rest_lp_tau_s,
+            1.0 / p.rest_bias_tau_s,
+            1.0 / p.nonin_lp_tau_s,
+            1.0 / p.nonin_release_s,
+            1.0 / p.turn_tau_s,
+            1.0 / p.turn_release_s,
+            1.0 / p.tau_acc_s,
+            1.0 / p.tau_acc_rest_s,
+            1.0 / p.bias_motion_tau_s,
+            1.0 / (p.nonin_high_m_s2 - p.nonin_low_m_s2),
+            1.0 / (p.turn_high_m_s2 - p.turn_low_m_s2),
+            1.0 / p.turn_rate_rad_s};
 }
 
 void TelltaleAttitudeFilter::initialise(const ImuSample& s) {
@@ -58,20 +63,14 @@ void TelltaleAttitudeFilter::initialise(const ImuSample& s) {
 
 void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // --- Should this sample be used? (gating apart from the algebra, STYLE rule 6) ---
-  if (!std::isfinite(s.t_s) || !s.gyro_body_rad_s.allFinite() || !s.acc_body_m_s2.allFinite()) {
-    ++diag_.rejected_non_finite;
-    return;
-  }
-  if (!state_.initialised) {
+  double dt = 0.0;
+  const SampleGate gate = gate_sample(s, state_.initialised, state_.last_t_s, dt,
+                                      diag_.rejected_non_finite, diag_.rejected_time);
+  if (gate == SampleGate::kReject) return;
+  if (gate == SampleGate::kFirst) {
     initialise(s);
     return;
   }
-  const double dt = s.t_s - state_.last_t_s;
-  if (!(dt > 0.0)) {
-    ++diag_.rejected_time;
-    return;
-  }
-  state_.last_t_s = s.t_s;
   const Params& p = params_;
   const Rates& k = rates_;
   const bool gyro_sat =
@@ -134,10 +133,9 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // rate e, which shows up as g * e * tau here; with tau = 1 s a 1 deg/s error reads 0.17 m/s^2
   // and cannot lock the gate shut.
   state_.acc_fast_i += step(k.nonin_lp) * (acc_i - state_.acc_fast_i);
-  const double nonin = std::max((acc_i - state_.acc_fast_i).norm(),
-                                std::abs(s.acc_body_m_s2.norm() - p.g_m_s2));
-  state_.nonin_hold_m_s2 =
-      std::max(nonin, state_.nonin_hold_m_s2 * (1.0 - step(k.nonin_release)));
+  const double nonin =
+      std::max((acc_i - state_.acc_fast_i).norm(), std::abs(s.acc_body_m_s2.norm() - p.g_m_s2));
+  state_.nonin_hold_m_s2 = std::max(nonin, state_.nonin_hold_m_s2 * (1.0 - step(k.nonin_release)));
   double w = 1.0 - (state_.nonin_hold_m_s2 - p.nonin_low_m_s2) * k.nonin_range;
   // A vehicle turning while it moves has a centripetal acceleration (a tack: 2.5 m/s * 0.5 rad/s
   // = 1.25 m/s^2 for seconds) that the low-pass would absorb as a tilt. Signature: a horizontal
@@ -167,8 +165,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // --- Low-pass in frame I. Fed with every sample: gating its input by the weight would bias
   // the mean that makes oscillations cancel (a shake with sharp stops and gentle starts would
   // leave a residue). Only a turn, a one-sided acceleration by nature, is kept out.
-  const double a_lp =
-      at_rest ? step(k.acc_rest) : std::max(p.lp_turn_min, w_turn) * step(k.acc);
+  const double a_lp = at_rest ? step(k.acc_rest) : std::max(p.lp_turn_min, w_turn) * step(k.acc);
   state_.acc_lp1_i += a_lp * (acc_i - state_.acc_lp1_i);
   state_.acc_lp2_i += a_lp * (state_.acc_lp1_i - state_.acc_lp2_i);
 
@@ -201,7 +198,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
 
   // --- Quality: a rough tilt variance, growing with gyro-only time, saturation and gaps,
   // shrinking while the accelerometer is trusted.
-  constexpr double kDriftVar = 1e-6;  // (0.06 deg/s)^2 * s: residual bias after learning
+  constexpr double kDriftVar = 1e-6;         // (0.06 deg/s)^2 * s: residual bias after learning
   constexpr double kInvVar0 = 1.0 / 7.6e-5;  // 1 / (0.5 deg)^2
   state_.tilt_var_rad2 += kDriftVar * dt + (gyro_sat ? 1e-4 : 0.0) + (gap ? 1e-2 : 0.0);
   state_.tilt_var_rad2 *= 1.0 - w * step(k.acc);

@@ -33,9 +33,12 @@ std::string gunzip_to_temp(const std::string& gz_path) {
 
 TEST(Broad, ProductionFilterMeanInclinationRmseWithinTarget) {
   const std::string dir = std::string(TELLTALE_TEST_DATA_DIR) + "/broad/";
-  const char* trials[] = {"02_undisturbed_slow_rotation_B", "07_undisturbed_fast_rotation_B",
-                          "11_undisturbed_slow_translation_B", "16_undisturbed_fast_translation_B",
-                          "25_disturbed_tapping_B", "27_disturbed_phone_vibration_B"};
+  const char* trials[] = {"02_undisturbed_slow_rotation_B",
+                          "07_undisturbed_fast_rotation_B",
+                          "11_undisturbed_slow_translation_B",
+                          "16_undisturbed_fast_translation_B",
+                          "25_disturbed_tapping_B",
+                          "27_disturbed_phone_vibration_B"};
   double sum = 0.0;
   for (const char* trial : trials) {
     const std::string imu = gunzip_to_temp(dir + trial + ".imu.csv.gz");

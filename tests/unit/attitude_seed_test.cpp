@@ -1,11 +1,11 @@
 // The paper's filter (seed 000/001) against golden values computed here, independently, from
 // equations 1-5 and table 1 with plain arrays.
+#include "telltale/fusion/attitude_seed.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
-
-#include "telltale/fusion/attitude_seed.hpp"
 
 namespace telltale::fusion {
 namespace {
@@ -15,21 +15,21 @@ constexpr double kRad = M_PI / 180.0;
 
 /// One axis of the paper's filter, written from the equations with scalars (degrees).
 struct RefAxis {
-  double x[3] = {0.0, 0.0, 0.0};                                     // X0 = 0 (table 1)
+  double x[3] = {0.0, 0.0, 0.0};                                         // X0 = 0 (table 1)
   double p[3][3] = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};  // P0 = I
   double r = 0.005;
   double out = 0.0;
 
   void step(double c, double inc, double acc, double dr) {
-    x[2] = inc;                                               // measured increment
-    const double xp[3] = {x[0] + x[2], x[1], x[2]};           // eq 1, A X
-    double ap[3][3];                                          // A P
+    x[2] = inc;                                      // measured increment
+    const double xp[3] = {x[0] + x[2], x[1], x[2]};  // eq 1, A X
+    double ap[3][3];                                 // A P
     for (int j = 0; j < 3; ++j) {
       ap[0][j] = p[0][j] + p[2][j];
       ap[1][j] = p[1][j];
       ap[2][j] = p[2][j];
     }
-    double pp[3][3];                                          // (A P) A^T + Q, eq 3
+    double pp[3][3];  // (A P) A^T + Q, eq 3
     for (int i = 0; i < 3; ++i) {
       pp[i][0] = ap[i][0] + ap[i][2];
       pp[i][1] = ap[i][1];
@@ -37,9 +37,9 @@ struct RefAxis {
     }
     pp[1][1] += 0.02;
     pp[2][2] += 0.02;
-    r = (c != 0.0) ? 0.005 : r + dr;                          // eq 4
+    r = (c != 0.0) ? 0.005 : r + dr;  // eq 4
     const double h[3] = {1.0 - c, c, 0.0};
-    const double y = (1.0 - c) * (out + inc) + c * acc;      // Y(k)
+    const double y = (1.0 - c) * (out + inc) + c * acc;  // Y(k)
     double pht[3];
     for (int i = 0; i < 3; ++i) pht[i] = pp[i][0] * h[0] + pp[i][1] * h[1] + pp[i][2] * h[2];
     const double s = h[0] * pht[0] + h[1] * pht[1] + h[2] * pht[2] + r;
@@ -84,10 +84,9 @@ TEST(SeedAttitudeFilter, ReproducesGoldenValuesFromTheEquations) {
     const double h_true = 12.0 * kRad * std::sin(0.7 * t);
     const double p_true = -6.0 * kRad * std::cos(0.4 * t);
     const double s = scales[(k / 7) % 6];
-    const Eigen::Vector3d f =
-        s * kG *
-        Eigen::Vector3d(std::sin(p_true), std::cos(p_true) * std::sin(h_true),
-                        std::cos(p_true) * std::cos(h_true));
+    const Eigen::Vector3d f = s * kG *
+                              Eigen::Vector3d(std::sin(p_true), std::cos(p_true) * std::sin(h_true),
+                                              std::cos(p_true) * std::cos(h_true));
     const Eigen::Vector3d w(0.15 * std::cos(0.7 * t), -0.05 * std::sin(0.4 * t), 0.3);
     filter.update({t, w, f});
     // Reference: eq 2 on |a|, tilt from the SPEC accelerometer model, Euler rates at phi_o.

@@ -24,7 +24,8 @@ ScenarioOptions ideal() {
 class Wobble final : public SmoothTrajectory {
  public:
   [[nodiscard]] Eigen::Quaterniond attitude(double t) const override {
-    return attitude_from_euler(0.4 * std::sin(1.3 * t), 0.2 * std::cos(0.9 * t), 0.8 * t + 0.3 * std::sin(2.1 * t));
+    return attitude_from_euler(0.4 * std::sin(1.3 * t), 0.2 * std::cos(0.9 * t),
+                               0.8 * t + 0.3 * std::sin(2.1 * t));
   }
   [[nodiscard]] Eigen::Vector3d position(double t) const {
     return {2.0 * t + 0.3 * std::sin(1.7 * t), 0.5 * std::cos(1.1 * t), 0.2 * std::sin(2.3 * t)};
@@ -42,7 +43,9 @@ TEST(Motion, LeverArmAccelerationMatchesFiniteDifferences) {
   for (double t : {0.3, 1.7, 4.2}) {
     const RigidMotion m = traj.motion(t);
     const double h = 1e-3;
-    const auto sensor = [&](double s) { return Eigen::Vector3d(traj.position(s) + traj.attitude(s) * r); };
+    const auto sensor = [&](double s) {
+      return Eigen::Vector3d(traj.position(s) + traj.attitude(s) * r);
+    };
     const Eigen::Vector3d acc = (sensor(t + h) - 2.0 * sensor(t) + sensor(t - h)) / (h * h);
     const Eigen::Vector3d expected = m.att.conjugate() * (acc + Eigen::Vector3d(0.0, 0.0, kG));
     EXPECT_LT((specific_force_body(m, r, kG) - expected).norm(), 1e-4) << "t=" << t;
@@ -68,7 +71,8 @@ TEST(Scenario, StaticPoseReadsGravity) {
   while (sc->next(s, t)) {
     const double h = -17.5 * kDeg;
     const double p = 7.5 * kDeg;
-    const Eigen::Vector3d g(kG * std::sin(p), kG * std::cos(p) * std::sin(h), kG * std::cos(p) * std::cos(h));
+    const Eigen::Vector3d g(kG * std::sin(p), kG * std::cos(p) * std::sin(h),
+                            kG * std::cos(p) * std::cos(h));
     EXPECT_LT((s.acc_body_m_s2 - g).norm(), 1e-9);
     EXPECT_LT(s.gyro_body_rad_s.norm(), 1e-12);
     EXPECT_NEAR(t.heel_rad / kDeg, -17.5, 1e-12);
@@ -113,7 +117,8 @@ TEST(Scenario, PendulumSwingsWithItsPhysicalPeriod) {
     prev = t.heel_rad;
   }
   ASSERT_GE(crossings.size(), 5u);
-  const double period = (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+  const double period =
+      (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
   EXPECT_NEAR(period, 2.0 * M_PI * std::sqrt(0.95 / kG), 0.01);
 }
 
@@ -142,7 +147,8 @@ TEST(Scenario, IdealGyroIntegratesToTheTruth) {
 // The error model: white noise with the datasheet density, one LSB steps, clipping at full scale.
 TEST(ImuErrorModel, NoiseQuantisationAndSaturation) {
   ImuErrorParams p;
-  p.gyro_bias_max_rad_s = p.gyro_bias_walk_rad_s_sqrt_s = p.gyro_scale_max = p.gyro_misalign_max_rad = 0;
+  p.gyro_bias_max_rad_s = p.gyro_bias_walk_rad_s_sqrt_s = p.gyro_scale_max =
+      p.gyro_misalign_max_rad = 0;
   p.gyro_lsb_rad_s = 0;
   ImuErrorModel m(p, 7);
   const double rate = 100.0;

@@ -1,5 +1,7 @@
 // The production filter against the simulator's truth: the accuracy the issue promises, over
 // seeds, at the paper's 25 Hz and at 100 Hz, and its behaviour on knocks, NaN, gaps and state.
+#include "telltale/fusion/attitude_telltale.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -8,7 +10,6 @@
 #include <vector>
 
 #include "telltale/fusion/attitude_eval.hpp"
-#include "telltale/fusion/attitude_telltale.hpp"
 #include "telltale/fusion/sim/scenario.hpp"
 
 namespace telltale::fusion {
@@ -48,7 +49,8 @@ TEST_P(Accuracy, ProductionFilterMeetsTargetsAndBeatsEveryOtherFilter) {
   const auto& names = attitude_filter_names();
   std::vector<TiltErrorStats> total(names.size());
   for (int seed = 1; seed <= c.seeds; ++seed) {
-    const auto st = evaluate_on_scenario(names, c.scenario, static_cast<std::uint64_t>(seed), c.rate_hz);
+    const auto st =
+        evaluate_on_scenario(names, c.scenario, static_cast<std::uint64_t>(seed), c.rate_hz);
     for (std::size_t i = 0; i < names.size(); ++i) total[i].merge(st[i]);
   }
   ASSERT_EQ(names[0], "telltale");
@@ -71,11 +73,14 @@ std::vector<Case> cases() {
   return v;
 }
 
-INSTANTIATE_TEST_SUITE_P(Scenarios, Accuracy, ::testing::ValuesIn(cases()), [](const auto& param_info) {
-  std::string n = param_info.param.scenario + "_" + std::to_string(static_cast<int>(param_info.param.rate_hz)) + "Hz";
-  for (auto& ch : n) ch = (ch == '-') ? '_' : ch;
-  return n;
-});
+INSTANTIATE_TEST_SUITE_P(Scenarios, Accuracy, ::testing::ValuesIn(cases()),
+                         [](const auto& param_info) {
+                           std::string n =
+                               param_info.param.scenario + "_" +
+                               std::to_string(static_cast<int>(param_info.param.rate_hz)) + "Hz";
+                           for (auto& ch : n) ch = (ch == '-') ? '_' : ch;
+                           return n;
+                         });
 
 // Given the pendulum sampled at 100 Hz with +-3 ms jitter and 20 % of the samples lost, the
 // production filter still holds +-1 deg.
@@ -84,7 +89,8 @@ TEST(TelltaleAttitudeFilter, NonUniformAndDroppedSamples) {
     sim::ScenarioOptions o;
     o.jitter_s = 0.003;
     o.drop_probability = 0.2;
-    auto sc = sim::make_scenario("pendulum-pitch-30", static_cast<std::uint64_t>(seed), 100.0, 65.0, o);
+    auto sc =
+        sim::make_scenario("pendulum-pitch-30", static_cast<std::uint64_t>(seed), 100.0, 65.0, o);
     TelltaleAttitudeFilter f;
     ImuSample s;
     sim::AttitudeTruth t;

@@ -16,7 +16,8 @@ constexpr double kDeg = M_PI / 180.0;
 /// of their k-th tack, gust or knock without storing anything.
 double hash_uniform(std::uint64_t seed, std::uint64_t stream, std::int64_t index) {
   std::uint64_t z = seed * 0x9E3779B97F4A7C15ull + stream * 0xBF58476D1CE4E5B9ull +
-                    static_cast<std::uint64_t>(index) * 0x94D049BB133111EBull + 0x632BE59BD9B4E019ull;
+                    static_cast<std::uint64_t>(index) * 0x94D049BB133111EBull +
+                    0x632BE59BD9B4E019ull;
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
   z ^= z >> 31;
@@ -24,7 +25,9 @@ double hash_uniform(std::uint64_t seed, std::uint64_t stream, std::int64_t index
 }
 
 /// Smooth step 0 -> 1 around t0 with width tau (C-infinity).
-double smooth_step(double t, double t0, double tau) { return 0.5 * (1.0 + std::tanh((t - t0) / tau)); }
+double smooth_step(double t, double t0, double tau) {
+  return 0.5 * (1.0 + std::tanh((t - t0) / tau));
+}
 double smooth_step_dt(double t, double t0, double tau) {
   const double c = std::cosh((t - t0) / tau);
   return 0.5 / (tau * c * c);
@@ -65,8 +68,9 @@ class PendulumTrajectory final : public Trajectory {
       : length_(length_m), zeta_(zeta), hold_(hold_s), g_(g), theta_(theta0_rad) {
     // Heel mounting: body x along the pivot axis (world x): the swing is a rotation about body x.
     // Pitch mounting: body y along the pivot axis: the swing is a rotation about body y.
-    mount_ = pitch_mount ? Eigen::Quaterniond(Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitZ()))
-                         : Eigen::Quaterniond::Identity();
+    mount_ = pitch_mount
+                 ? Eigen::Quaterniond(Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitZ()))
+                 : Eigen::Quaterniond::Identity();
     t_ = hold_s;
   }
   RigidMotion motion(double t) override {
@@ -145,15 +149,16 @@ class DeskTrajectory final : public SmoothTrajectory {
              Sines(seed, 6, 0.003, 0.01, 0.3, 1.5)} {}
   [[nodiscard]] Eigen::Quaterniond attitude(double t) const override {
     const double e = envelope(t);
-    Eigen::Quaterniond q = attitude_from_euler(e * heel_.value(t), e * pitch_.value(t),
-                                               e * yaw_.value(t));
+    Eigen::Quaterniond q =
+        attitude_from_euler(e * heel_.value(t), e * pitch_.value(t), e * yaw_.value(t));
     // Knocks jolt the attitude too: 1 deg about a seeded horizontal axis, 20 ms wide.
     for (std::int64_t k = knock_index(t) - 1; k <= knock_index(t) + 1; ++k) {
       if (k < 0) continue;
       const double dt = t - knock_time(k);
       const double a = kDeg * std::exp(-(dt * dt) / (0.02 * 0.02));
       const double dir = 2.0 * M_PI * hash_uniform(seed_, 8, k);
-      q = q * Eigen::Quaterniond(Eigen::AngleAxisd(a, Eigen::Vector3d(std::cos(dir), std::sin(dir), 0)));
+      q = q * Eigen::Quaterniond(
+                  Eigen::AngleAxisd(a, Eigen::Vector3d(std::cos(dir), std::sin(dir), 0)));
     }
     return q;
   }
@@ -178,7 +183,8 @@ class DeskTrajectory final : public SmoothTrajectory {
  private:
   [[nodiscard]] double envelope(double t) const { return smooth_step(t, rest_ + 1.0, 0.4); }
   [[nodiscard]] double knock_time(std::int64_t k) const {
-    return rest_ + 3.0 + 4.0 * static_cast<double>(k) + 2.0 * (hash_uniform(seed_, 7, k) - 0.5) * 2.0;
+    return rest_ + 3.0 + 4.0 * static_cast<double>(k) +
+           2.0 * (hash_uniform(seed_, 7, k) - 0.5) * 2.0;
   }
   [[nodiscard]] std::int64_t knock_index(double t) const {
     return static_cast<std::int64_t>(std::floor((t - rest_ - 3.0) / 4.0 + 0.5));
@@ -241,7 +247,8 @@ class DinghyTrajectory final : public SmoothTrajectory {
     return rest_ + 40.0 + 40.0 * static_cast<double>(k) + 15.0 * (hash_uniform(seed_, 18, k) - 0.5);
   }
   [[nodiscard]] std::int64_t tack_index(double t) const {
-    return std::max<std::int64_t>(0, static_cast<std::int64_t>(std::floor((t - rest_ - 40.0) / 40.0 + 0.5)));
+    return std::max<std::int64_t>(
+        0, static_cast<std::int64_t>(std::floor((t - rest_ - 40.0) / 40.0 + 0.5)));
   }
   /// +1 on one tack, -1 on the other; a roll tack takes ~4 s (heel and heading swing together).
   [[nodiscard]] double side(double t) const {
@@ -254,7 +261,8 @@ class DinghyTrajectory final : public SmoothTrajectory {
     const std::int64_t k = static_cast<std::int64_t>(std::floor((t - rest_) / 17.0));
     double g = 0.0;
     for (std::int64_t j = k - 2; j <= k + 2; ++j) {
-      const double t0 = rest_ + 17.0 * static_cast<double>(j) + 8.5 + 5.0 * (hash_uniform(seed_, 19, j) - 0.5);
+      const double t0 =
+          rest_ + 17.0 * static_cast<double>(j) + 8.5 + 5.0 * (hash_uniform(seed_, 19, j) - 0.5);
       const double a = (3.0 + 5.0 * hash_uniform(seed_, 20, j)) * kDeg;
       const double w = 2.0 + 2.0 * hash_uniform(seed_, 21, j);
       const double d = (t - t0) / w;
@@ -363,7 +371,8 @@ std::unique_ptr<ImuScenario> make_scenario(std::string_view name, std::uint64_t 
     }
     // Release angle: the pendulum swings toward negative angles first for seed parity.
     const double theta0 = std::stod(amp) * kDeg * ((seed % 2 == 0) ? 1.0 : -1.0);
-    auto traj = std::make_unique<PendulumTrajectory>(0.95, 0.018, theta0, kRest, options.g_m_s2, pitch);
+    auto traj =
+        std::make_unique<PendulumTrajectory>(0.95, 0.018, theta0, kRest, options.g_m_s2, pitch);
     const Eigen::Vector3d arm = traj->lever_arm();
     return std::make_unique<ImuScenario>(std::move(traj), arm, rate_hz, duration_s, kRest, seed,
                                          options);

@@ -7,7 +7,8 @@
 /// rest); heel > 0 = starboard down; pitch > 0 = bow up (= -theta of the ZYX sequence).
 ///
 /// Filters in the registry:
-///   - `telltale`     TelltaleAttitudeFilter (attitude_telltale.hpp): the production filter, default.
+///   - `telltale`     TelltaleAttitudeFilter (attitude_telltale.hpp): the production filter,
+///   default.
 ///   - `seed`         SeedAttitudeFilter (attitude_seed.hpp): the paper's filter as published.
 ///   - `gyro`, `accel`, `average`, `kalman-const` (attitude_baselines.hpp): the paper's yardsticks.
 
@@ -43,6 +44,17 @@ class AttitudeFilter {
   virtual void update(const ImuSample& sample) = 0;
   [[nodiscard]] virtual AttitudeOutput output() const = 0;
 };
+
+/// Outcome of gate_sample.
+enum class SampleGate { kReject, kFirst, kNext };
+
+/// The one gate every attitude filter applies before using a sample: NaN/Inf anywhere, or a time
+/// not after the last accepted one -> kReject (counted in the given counter). The first accepted
+/// sample -> kFirst (dt_s = 0); later ones -> kNext with dt_s > 0. Accepting advances last_t_s and
+/// sets started.
+[[nodiscard]] SampleGate gate_sample(const ImuSample& sample, bool& started, double& last_t_s,
+                                     double& dt_s, unsigned& rejected_non_finite,
+                                     unsigned& rejected_time);
 
 /// Heel and pitch (rad) of the gravity direction seen by an accelerometer at rest:
 /// f = g (sin(pitch), cos(pitch) sin(heel), cos(pitch) cos(heel)) inverted.

@@ -25,37 +25,33 @@ struct EulerTiltState {
   bool initialised = false;
 };
 
-/// `gyro`: Euler-rate integration of the gyro from the first sample's accelerometer tilt.
-/// Never corrected afterwards: it shows the drift every fusion must remove.
-class GyroAttitudeFilter final : public AttitudeFilter {
+/// What the Euler-angle baselines share: their state, counters and accessors.
+class EulerBaseline : public AttitudeFilter {
  public:
   using State = EulerTiltState;
   using Diagnostics = BaselineDiagnostics;
-  void update(const ImuSample& sample) override;
-  [[nodiscard]] AttitudeOutput output() const override;
   [[nodiscard]] const State& state() const { return state_; }
   void set_state(const State& s) { state_ = s; }
   [[nodiscard]] const Diagnostics& diagnostics() const { return diag_; }
 
- private:
+ protected:
   State state_;
   Diagnostics diag_;
 };
 
-/// `accel`: tilt of the measured specific force, every sample on its own (tilt_from_accel).
-class AccelAttitudeFilter final : public AttitudeFilter {
+/// `gyro`: Euler-rate integration of the gyro from the first sample's accelerometer tilt.
+/// Never corrected afterwards: it shows the drift every fusion must remove.
+class GyroAttitudeFilter final : public EulerBaseline {
  public:
-  using State = EulerTiltState;
-  using Diagnostics = BaselineDiagnostics;
   void update(const ImuSample& sample) override;
   [[nodiscard]] AttitudeOutput output() const override;
-  [[nodiscard]] const State& state() const { return state_; }
-  void set_state(const State& s) { state_ = s; }
-  [[nodiscard]] const Diagnostics& diagnostics() const { return diag_; }
+};
 
- private:
-  State state_;
-  Diagnostics diag_;
+/// `accel`: tilt of the measured specific force, every sample on its own (tilt_from_accel).
+class AccelAttitudeFilter final : public EulerBaseline {
+ public:
+  void update(const ImuSample& sample) override;
+  [[nodiscard]] AttitudeOutput output() const override;
 };
 
 /// Settings of AverageAttitudeFilter.
@@ -68,22 +64,15 @@ struct AverageAttitudeParams {
 /// `average`: the fixed-weight average of gyro and accelerometer angles the paper cites ([5]),
 /// angle = (1 - w) (angle + rate dt) + w tilt_acc. This is the walking skeleton's
 /// complementary filter; it has no defence against non-inertial motion.
-class AverageAttitudeFilter final : public AttitudeFilter {
+class AverageAttitudeFilter final : public EulerBaseline {
  public:
   using Params = AverageAttitudeParams;
-  using State = EulerTiltState;
-  using Diagnostics = BaselineDiagnostics;
   explicit AverageAttitudeFilter(Params params = {}) : params_(params) {}
   void update(const ImuSample& sample) override;
   [[nodiscard]] AttitudeOutput output() const override;
-  [[nodiscard]] const State& state() const { return state_; }
-  void set_state(const State& s) { state_ = s; }
-  [[nodiscard]] const Diagnostics& diagnostics() const { return diag_; }
 
  private:
   Params params_;
-  State state_;
-  Diagnostics diag_;
   double weight_ = 0.0;
 };
 

@@ -33,8 +33,8 @@ struct TiltErrorStats {
     std::uint64_t seed, double rate_hz, double duration_s = 0.0);
 
 /// Angle (rad) between the up vectors of two heel/pitch pairs (heading does not matter).
-[[nodiscard]] double inclination_error_rad(double heel_a_rad, double pitch_a_rad,
-                                           double heel_b_rad, double pitch_b_rad);
+[[nodiscard]] double inclination_error_rad(double heel_a_rad, double pitch_a_rad, double heel_b_rad,
+                                           double pitch_b_rad);
 
 /// A recording with heel/pitch truth (BROAD): rows not to be scored have scored = 0.
 struct InclinationTrial {

@@ -29,28 +29,28 @@ namespace telltale::fusion {
 
 /// Settings of SeedAttitudeFilter: table 1 of the paper, angles in degrees.
 struct SeedAttitudeParams {
-  double q_a_deg2 = 0.02;       ///< process noise of phi_a (table 1)
-  double q_g_deg2 = 0.02;       ///< process noise of dphi_g (table 1)
-  double r_a_deg2 = 0.005;      ///< measurement noise while c != 0 (table 1, R)
+  double q_a_deg2 = 0.02;   ///< process noise of phi_a (table 1)
+  double q_g_deg2 = 0.02;   ///< process noise of dphi_g (table 1)
+  double r_a_deg2 = 0.005;  ///< measurement noise while c != 0 (table 1, R)
   /// Growth of r_k per sample while c = 0 (eq 4), "found by experiment" in the paper. Default:
   /// r_a per sample, i.e. each gyro-only step is assumed to add as much variance as one
   /// accelerometer reading. Only the covariance depends on it: while c = 0 the innovation is zero.
   double dr_deg2 = 0.005;
   double g_c_m_s2 = kStandardGravity_m_s2;  ///< g_c of the operator da
-  double c_max = 0.7;           ///< eq 2, da < 0.005
-  double da_low = 0.005;        ///< eq 2 thresholds
+  double c_max = 0.7;                       ///< eq 2, da < 0.005
+  double da_low = 0.005;                    ///< eq 2 thresholds
   double da_high = 0.03;
-  double c_slope = 240.0;       ///< eq 2: c = 1 / (slope * da)^2
+  double c_slope = 240.0;  ///< eq 2: c = 1 / (slope * da)^2
 };
 
 class SeedAttitudeFilter final : public AttitudeFilter {
  public:
   using Params = SeedAttitudeParams;
   struct Axis {
-    Eigen::Vector3d x = Eigen::Vector3d::Zero();  ///< [phi_g, phi_a, dphi_g], deg (X0 = 0)
+    Eigen::Vector3d x = Eigen::Vector3d::Zero();      ///< [phi_g, phi_a, dphi_g], deg (X0 = 0)
     Eigen::Matrix3d p = Eigen::Matrix3d::Identity();  ///< P0 = I
-    double r_deg2 = 0.005;  ///< r_k (eq 4)
-    double out_deg = 0.0;   ///< phi_o, the published angle
+    double r_deg2 = 0.005;                            ///< r_k (eq 4)
+    double out_deg = 0.0;                             ///< phi_o, the published angle
   };
   struct State {
     Axis heel;

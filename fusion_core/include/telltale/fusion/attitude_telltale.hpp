@@ -54,21 +54,21 @@ struct TelltaleAttitudeParams {
   double turn_low_m_s2 = 0.4;
   double turn_high_m_s2 = 1.5;
   double lp_turn_min = 0.1;
-  double w_min = 0.05;           ///< floor of the accelerometer weight (keeps long-run correction)
+  double w_min = 0.05;  ///< floor of the accelerometer weight (keeps long-run correction)
   /// Rest detection (gyro bias learning): deviations below these for rest_min_s.
   double rest_gyro_rad_s = 0.035;  ///< 2 deg/s
   double rest_acc_m_s2 = 0.4;
   double rest_min_s = 1.0;
   double rest_bias_match_rad_s = 0.0026;  ///< 0.15 deg/s: rest = the gyro reads the known bias
   double rest_bias_tau_s = 5.0;  ///< bias refinement at rest after the first (which sets it)
-  double rest_lp_tau_s = 0.5;      ///< low-pass of gyro/acc for the rest test and the bias
+  double rest_lp_tau_s = 0.5;    ///< low-pass of gyro/acc for the rest test and the bias
   /// Bias learning in motion: time constant of the integral of the accelerometer corrections.
   double bias_motion_tau_s = 60.0;
-  double max_bias_rad_s = 0.35;    ///< |bias| clamp (20 deg/s, twice the L3G4200D zero-rate spread)
-  double gyro_range_rad_s = 250.0 * M_PI / 180.0;  ///< full scale (L3G4200D default 250 dps)
+  double max_bias_rad_s = 0.35;  ///< |bias| clamp (20 deg/s, twice the L3G4200D zero-rate spread)
+  double gyro_range_rad_s = 250.0 * M_PI / 180.0;       ///< full scale (L3G4200D default 250 dps)
   double acc_range_m_s2 = 2.0 * kStandardGravity_m_s2;  ///< full scale (LSM303DLH default 2 g)
-  double saturation_fraction = 0.98;  ///< |reading| >= this * range -> saturated
-  double max_gap_s = 1.0;             ///< longer gaps are not integrated
+  double saturation_fraction = 0.98;                    ///< |reading| >= this * range -> saturated
+  double max_gap_s = 1.0;                               ///< longer gaps are not integrated
 };
 
 class TelltaleAttitudeFilter final : public AttitudeFilter {
@@ -78,8 +78,8 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
     Eigen::Quaterniond q_gyro = Eigen::Quaterniond::Identity();  ///< body -> inertial frame I
     Eigen::Quaterniond q_corr = Eigen::Quaterniond::Identity();  ///< I -> earth (tilt only)
     Eigen::Vector3d bias_rad_s = Eigen::Vector3d::Zero();        ///< gyro bias, body
-    Eigen::Vector3d acc_lp1_i = Eigen::Vector3d::Zero();  ///< first low-pass stage, frame I
-    Eigen::Vector3d acc_lp2_i = Eigen::Vector3d::Zero();  ///< second stage, frame I
+    Eigen::Vector3d acc_lp1_i = Eigen::Vector3d::Zero();         ///< first low-pass stage, frame I
+    Eigen::Vector3d acc_lp2_i = Eigen::Vector3d::Zero();         ///< second stage, frame I
     Eigen::Vector3d acc_fast_i = Eigen::Vector3d::Zero();  ///< 1 s low-pass for the gate, frame I
     Eigen::Vector3d gyro_rest_lp_rad_s = Eigen::Vector3d::Zero();
     Eigen::Vector3d acc_rest_lp_m_s2 = Eigen::Vector3d::Zero();

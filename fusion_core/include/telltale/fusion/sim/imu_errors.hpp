@@ -18,9 +18,10 @@ namespace telltale::fusion::sim {
 
 struct ImuErrorParams {
   // L3G4200D at FS = 250 dps.
-  double gyro_bias_max_rad_s = 10.0 * M_PI / 180.0;  ///< zero-rate level +-10 dps (Table 4), uniform
+  double gyro_bias_max_rad_s =
+      10.0 * M_PI / 180.0;  ///< zero-rate level +-10 dps (Table 4), uniform
   double gyro_bias_walk_rad_s_sqrt_s = 0.005 * M_PI / 180.0;  ///< assumed: 0.03 dps/degC drift
-                                                             ///< (Table 4) over a few degC/hour
+                                                              ///< (Table 4) over a few degC/hour
   double gyro_noise_density_rad_s_sqrt_hz = 0.03 * M_PI / 180.0;  ///< 0.03 dps/sqrt(Hz) (Table 4)
   /// Scale and cross-axis after the instrument's one-off rate-table calibration (assumed
   /// residual; the datasheet's +-2 % sensitivity change spans -40..85 degC, i.e. ~0.3 % over a
@@ -28,7 +29,7 @@ struct ImuErrorParams {
   /// L3G4200D datasheet gives none).
   double gyro_scale_max = 0.003;
   double gyro_misalign_max_rad = 0.002;
-  double gyro_lsb_rad_s = 8.75e-3 * M_PI / 180.0;  ///< 8.75 mdps/digit (Table 4)
+  double gyro_lsb_rad_s = 8.75e-3 * M_PI / 180.0;                 ///< 8.75 mdps/digit (Table 4)
   double gyro_full_scale_rad_s = 32767 * 8.75e-3 * M_PI / 180.0;  ///< 16-bit register, 286.7 dps
 
   // LSM303DLH at FS = 2 g, after the one-off six-position calibration of the instrument
@@ -38,11 +39,11 @@ struct ImuErrorParams {
   double acc_bias_max_m_s2 = 0.003 * 9.80665;
   double acc_bias_walk_m_s2_sqrt_s = 1e-5;  ///< 0.1 mg/degC (LA_TCOff) over a few degC/hour
   double acc_noise_density_m_s2_sqrt_hz = 220e-6 * 9.80665;  ///< 220 ug/sqrt(Hz) (assumed:
-                                                            ///< LSM303DLHC figure, DLH gives none)
+                                                             ///< LSM303DLHC figure, DLH gives none)
   double acc_scale_max = 0.003;
   double acc_misalign_max_rad = 0.0017;
-  double acc_lsb_m_s2 = 1e-3 * 9.80665;                ///< 1 mg/digit (12 bit at 2 g)
-  double acc_full_scale_m_s2 = 2.048 * 9.80665;        ///< 2048 digits
+  double acc_lsb_m_s2 = 1e-3 * 9.80665;          ///< 1 mg/digit (12 bit at 2 g)
+  double acc_full_scale_m_s2 = 2.048 * 9.80665;  ///< 2048 digits
 
   /// The same sensors without the accelerometer calibration (datasheet figures as they are).
   [[nodiscard]] static ImuErrorParams uncalibrated();

@@ -12,7 +12,7 @@ namespace telltale::fusion::sim {
 
 /// Pose and its derivatives at one instant.
 struct RigidMotion {
-  Eigen::Quaterniond att = Eigen::Quaterniond::Identity();  ///< body (FLU) -> world (ENU)
+  Eigen::Quaterniond att = Eigen::Quaterniond::Identity();      ///< body (FLU) -> world (ENU)
   Eigen::Vector3d omega_body_rad_s = Eigen::Vector3d::Zero();   ///< angular rate, body frame
   Eigen::Vector3d alpha_body_rad_s2 = Eigen::Vector3d::Zero();  ///< angular acceleration, body
   Eigen::Vector3d acc_world_m_s2 = Eigen::Vector3d::Zero();     ///< acceleration of the origin

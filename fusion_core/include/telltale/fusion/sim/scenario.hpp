@@ -18,7 +18,8 @@
 ///     ~10 g, the 2 g accelerometer saturates), after 5 s still.
 ///   dinghy: a Laser upwind in a chop: 10 s still ashore, then sailing at 2.5 m/s, tacking every
 ///     ~40 s (90 deg in ~4 s, heel flips +-12 deg), gusts (+3..8 deg of heel), waves (heave, surge,
-///     sway ~1.5 m/s^2; roll +-3 deg, pitch +-5 deg), instrument on the bow (1.5 m ahead of the CG).
+///     sway ~1.5 m/s^2; roll +-3 deg, pitch +-5 deg), instrument on the bow (1.5 m ahead of the
+///     CG).
 /// Sensor: ImuErrorModel with the L3G4200D/LSM303DLH defaults of imu_errors.hpp.
 
 #include <cstdint>
@@ -51,8 +52,8 @@ struct AttitudeTruth {
 /// Timing and sensor options of a run.
 struct ScenarioOptions {
   ImuErrorParams errors{};
-  double jitter_s = 0.0;           ///< uniform +- jitter on every time stamp (< 0.5 / rate)
-  double drop_probability = 0.0;   ///< chance that a sample is lost (non-uniform sampling)
+  double jitter_s = 0.0;          ///< uniform +- jitter on every time stamp (< 0.5 / rate)
+  double drop_probability = 0.0;  ///< chance that a sample is lost (non-uniform sampling)
   double g_m_s2 = 9.80665;
 };
 
@@ -85,9 +86,8 @@ class ImuScenario {
 /// Length of the scenario's scripted part (what tests and eval run), s.
 [[nodiscard]] double scenario_default_duration_s(std::string_view name);
 /// nullptr for an unknown name. duration_s <= 0: endless.
-[[nodiscard]] std::unique_ptr<ImuScenario> make_scenario(std::string_view name,
-                                                         std::uint64_t seed, double rate_hz,
-                                                         double duration_s,
+[[nodiscard]] std::unique_ptr<ImuScenario> make_scenario(std::string_view name, std::uint64_t seed,
+                                                         double rate_hz, double duration_s,
                                                          const ScenarioOptions& options = {});
 
 }  // namespace telltale::fusion::sim
