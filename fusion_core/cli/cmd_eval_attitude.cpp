@@ -24,6 +24,7 @@ struct EvalAttitudeOptions {
   std::vector<std::string> scenarios;  // empty = all
   std::string broad_dir;               // empty = look in the usual places
   bool skip_broad = false;
+  bool uncalibrated = false;  ///< raw datasheet sensor errors instead of the calibrated instrument
 };
 
 bool progress_enabled() { return isatty(fileno(stderr)) != 0; }
@@ -56,11 +57,12 @@ void run_eval_attitude(const EvalAttitudeOptions& o) {
     if (!fusion::sim::make_scenario(s, 1, 25.0, 1.0))
       throw UsageError("unknown scenario '" + s + "'");
   }
+  const fusion::sim::ImuErrorParams raw = fusion::sim::ImuErrorParams::uncalibrated();
   for (const double rate : o.rates_hz) {
     std::printf(
-        "\n## attitude: simulator, %d seeds, %.0f Hz: heel RMS, pitch RMS (heel max, pitch max), "
-        "deg\n\n",
-        o.seeds, rate);
+        "\n## attitude: simulator (%s sensors), %d seeds, %.0f Hz: heel RMS, pitch RMS (heel max, "
+        "pitch max), deg\n\n",
+        o.uncalibrated ? "uncalibrated" : "calibrated", o.seeds, rate);
     std::printf("| scenario |");
     for (const auto& f : filters) std::printf(" %s |", f.c_str());
     std::printf("\n|---|");
@@ -71,8 +73,8 @@ void run_eval_attitude(const EvalAttitudeOptions& o) {
       for (int seed = 1; seed <= o.seeds; ++seed) {
         progress("eval attitude: " + sc + " seed " + std::to_string(seed) + " at " +
                  std::to_string(static_cast<int>(rate)) + " Hz");
-        const auto st =
-            fusion::evaluate_on_scenario(filters, sc, static_cast<std::uint64_t>(seed), rate);
+        const auto st = fusion::evaluate_on_scenario(filters, sc, static_cast<std::uint64_t>(seed),
+                                                     rate, 0.0, o.uncalibrated ? &raw : nullptr);
         for (std::size_t i = 0; i < filters.size(); ++i) total[i].merge(st[i]);
       }
       progress_done();
@@ -141,6 +143,8 @@ void register_eval_attitude(CLI::App& eval, std::vector<std::function<void()>>& 
   cmd->add_option("--broad-dir", opts->broad_dir,
                   "BROAD CSV folder (default: /work/shared/data/broad or ../shared/data/broad)");
   cmd->add_flag("--no-broad", opts->skip_broad, "skip the BROAD recordings");
+  cmd->add_flag("--uncalibrated", opts->uncalibrated,
+                "simulate the sensors with raw datasheet errors (no instrument calibration)");
   cmd->callback([opts] { run_eval_attitude(*opts); });
   run_all.push_back([opts] { run_eval_attitude(*opts); });
 }

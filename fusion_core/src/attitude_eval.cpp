@@ -30,13 +30,16 @@ void TiltErrorStats::merge(const TiltErrorStats& o) {
 
 std::vector<TiltErrorStats> evaluate_on_scenario(const std::vector<std::string>& filter_names,
                                                  std::string_view scenario_name, std::uint64_t seed,
-                                                 double rate_hz, double duration_s) {
+                                                 double rate_hz, double duration_s,
+                                                 const sim::ImuErrorParams* errors) {
   const std::size_t n = filter_names.size();
   std::vector<TiltErrorStats> st(n);
   std::vector<std::unique_ptr<AttitudeFilter>> filters;
   for (const auto& name : filter_names) filters.push_back(make_attitude_filter(name));
   if (duration_s <= 0.0) duration_s = sim::scenario_default_duration_s(scenario_name);
-  auto sc = sim::make_scenario(scenario_name, seed, rate_hz, duration_s);
+  sim::ScenarioOptions options;
+  if (errors != nullptr) options.errors = *errors;
+  auto sc = sim::make_scenario(scenario_name, seed, rate_hz, duration_s, options);
   if (!sc) return st;
   std::vector<double> se_h(n, 0.0);
   std::vector<double> se_p(n, 0.0);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "telltale/fusion/attitude.hpp"
+#include "telltale/fusion/sim/imu_errors.hpp"
 
 namespace telltale::fusion {
 
@@ -27,10 +28,12 @@ struct TiltErrorStats {
 
 /// Runs filters side by side over one simulated run and scores every sample after the
 /// scenario's warm-up; one result per filter name, in order. duration_s <= 0 picks the scenario's
-/// default length. An unknown scenario or filter name yields samples = 0.
+/// default length; `errors` replaces the simulator's sensor profile (nullptr: the default).
+/// An unknown scenario or filter name yields samples = 0.
 [[nodiscard]] std::vector<TiltErrorStats> evaluate_on_scenario(
     const std::vector<std::string>& filter_names, std::string_view scenario_name,
-    std::uint64_t seed, double rate_hz, double duration_s = 0.0);
+    std::uint64_t seed, double rate_hz, double duration_s = 0.0,
+    const sim::ImuErrorParams* errors = nullptr);
 
 /// Angle (rad) between the up vectors of two heel/pitch pairs (heading does not matter).
 [[nodiscard]] double inclination_error_rad(double heel_a_rad, double pitch_a_rad, double heel_b_rad,
