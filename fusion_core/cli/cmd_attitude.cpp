@@ -27,7 +27,7 @@ void run_attitude(const AttitudeOptions& o) {
       {{"t_s"}, {"gx_rad_s"}, {"gy_rad_s"}, {"gz_rad_s"}, {"ax_m_s2"}, {"ay_m_s2"}, {"az_m_s2"}},
       "t_s");
   io::CsvWriter writer(o.out, {"t_s", "heel_deg", "pitch_deg", "heel_rate_deg_s",
-                               "pitch_rate_deg_s", "acc_weight", "quality"});
+                               "pitch_rate_deg_s", "yaw_rate_deg_s", "acc_weight", "quality"});
   std::vector<double> row;
   std::size_t samples = 0;
   std::chrono::nanoseconds in_filter{0};
@@ -42,7 +42,7 @@ void run_attitude(const AttitudeOptions& o) {
     in_filter += std::chrono::steady_clock::now() - t0;
     const fusion::AttitudeOutput a = filter->output();
     writer.row({s.t_s, a.heel_rad * kDeg, a.pitch_rad * kDeg, a.heel_rate_rad_s * kDeg,
-                a.pitch_rate_rad_s * kDeg, a.acc_weight, a.quality});
+                a.pitch_rate_rad_s * kDeg, a.yaw_rate_rad_s * kDeg, a.acc_weight, a.quality});
     ++samples;
   }
   writer.close();
@@ -67,7 +67,7 @@ void register_attitude(CLI::App& app) {
       ->required();
   cmd->add_option("--out", opts->out,
                   "output CSV: t_s,heel_deg,pitch_deg,heel_rate_deg_s,pitch_rate_deg_s,"
-                  "acc_weight,quality")
+                  "yaw_rate_deg_s,acc_weight,quality")
       ->required();
   cmd->add_option("--filter", opts->filter, filters);
   cmd->callback([opts] { run_attitude(*opts); });

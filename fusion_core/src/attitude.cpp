@@ -56,6 +56,10 @@ void euler_rates_from_up(const Eigen::Vector3d& w, const Eigen::Vector3d& u,
   pitch_rate_rad_s = (w.z() * u.y() - w.y() * u.z()) / c;
 }
 
+double yaw_rate_from_up(const Eigen::Vector3d& w, const Eigen::Vector3d& u) {
+  return (w.y() * u.y() + w.z() * u.z()) / (u.y() * u.y() + u.z() * u.z());
+}
+
 const std::vector<std::string>& attitude_filter_names() {
   static const std::vector<std::string> names{"telltale", "seed",    "gyro",
                                               "accel",    "average", "kalman-const"};

@@ -18,8 +18,15 @@ bool accept(const ImuSample& s, EulerTiltState& st, BaselineDiagnostics& d, doub
 }
 
 AttitudeOutput euler_output(const EulerTiltState& st, double acc_weight) {
-  return {st.heel_rad, st.pitch_rad, st.heel_rate_rad_s, st.pitch_rate_rad_s,
-          acc_weight,  acc_weight,   st.initialised};
+  AttitudeOutput o;
+  o.heel_rad = st.heel_rad;
+  o.pitch_rad = st.pitch_rad;
+  o.heel_rate_rad_s = st.heel_rate_rad_s;
+  o.pitch_rate_rad_s = st.pitch_rate_rad_s;
+  o.acc_weight = acc_weight;
+  o.quality = acc_weight;
+  o.valid = st.initialised;
+  return o;
 }
 
 }  // namespace
@@ -108,13 +115,15 @@ void ConstKalmanAttitudeFilter::update(const ImuSample& s) {
 
 AttitudeOutput ConstKalmanAttitudeFilter::output() const {
   const double k = state_.heel.p00 / (state_.heel.p00 + params_.r_deg2);
-  return {state_.heel.angle_deg / kRadToDeg,
-          state_.pitch.angle_deg / kRadToDeg,
-          state_.heel_rate_rad_s - state_.heel.bias_deg_s / kRadToDeg,
-          state_.pitch_rate_rad_s - state_.pitch.bias_deg_s / kRadToDeg,
-          k,
-          k,
-          state_.initialised};
+  AttitudeOutput o;
+  o.heel_rad = state_.heel.angle_deg / kRadToDeg;
+  o.pitch_rad = state_.pitch.angle_deg / kRadToDeg;
+  o.heel_rate_rad_s = state_.heel_rate_rad_s - state_.heel.bias_deg_s / kRadToDeg;
+  o.pitch_rate_rad_s = state_.pitch_rate_rad_s - state_.pitch.bias_deg_s / kRadToDeg;
+  o.acc_weight = k;
+  o.quality = k;
+  o.valid = state_.initialised;
+  return o;
 }
 
 }  // namespace telltale::fusion

@@ -75,13 +75,15 @@ void SeedAttitudeFilter::update(const ImuSample& s) {
 }
 
 AttitudeOutput SeedAttitudeFilter::output() const {
-  return {state_.heel.out_deg / kRadToDeg,
-          state_.pitch.out_deg / kRadToDeg,
-          state_.heel_rate_rad_s,
-          state_.pitch_rate_rad_s,
-          state_.c,
-          state_.c / params_.c_max,
-          state_.started};
+  AttitudeOutput o;
+  o.heel_rad = state_.heel.out_deg / kRadToDeg;
+  o.pitch_rad = state_.pitch.out_deg / kRadToDeg;
+  o.heel_rate_rad_s = state_.heel_rate_rad_s;
+  o.pitch_rate_rad_s = state_.pitch_rate_rad_s;
+  o.acc_weight = state_.c;
+  o.quality = state_.c / params_.c_max;
+  o.valid = state_.started;
+  return o;
 }
 
 }  // namespace telltale::fusion

@@ -58,7 +58,10 @@ void TelltaleAttitudeFilter::initialise(const ImuSample& s) {
   state_.last_t_s = s.t_s;
   state_.tilt_var_rad2 = 0.01;  // (6 deg)^2: unknown until the first seconds have been seen
   state_.initialised = true;
-  state_.out = {heel, pitch, 0.0, 0.0, 0.0, 0.0, true};
+  state_.out = AttitudeOutput{};
+  state_.out.heel_rad = heel;
+  state_.out.pitch_rad = pitch;
+  state_.out.valid = true;
 }
 
 void TelltaleAttitudeFilter::update(const ImuSample& s) {
@@ -212,6 +215,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   AttitudeOutput& o = state_.out;
   tilt_from_accel(up_body, o.heel_rad, o.pitch_rad);
   euler_rates_from_up(gyro, up_body, o.heel_rate_rad_s, o.pitch_rate_rad_s);
+  o.yaw_rate_rad_s = yaw_rate_from_up(gyro, up_body);
   o.acc_weight = w;
   o.quality = 1.0 / (1.0 + state_.tilt_var_rad2 * kInvVar0);
   o.valid = true;

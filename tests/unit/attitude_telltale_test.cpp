@@ -191,10 +191,14 @@ TEST(TelltaleAttitudeFilter, ReportsRatesWeightAndQuality) {
   ImuSample s;
   sim::AttitudeTruth t;
   double se = 0.0;
+  double se_yaw = 0.0;
   int n = 0;
   double min_w = 1.0;
   double last_q = 0.0;
+  double last_yaw = 0.0;
   while (sc->next(s, t)) {
+    const double yaw_rate_true = std::remainder(t.yaw_rad - last_yaw, 2.0 * M_PI) * 25.0;
+    last_yaw = t.yaw_rad;
     f.update(s);
     const AttitudeOutput o = f.output();
     ASSERT_GE(o.acc_weight, 0.0);
@@ -203,12 +207,15 @@ TEST(TelltaleAttitudeFilter, ReportsRatesWeightAndQuality) {
     ASSERT_LE(o.quality, 1.0);
     if (t.t_s < 20.0) continue;
     se += std::pow((o.heel_rate_rad_s - t.heel_rate_rad_s) / kDeg, 2);
+    se_yaw += std::pow((o.yaw_rate_rad_s - yaw_rate_true) / kDeg, 2);
     ++n;
     min_w = std::min(min_w, o.acc_weight);
     last_q = o.quality;
   }
   EXPECT_LT(std::sqrt(se / n), 1.0);  // deg/s
-  EXPECT_LT(min_w, 0.5);              // tacks and waves are recognised as non-inertial
+  // Yaw rate against the truth's yaw differenced over each 40 ms step (the gyro's interval mean).
+  EXPECT_LT(std::sqrt(se_yaw / n), 1.0);
+  EXPECT_LT(min_w, 0.5);  // tacks and waves are recognised as non-inertial
   EXPECT_GT(last_q, 0.5);
 }
 

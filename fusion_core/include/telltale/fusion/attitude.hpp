@@ -29,9 +29,13 @@ struct AttitudeOutput {
   double pitch_rad = 0.0;         ///< + = bow up
   double heel_rate_rad_s = 0.0;   ///< d(heel)/dt
   double pitch_rate_rad_s = 0.0;  ///< d(pitch)/dt
-  double acc_weight = 0.0;        ///< 0..1: how much the accelerometer steered this update
-  double quality = 0.0;           ///< 0..1: filter's own confidence (1 = converged, inertial)
-  bool valid = false;             ///< false until the first accepted sample
+  /// d(yaw)/dt of the ZYX sequence: + = turning counter-clockwise seen from above (bow to port);
+  /// the compass heading rate is its negative. Filled by the production filter (0 from the
+  /// others).
+  double yaw_rate_rad_s = 0.0;
+  double acc_weight = 0.0;  ///< 0..1: how much the accelerometer steered this update
+  double quality = 0.0;     ///< 0..1: filter's own confidence (1 = converged, inertial)
+  bool valid = false;       ///< false until the first accepted sample
 };
 
 /// Common interface so tools can run any filter by name. Concrete filters are `final`, so code
@@ -71,6 +75,11 @@ void euler_rates_from_body(const Eigen::Vector3d& gyro_body_rad_s, double heel_r
 /// up = (sin(pitch), cos(pitch) sin(heel), cos(pitch) cos(heel)), without trigonometry.
 void euler_rates_from_up(const Eigen::Vector3d& gyro_body_rad_s, const Eigen::Vector3d& up_body,
                          double& heel_rate_rad_s, double& pitch_rate_rad_s);
+
+/// Yaw rate (rad/s) of the ZYX sequence from body rates and the up vector:
+/// dpsi/dt = (q sin(heel) + r cos(heel)) / cos(pitch) = (q u_y + r u_z) / (u_y^2 + u_z^2).
+[[nodiscard]] double yaw_rate_from_up(const Eigen::Vector3d& gyro_body_rad_s,
+                                      const Eigen::Vector3d& up_body);
 
 /// Names accepted by make_attitude_filter, the default first.
 [[nodiscard]] const std::vector<std::string>& attitude_filter_names();
