@@ -50,6 +50,9 @@ void run_eval_attitude(const EvalAttitudeOptions& o) {
       o.filters.empty() ? fusion::attitude_filter_names() : o.filters;
   const std::vector<std::string> scenarios =
       o.scenarios.empty() ? fusion::sim::scenario_names() : o.scenarios;
+  if (!o.broad_dir.empty() && !std::filesystem::is_directory(o.broad_dir)) {
+    throw UsageError("--broad-dir '" + o.broad_dir + "' is not a directory");
+  }
   for (const auto& f : filters) {
     if (!fusion::make_attitude_filter(f)) throw UsageError("unknown filter '" + f + "'");
   }
