@@ -30,6 +30,28 @@ SampleGate gate_sample(const ImuSample& s, bool& started, double& last_t_s, doub
   return SampleGate::kNext;
 }
 
+double fast_atan2(double y, double x) {
+  const double ay = std::abs(y);
+  const double ax = std::abs(x);
+  const bool swap = ay > ax;
+  double z = swap ? ax / ay : ay / ax;  // in [0, 1]
+  double r = 0.0;
+  constexpr double kTanPi12 = 0.26794919243112270;
+  constexpr double kSqrt3 = 1.7320508075688772;
+  if (z > kTanPi12) {  // atan(z) = pi/6 + atan((sqrt(3) z - 1) / (z + sqrt(3))), |.| <= tan(pi/12)
+    z = (kSqrt3 * z - 1.0) / (z + kSqrt3);
+    r = M_PI / 6.0;
+  }
+  const double z2 = z * z;  // |z|^15 / 15 < 2.6e-10 at |z| = tan(pi/12)
+  r += z * (1.0 + z2 * (-1.0 / 3.0 +
+                        z2 * (1.0 / 5.0 +
+                              z2 * (-1.0 / 7.0 +
+                                    z2 * (1.0 / 9.0 + z2 * (-1.0 / 11.0 + z2 * (1.0 / 13.0)))))));
+  if (swap) r = M_PI / 2.0 - r;
+  if (x < 0.0) r = M_PI - r;
+  return y < 0.0 ? -r : r;
+}
+
 void tilt_from_accel(const Eigen::Vector3d& f, double& heel_rad, double& pitch_rad) {
   // At rest f = g (sin(pitch), cos(pitch) sin(heel), cos(pitch) cos(heel)).
   heel_rad = std::atan2(f.y(), f.z());
