@@ -50,6 +50,7 @@ export function mountFleet(container, { live }) {
   // grouping, and every second when sorting by a live value, so cards do not jump at 25 Hz.
   function arrange() {
     const ids = [...cards.keys()].sort(cmp);
+    for (const id of ids) cards.get(id).dataset.sortKey = String(Math.abs(key(id)[0]));
     empty.hidden = ids.length > 0;
     count.textContent = `${ids.length} boat${ids.length === 1 ? '' : 's'}`;
     if (!group.checked) {
