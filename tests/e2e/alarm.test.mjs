@@ -3,14 +3,14 @@
 // the rules in the boat view.
 import assert from 'node:assert/strict';
 import { after, before, test } from 'node:test';
-import { eventually, login, screenshots, startBrowser, startFleet } from './harness.mjs';
+import { domainFor, eventually, login, screenshots, startBrowser, startFleet } from './harness.mjs';
 
 let fleet;
 let browser;
 let page;
 
 before(async () => {
-  fleet = await startFleet({ domain: 174, boats: ['ILCA-1', 'ILCA-2'] });
+  fleet = await startFleet({ domain: domainFor(1), boats: ['ILCA-1', 'ILCA-2'] });
   browser = await startBrowser();
   page = await browser.page();
   await fleet.rest('/alarms/rules', { method: 'PUT', body: '[]', headers: { 'Content-Type': 'application/json' } });

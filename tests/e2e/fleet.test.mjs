@@ -2,14 +2,14 @@
 // marked, the live charts draw, sorting works, no console errors; screenshots of every view.
 import assert from 'node:assert/strict';
 import { after, before, test } from 'node:test';
-import { eventually, login, screenshots, startBrowser, startFleet, stop } from './harness.mjs';
+import { domainFor, eventually, login, screenshots, startBrowser, startFleet, stop } from './harness.mjs';
 
 let fleet;
 let browser;
 let page;
 
 before(async () => {
-  fleet = await startFleet({ domain: 171, boats: ['ILCA-1', 'ILCA-2', 'ILCA-3'] });
+  fleet = await startFleet({ domain: domainFor(0), boats: ['ILCA-1', 'ILCA-2', 'ILCA-3'] });
   browser = await startBrowser();
   page = await browser.page();
 });

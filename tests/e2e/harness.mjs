@@ -62,7 +62,15 @@ export async function stop(child, signal = 'SIGINT') {
   children.delete(child);
 }
 
-// A shore server plus boats. `domain` must be unique per test file (150-199).
+// A DDS domain in 150-199 for one test file: `slot` differs per file, the run's base is random
+// so two runs on one machine (two worktrees, a demo) are unlikely to share a domain.
+// TELLTALE_E2E_DOMAIN_BASE pins the base.
+const domainBase = Number(process.env.TELLTALE_E2E_DOMAIN_BASE ?? Math.floor(Math.random() * 50));
+export function domainFor(slot) {
+  return 150 + ((domainBase + slot) % 50);
+}
+
+// A shore server plus boats on their own DDS domain and a free HTTP port.
 export async function startFleet({ domain, boats = [] }) {
   const dir = mkdtempSync(join(tmpdir(), 'telltale-e2e-'));
   const token = `e2e-${Math.random().toString(36).slice(2)}`;

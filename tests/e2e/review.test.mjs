@@ -4,7 +4,7 @@
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import { after, before, test } from 'node:test';
-import { login, screenshots, startBrowser, startFleet, stop } from './harness.mjs';
+import { domainFor, login, screenshots, startBrowser, startFleet, stop } from './harness.mjs';
 
 let fleet;
 let browser;
@@ -12,7 +12,7 @@ let page;
 let sessions;
 
 before(async () => {
-  fleet = await startFleet({ domain: 175, boats: ['ILCA-1', 'ILCA-2'] });
+  fleet = await startFleet({ domain: domainFor(2), boats: ['ILCA-1', 'ILCA-2'] });
   browser = await startBrowser();
   page = await browser.page();
   // Record ~8 s, then stop the boats so the sessions are final (the shore commits every 250 ms).
