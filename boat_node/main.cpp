@@ -1,122 +1,364 @@
-// boat_node: runs the fusion core on a boat's IMU and publishes heel, pitch and heading over DDS.
+// boat_node: runs the fusion core on a boat's sensors and publishes heel, pitch and heading over
+// DDS; logs every published sample to disk and backfills the shore after a link outage.
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+#include <fastdds/rtps/transport/test_UDPv4TransportDescriptor.h>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <functional>
 #include <limits>
+#include <random>
 #include <regex>
 #include <string>
 
-#include "boat_publisher.hpp"
+#include "backfill.hpp"
+#include "boat_dds.hpp"
+#include "console.hpp"
+#include "csv.hpp"
+#include "heading_input.hpp"
+#include "imu_source.hpp"
+#include "session_log.hpp"
 #include "shutdown.hpp"
-#include "sim_source.hpp"
+#include "telltale/fusion/alarm_engine.hpp"
 #include "telltale/fusion/complementary.hpp"
 #include "telltale/fusion/led_panel.hpp"
+#include "telltale/fusion/mounting.hpp"
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
+using telltale::fusion::AlarmLevel;
 constexpr double kRadToDeg = 180.0 / M_PI;
 
 struct Options {
   telltale::dds::DdsOptions dds;
   std::string boat_id;
+  std::string group;
   std::string source = "sim";
+  std::vector<std::string> headings;
+  double variation_deg = std::numeric_limits<double>::quiet_NaN();
   double rate_hz = 25.0;
   double imu_rate_hz = 100.0;
   std::uint64_t seed = 0;
+  telltale::boat::ReplayOptions replay;
+  std::string log_dir = "boat_log";
+  double log_max_mb = 1024;
+  std::string axis_remap = "x=x,y=y,z=z";
+  std::string mount_file;
+  double calibrate_s = 0;
+  bool console = false;
+  std::string warn_command;
+  double led_step_deg = 5.0;
+  int leds_per_bar = 6;
+  double default_max_heel_deg = 30.0;
+  std::string fault_drop_link;  ///< "START_S:DURATION_S"
 };
 
-void validate(const Options& o) {
-  static const std::regex kId("[A-Za-z0-9_-]{1,32}");
-  if (!std::regex_match(o.boat_id, kId))
-    throw std::invalid_argument("boat id must be 1-32 of [A-Za-z0-9_-], got '" + o.boat_id + "'");
-  if (o.source != "sim") throw std::invalid_argument("unknown source '" + o.source + "'");
-  if (!(o.imu_rate_hz > 0.0 && o.imu_rate_hz <= 1000.0))
-    throw std::invalid_argument("--imu-rate-hz must be in (0, 1000]");
-  if (!(o.rate_hz > 0.0 && o.rate_hz <= o.imu_rate_hz))
-    throw std::invalid_argument("--rate-hz must be in (0, --imu-rate-hz]");
+/// Fault injection for tests: every packet this node sends is dropped from START_S to
+/// START_S + DURATION_S after start (Fast DDS's test UDP transport, loopback only), as if the
+/// radio link were cut.
+void inject_link_drop(Options& o) {
+  if (o.fault_drop_link.empty()) return;
+  const auto colon = o.fault_drop_link.find(':');
+  if (colon == std::string::npos)
+    throw std::invalid_argument("--fault-drop-link takes START_S:DURATION_S");
+  const double start_s = std::stod(o.fault_drop_link.substr(0, colon));
+  const double duration_s = std::stod(o.fault_drop_link.substr(colon + 1));
+  const auto t0 = Clock::now();
+  o.dds.customize = [=](eprosima::fastdds::dds::DomainParticipantQos& qos) {
+    auto lossy = std::make_shared<eprosima::fastdds::rtps::test_UDPv4TransportDescriptor>();
+    lossy->interfaceWhiteList.push_back("127.0.0.1");
+    lossy->maxInitialPeersRange = 40;
+    lossy->messages_filter_ = [=](eprosima::fastrtps::rtps::CDRMessage_t&) {
+      const double t = std::chrono::duration<double>(Clock::now() - t0).count();
+      return t >= start_s && t < start_s + duration_s;
+    };
+    qos.transport().user_transports.clear();
+    qos.transport().user_transports.push_back(lossy);
+    qos.transport().use_builtin_transports = false;
+  };
+}
+
+const std::regex kId("[A-Za-z0-9_-]{1,32}");
+
+/// The rule a boat uses until a shore pushes its own: heel beyond +-N deg for 2 s.
+std::vector<telltale::fusion::AlarmRule> default_rules(const Options& o) {
+  telltale::fusion::AlarmRule r;
+  r.id = "local-heel";
+  r.quantity = telltale::fusion::AlarmQuantity::kHeel;
+  r.min_deg = -o.default_max_heel_deg;
+  r.max_deg = o.default_max_heel_deg;
+  r.hold_s = 2.0;
+  r.hysteresis_deg = 2.0;
+  r.level = AlarmLevel::kAlarm;
+  return {r};
+}
+
+/// Mounting offsets file: "heel_offset_deg pitch_offset_deg" on one line.
+void load_offsets(const std::string& path, telltale::fusion::Mounting& m) {
+  if (path.empty()) return;
+  std::ifstream in(path);
+  if (!in) return;  // not calibrated yet
+  if (!(in >> m.heel_offset_deg >> m.pitch_offset_deg) || !std::isfinite(m.heel_offset_deg) ||
+      !std::isfinite(m.pitch_offset_deg) || std::abs(m.heel_offset_deg) > 45 ||
+      std::abs(m.pitch_offset_deg) > 45)
+    throw std::invalid_argument("mount file " + path + ": expected two offsets in degrees");
+}
+
+void save_offsets(const std::string& path, const telltale::fusion::Mounting& m) {
+  std::ofstream out(path + ".tmp");
+  out << m.heel_offset_deg << ' ' << m.pitch_offset_deg << '\n';
+  out.close();
+  if (!out || std::rename((path + ".tmp").c_str(), path.c_str()) != 0)
+    throw std::runtime_error("cannot write mount file " + path);
 }
 
 void run(const Options& o, telltale::ShutdownSignal& shutdown) {
-  validate(o);
-  telltale::boat::BoatPublisher publisher(o.dds, o.boat_id);
+  if (!std::regex_match(o.boat_id, kId))
+    throw std::invalid_argument("boat id must be 1-32 of [A-Za-z0-9_-], got '" + o.boat_id + "'");
+  if (!o.group.empty() && !std::regex_match(o.group, kId))
+    throw std::invalid_argument("group must be 1-32 of [A-Za-z0-9_-], got '" + o.group + "'");
+  if (!(o.rate_hz > 0.0 && o.rate_hz <= 200.0))
+    throw std::invalid_argument("--rate-hz must be in (0, 200]");
+  if (!(o.imu_rate_hz > 0.0 && o.imu_rate_hz <= 1000.0))
+    throw std::invalid_argument("--imu-rate-hz must be in (0, 1000]");
+  telltale::fusion::Mounting mounting;
+  const auto remap = telltale::fusion::parse_axis_remap(o.axis_remap);
+  if (!remap) throw std::invalid_argument("--axis-remap: e.g. x=-y,y=x,z=z (a proper rotation)");
+  mounting.remap = *remap;
+  load_offsets(o.mount_file, mounting);
+  if (o.calibrate_s > 0 && o.mount_file.empty())
+    throw std::invalid_argument("--calibrate-s needs --mount-file to store the offsets");
+
   const std::uint64_t seed = o.seed ? o.seed : std::hash<std::string>{}(o.boat_id);
-  telltale::boat::SimSource source(seed, o.imu_rate_hz);
-  telltale::fusion::ComplementaryFilter filter;
+  auto source = telltale::boat::make_imu_source(o.source, seed, o.imu_rate_hz, o.replay);
+  std::unique_ptr<telltale::boat::HeadingInput> heading;
+  if (!o.headings.empty())
+    heading = std::make_unique<telltale::boat::HeadingInput>(o.headings, o.variation_deg);
+
+  std::random_device rd;
+  const std::uint64_t boot_id = (static_cast<std::uint64_t>(rd()) << 32) ^ rd() ^
+                                static_cast<std::uint64_t>(getpid());
+  telltale::boat::SessionLog log({o.log_dir, o.boat_id, boot_id, 100000,
+                                  static_cast<std::uint64_t>(o.log_max_mb * 1024 * 1024)});
+
+  telltale::fusion::AlarmEngine alarms;
+  alarms.set_rules(default_rules(o), 0);
+  std::atomic<bool> shore_rules{false};
+  std::atomic<bool> silenced{false};
+
+  std::unique_ptr<telltale::boat::Backfiller> backfiller;
+  telltale::boat::BoatDdsCallbacks callbacks;
+  callbacks.on_ack = [&](std::uint64_t boot, std::uint64_t acked) {
+    if (backfiller) backfiller->on_ack(boot, acked);
+  };
+  callbacks.on_rules = [&](std::vector<telltale::fusion::AlarmRule> rules) {
+    shore_rules = true;
+    alarms.set_rules(rules.empty() ? default_rules(o) : std::move(rules),
+                     telltale::utc_now_ns());
+  };
+  callbacks.on_event = [&](const telltale::msg::AlarmEvent& e) {
+    silenced = e.phase() == telltale::msg::ALARM_PHASE_SILENCED;
+  };
+  telltale::boat::BoatDds dds(o.dds, o.boat_id, callbacks);
 
   telltale::msg::BoatAttitude out;
-  telltale::dds::assign_bounded<32>(out.boat_id(), o.boat_id, "boat id");
+  out.boat_id(o.boat_id);
+  out.boot_id(boot_id);
+  const auto to_wire = [&](const telltale::boat::LogRecord& r) {
+    out.seq(r.seq);
+    out.t_utc_ns(r.t_utc_ns);
+    out.heel_deg(r.heel_deg);
+    out.pitch_deg(r.pitch_deg);
+    out.heading_deg(r.heading_deg);
+    out.heel_rate_deg_s(r.heel_rate_deg_s);
+    out.pitch_rate_deg_s(r.pitch_rate_deg_s);
+    out.yaw_rate_deg_s(r.yaw_rate_deg_s);
+    out.accel_weight(r.accel_weight);
+    out.quality(r.quality);
+    out.leds().left_leds(r.leds[0]);
+    out.leds().right_leds(r.leds[1]);
+    out.leds().up_leds(r.leds[2]);
+    out.leds().down_leds(r.leds[3]);
+    out.leds().led_count(r.led_count);
+    out.leds().level(static_cast<telltale::msg::AlarmLevel>(r.level));
+    return &out;
+  };
+  std::mutex backfill_msg_mutex;
+  telltale::msg::BoatAttitude backfill_msg;
+  backfill_msg.boat_id(o.boat_id);
+  backfill_msg.boot_id(boot_id);
+  backfiller = std::make_unique<telltale::boat::Backfiller>(
+      telltale::boat::BackfillConfig{boot_id, static_cast<std::uint64_t>(2 * o.rate_hz), 2500,
+                                     std::chrono::milliseconds(5000)},
+      telltale::boat::SessionLogReader(o.log_dir, o.boat_id, boot_id),
+      [&](const telltale::boat::LogRecord& r) {
+        std::lock_guard lock(backfill_msg_mutex);
+        telltale::msg::BoatAttitude m = *to_wire(r);  // copy: `out` belongs to the sensor loop
+        return dds.backfill(m);
+      });
+
   telltale::msg::NodeStatus status;
-  telltale::dds::assign_bounded<32>(status.node_id(), o.boat_id, "boat id");
+  status.node_id(o.boat_id);
   status.kind(telltale::msg::NODE_KIND_BOAT);
   status.software_version(TELLTALE_VERSION);
+  status.group(o.group);
 
-  std::printf("boat_node ready: boat=%s domain=%d source=%s rate=%gHz\n", o.boat_id.c_str(),
-              telltale::dds::resolve_domain(o.dds.domain), o.source.c_str(), o.rate_hz);
+  telltale::boat::WarningHook hook(o.warn_command, std::chrono::seconds(5));
+  const bool tty = isatty(STDOUT_FILENO) != 0;
+  telltale::fusion::ComplementaryFilter filter;
+  const telltale::fusion::LedPanelParams led_params{o.led_step_deg,
+                                                    static_cast<std::uint8_t>(o.leds_per_bar)};
+
+  std::printf("boat_node ready: boat=%s domain=%d source=%s rate=%gHz boot=%016llx log=%s\n",
+              o.boat_id.c_str(), dds.domain(), source->describe().c_str(), o.rate_hz,
+              static_cast<unsigned long long>(boot_id), o.log_dir.c_str());
   std::fflush(stdout);
 
   const auto start = Clock::now();
   const unsigned long long start_utc_ns = telltale::utc_now_ns();
-  const auto period = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(1.0 / o.imu_rate_hz));
   const double publish_period_s = 1.0 / o.rate_hz;
+  double first_t = std::numeric_limits<double>::quiet_NaN();
   double next_publish_s = 0.0;
+  double last_t = -std::numeric_limits<double>::infinity();
   double last_heel = std::numeric_limits<double>::quiet_NaN();
   double last_pitch = last_heel;
-  double last_publish_s = 0.0;
-  unsigned long long seq = 0;
+  double last_publish_t = 0.0;
+  double calib_heel = 0.0, calib_pitch = 0.0;
+  int calib_n = 0;
+  bool calibrating = o.calibrate_s > 0;
+  std::uint64_t seq = 0;
+  std::uint32_t health = telltale::msg::SENSOR_OK;
+  unsigned write_failures = 0, log_failures = 0, bad_samples = 0;
   auto next_status = start;
-  auto tick = start;
-  unsigned write_failures = 0;
+  auto next_console = start;
+  auto next_flush = start + std::chrono::seconds(1);
+  Clock::time_point last_sample_wall = start;
 
   while (!shutdown.stop_requested()) {
-    const telltale::fusion::ImuSample s = source.next();
-    filter.update(s);
-    if (s.t_s + 1e-9 >= next_publish_s) {
-      next_publish_s += publish_period_s;
-      const double heel = filter.heel_rad() * kRadToDeg;
-      const double pitch = filter.pitch_rad() * kRadToDeg;
-      const double dt = s.t_s - last_publish_s;
-      out.seq(++seq);
-      out.t_utc_ns(start_utc_ns + static_cast<unsigned long long>(s.t_s * 1e9));
-      out.heel_deg(heel);
-      out.pitch_deg(pitch);
-      out.heading_deg(std::numeric_limits<double>::quiet_NaN());
-      out.heel_rate_deg_s(std::isfinite(last_heel) && dt > 0 ? (heel - last_heel) / dt : 0.0);
-      out.pitch_rate_deg_s(std::isfinite(last_pitch) && dt > 0 ? (pitch - last_pitch) / dt : 0.0);
-      out.yaw_rate_deg_s(s.gyro_body_rad_s.z() * kRadToDeg);
-      out.accel_weight(0.0f);
-      out.quality(1.0f);
-      const auto leds = telltale::fusion::led_panel(heel, pitch);
-      out.leds().left_leds(leds.left);
-      out.leds().right_leds(leds.right);
-      out.leds().up_leds(leds.up);
-      out.leds().down_leds(leds.down);
-      out.leds().led_count(6);
-      out.leds().level(telltale::msg::ALARM_LEVEL_NORMAL);
-      if (!publisher.publish(out)) ++write_failures;
-      last_heel = heel;
-      last_pitch = pitch;
-      last_publish_s = s.t_s;
+    const auto sample = source->next();
+    if (!sample) break;  // end of a replay
+    if (std::isnan(first_t)) first_t = sample->t_s;
+    const double t = sample->t_s - first_t;
+    if (source->real_time()) {
+      // Pace on the sample clock; a stop request wakes the wait.
+      const auto due = start + std::chrono::duration_cast<Clock::duration>(
+                                   std::chrono::duration<double>(t));
+      if (shutdown.wait_for(due - Clock::now())) break;
     }
     const auto now = Clock::now();
+    // Bad input is flagged, never fused: time going backwards, NaN/Inf, saturated values.
+    if (!(sample->t_s > last_t)) {
+      health |= telltale::msg::SENSOR_TIME_BACKWARDS;
+      ++bad_samples;
+      continue;
+    }
+    last_t = sample->t_s;
+    if (!sample->gyro_body_rad_s.allFinite() || !sample->acc_body_m_s2.allFinite()) {
+      health |= telltale::msg::SENSOR_NON_FINITE;
+      ++bad_samples;
+      continue;
+    }
+    if (sample->acc_body_m_s2.cwiseAbs().maxCoeff() > 156.0 ||
+        sample->gyro_body_rad_s.cwiseAbs().maxCoeff() > 34.9) {
+      health |= telltale::msg::SENSOR_SATURATED;  // +-16 g, +-2000 dps: a typical MEMS range
+    }
+    last_sample_wall = now;
+    filter.update(mounting.apply(*sample));
+
+    if (t + 1e-9 >= next_publish_s) {
+      next_publish_s += publish_period_s;
+      if (next_publish_s < t) next_publish_s = t + publish_period_s;  // after a gap in the data
+      const double raw_heel = filter.heel_rad() * kRadToDeg;
+      const double raw_pitch = filter.pitch_rad() * kRadToDeg;
+      if (calibrating) {
+        calib_heel += raw_heel;
+        calib_pitch += raw_pitch;
+        ++calib_n;
+        if (t >= o.calibrate_s) {
+          mounting.heel_offset_deg = calib_heel / calib_n;
+          mounting.pitch_offset_deg = calib_pitch / calib_n;
+          save_offsets(o.mount_file, mounting);
+          std::printf("boat_node calibrated: heel offset %.2f deg, pitch offset %.2f deg -> %s\n",
+                      mounting.heel_offset_deg, mounting.pitch_offset_deg, o.mount_file.c_str());
+          std::fflush(stdout);
+          calibrating = false;
+        }
+      }
+      const double heel = raw_heel - mounting.heel_offset_deg;
+      const double pitch = raw_pitch - mounting.pitch_offset_deg;
+      const double dt = t - last_publish_t;
+      telltale::boat::LogRecord r;
+      r.seq = ++seq;
+      r.t_utc_ns = start_utc_ns + static_cast<unsigned long long>(t * 1e9);
+      r.heel_deg = heel;
+      r.pitch_deg = pitch;
+      r.heading_deg = heading ? heading->tick(now) : std::numeric_limits<double>::quiet_NaN();
+      r.heel_rate_deg_s = std::isfinite(last_heel) && dt > 0 ? (heel - last_heel) / dt : 0.0;
+      r.pitch_rate_deg_s = std::isfinite(last_pitch) && dt > 0 ? (pitch - last_pitch) / dt : 0.0;
+      r.yaw_rate_deg_s = sample->gyro_body_rad_s.z() * kRadToDeg;
+      r.accel_weight = 0.0f;
+      r.quality = health == telltale::msg::SENSOR_OK ? 1.0f : 0.5f;
+      alarms.evaluate(o.boat_id, o.group, r.t_utc_ns, heel, pitch);
+      const AlarmLevel level = alarms.level_of(o.boat_id);
+      const auto leds = telltale::fusion::led_panel(heel, pitch, led_params);
+      r.leds[0] = leds.left;
+      r.leds[1] = leds.right;
+      r.leds[2] = leds.up;
+      r.leds[3] = leds.down;
+      r.led_count = led_params.leds_per_bar;
+      r.level = static_cast<std::uint8_t>(level);
+      if (!log.append(r)) ++log_failures;
+      if (!dds.publish(*to_wire(r))) ++write_failures;
+      backfiller->on_published(r.seq);
+      if (!silenced) hook.on_level(o.boat_id, level, heel, now);
+      last_heel = heel;
+      last_pitch = pitch;
+      last_publish_t = t;
+      if (o.console && now >= next_console) {
+        next_console = now + std::chrono::milliseconds(200);
+        std::printf("%s%s", telltale::boat::render_panel(o.boat_id, heel, pitch, leds,
+                                                         o.leds_per_bar, level, tty)
+                                .c_str(),
+                    tty ? "\r" : "\n");
+        std::fflush(stdout);
+      }
+    }
+    if (now >= next_flush) {
+      next_flush = now + std::chrono::seconds(1);
+      log.flush();
+    }
     if (now >= next_status) {
-      next_status += std::chrono::seconds(1);
-      const auto& diag = filter.diagnostics();
+      next_status = now + std::chrono::seconds(1);
+      std::uint32_t h = health;
+      if (heading && heading->degraded()) h |= telltale::msg::SENSOR_HEADING_DEGRADED;
+      if (filter.diagnostics().rejected_non_finite) h |= telltale::msg::SENSOR_NON_FINITE;
+      std::string text = h == 0 ? "ok" : "sensor flags " + std::to_string(h);
+      if (write_failures) text += "; dds write failures " + std::to_string(write_failures);
+      if (log_failures) text += "; session log write failures " + std::to_string(log_failures);
+      if (!backfiller->shore_seen()) text += "; no shore receipt yet";
       status.t_utc_ns(telltale::utc_now_ns());
       status.uptime_s(std::chrono::duration<double>(now - start).count());
       status.samples_published(seq);
-      status.sensor_health(diag.rejected_non_finite ? telltale::msg::SENSOR_NON_FINITE
-                                                    : telltale::msg::SENSOR_OK);
-      status.health_text(write_failures ? "dds write failures" : "ok");
-      publisher.publish(status);
+      status.sensor_health(h);
+      status.health_text(text.substr(0, 128));
+      dds.publish(status);
+      health = telltale::msg::SENSOR_OK;  // flags cover the last second
     }
-    tick += period;
-    shutdown.wait_for(tick - Clock::now());
   }
-  std::printf("boat_node stopped: boat=%s published=%llu\n", o.boat_id.c_str(), seq);
+  log.flush();
+  if (o.console && tty) std::printf("\n");
+  // Hand the shore what it is missing before going (bounded wait).
+  const bool complete = backfiller->drain(std::chrono::seconds(3));
+  std::printf("boat_node stopped: boat=%s published=%llu resent=%llu shore_has_all=%s bad_samples=%u\n",
+              o.boat_id.c_str(), static_cast<unsigned long long>(seq),
+              static_cast<unsigned long long>(backfiller->resent()), complete ? "yes" : "no",
+              bad_samples);
+  (void)last_sample_wall;
 }
 
 }  // namespace
@@ -125,15 +367,45 @@ int main(int argc, char** argv) {
   telltale::ShutdownSignal shutdown;  // first: every later thread inherits the blocked signals
   Options o;
   int domain = -1;
-  CLI::App app{"Telltale boat node: IMU -> fusion core -> heel, pitch, heading over DDS"};
+  CLI::App app{"Telltale boat node: IMU (+ heading sensors) -> fusion core -> DDS, with a session "
+               "log and backfill"};
+  app.set_config("--config", "", "read options from this file (INI/TOML: key = value)");
   app.add_option("--domain", domain, "DDS domain id (default: $TELLTALE_DOMAIN)");
   app.add_option("--boat-id", o.boat_id, "fleet-unique boat id, 1-32 of [A-Za-z0-9_-]")
       ->required();
-  app.add_option("--source", o.source, "sensor source: sim")->capture_default_str();
+  app.add_option("--group", o.group, "fleet group or class (alarm rules can target it)");
+  app.add_option("--source", o.source, "IMU: sim | replay:FILE.csv")->capture_default_str();
+  app.add_option("--heading", o.headings,
+                 "heading sensor, repeatable: nmea:DEVICE[@BAUD] | nmea:udp:[ADDR:]PORT");
+  app.add_option("--variation-deg", o.variation_deg,
+                 "magnetic variation (E positive) to use HDM/HDG sentences without one");
   app.add_option("--rate-hz", o.rate_hz, "publish rate, Hz")->capture_default_str();
-  app.add_option("--imu-rate-hz", o.imu_rate_hz, "IMU sample rate of the sim source, Hz")
+  app.add_option("--imu-rate-hz", o.imu_rate_hz, "IMU rate of the sim source, Hz")
       ->capture_default_str();
-  app.add_option("--seed", o.seed, "simulator seed (default: derived from the boat id)");
+  app.add_option("--seed", o.seed, "simulator seed (default: from the boat id)");
+  app.add_flag("--replay-fast", o.replay.fast, "replay as fast as possible (default: real time)");
+  app.add_flag("--replay-loop", o.replay.loop, "replay the file again at its end");
+  app.add_option("--log-dir", o.log_dir, "session log directory")->capture_default_str();
+  app.add_option("--log-max-mb", o.log_max_mb, "session log disk budget; oldest files go first")
+      ->capture_default_str();
+  app.add_option("--axis-remap", o.axis_remap, "boat axes from sensor axes, e.g. x=-y,y=x,z=z")
+      ->capture_default_str();
+  app.add_option("--mount-file", o.mount_file, "heel/pitch zero offsets (read, and written by "
+                                               "--calibrate-s)");
+  app.add_option("--calibrate-s", o.calibrate_s,
+                 "with the boat level at the dock: average this long and store the offsets");
+  app.add_flag("--console", o.console, "show the LED panel on the console");
+  app.add_option("--warn-command", o.warn_command,
+                 "command run when the alarm level rises (TELLTALE_LEVEL etc. in its environment)");
+  app.add_option("--led-step-deg", o.led_step_deg, "degrees per LED")->capture_default_str();
+  app.add_option("--leds-per-bar", o.leds_per_bar, "LEDs per bar")->capture_default_str()
+      ->check(CLI::Range(1, 20));
+  app.add_option("--default-max-heel-deg", o.default_max_heel_deg,
+                 "local alarm when no shore has pushed rules: |heel| above this for 2 s")
+      ->capture_default_str();
+  app.add_option("--fault-drop-link", o.fault_drop_link,
+                 "testing: drop every packet this node sends from START_S for DURATION_S")
+      ->group("Fault injection");
   app.add_option("--dds-profiles", o.dds.profiles_file,
                  "Fast DDS profiles XML (default: $TELLTALE_DDS_PROFILES or deploy/dds/)");
   app.add_option("--dds-participant", o.dds.participant_profile,
@@ -142,6 +414,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   if (domain >= 0) o.dds.domain = domain;
   try {
+    inject_link_drop(o);
     run(o, shutdown);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "boat_node: %s\n", e.what());

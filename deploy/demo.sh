@@ -3,7 +3,9 @@
 # dashboard. Prints the dashboard link with its token; Ctrl-C stops everything cleanly.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-"$root/deploy/build.sh"
+echo "building (log: $root/build/build.log)..."
+mkdir -p "$root/build"
+"$root/deploy/build.sh" >"$root/build/build.log" 2>&1 || { tail -n 40 "$root/build/build.log"; exit 1; }
 bin="$root/build/bin"
 export TELLTALE_DOMAIN=${TELLTALE_DOMAIN:-$((10 + $$ % 90))}
 port=${TELLTALE_HTTP_PORT:-8080}
@@ -12,13 +14,16 @@ db=${TELLTALE_DB:-$root/build/demo.db}
 log=$(mktemp -d)
 pids=()
 stop() {
+  local status=${1:-0}
   trap - INT TERM EXIT
   [ ${#pids[@]} -gt 0 ] && kill -INT "${pids[@]}" 2>/dev/null || true
   wait 2>/dev/null || true
   rm -rf "$log"
   echo "demo stopped (recording kept in $db)"
+  exit "$status"
 }
-trap stop INT TERM EXIT
+trap 'stop 0' INT TERM
+trap 'stop 1' EXIT
 "$bin/shore_server" --http-port "$port" --db "$db" --coach-token "$token" >"$log/shore" 2>&1 &
 pids+=($!)
 for _ in $(seq 100); do grep -q "ready" "$log/shore" && break; sleep 0.1; done
@@ -33,5 +38,6 @@ echo "Dashboard: ${url}#token=${token}"
 echo "Coach token: ${token}   (curl -H 'Authorization: Bearer ${token}' ${url}api/v1/boats)"
 echo "Ctrl-C to stop."
 wait -n "${pids[@]}" || true
-echo "a demo process exited:" >&2
+echo "a demo process exited unexpectedly:" >&2
 tail -n 5 "$log"/* >&2
+stop 1

@@ -1,5 +1,7 @@
 #include "fleet.hpp"
 
+#include <algorithm>
+
 namespace telltale::shore {
 
 BoatView FleetModel::update(const AttitudeSample& sample, SteadyTime arrival,
@@ -7,6 +9,19 @@ BoatView FleetModel::update(const AttitudeSample& sample, SteadyTime arrival,
   std::lock_guard lock(mutex_);
   auto it = boats_.try_emplace(sample.boat_id).first;
   BoatView& b = it->second;
+  // Clock offset: the minimum of (arrival - sample time) over a 10 s window filters out network
+  // and scheduling delays, leaving the clock difference (plus the least delay, < 1 ms on a LAN).
+  const double offset_ms =
+      (static_cast<double>(arrival_utc_ns) - static_cast<double>(sample.t_utc_ns)) * 1e-6;
+  if (b.samples_received == 0 || arrival - b.window_start > std::chrono::seconds(10)) {
+    if (b.samples_received > 0) b.clock_offset_ms = b.window_min_offset_ms;
+    b.window_start = arrival;
+    b.window_min_offset_ms = offset_ms;
+    if (b.samples_received == 0) b.clock_offset_ms = offset_ms;
+  } else {
+    b.window_min_offset_ms = std::min(b.window_min_offset_ms, offset_ms);
+    b.clock_offset_ms = std::min(b.clock_offset_ms, b.window_min_offset_ms);
+  }
   b.last = sample;
   b.last_arrival = arrival;
   b.arrival_utc_ns = arrival_utc_ns;
@@ -40,6 +55,20 @@ std::optional<BoatView> FleetModel::mark_stale(const std::string& boat_id) {
   auto it = boats_.find(boat_id);
   if (it == boats_.end() || it->second.stale) return std::nullopt;
   it->second.stale = true;
+  return it->second;
+}
+
+std::optional<BoatView> FleetModel::set_alarm_state(const std::string& boat_id,
+                                                    const std::string& state) {
+  std::lock_guard lock(mutex_);
+  auto it = boats_.find(boat_id);
+  if (it == boats_.end()) {
+    // Known from a stored alarm before the boat's first sample after a restart.
+    it = boats_.try_emplace(boat_id).first;
+    it->second.last.boat_id = boat_id;
+    it->second.stale = true;
+  }
+  it->second.alarm_state = state;
   return it->second;
 }
 

@@ -12,7 +12,21 @@
 #include <string>
 #include <vector>
 
+#include "telltale/fusion/alarm_engine.hpp"
+
 namespace telltale::shore {
+
+// The alarm engine is shared with the boats (fusion_core); the shore uses its names directly.
+using fusion::AlarmEngine;
+using fusion::AlarmEvent;
+using fusion::AlarmLevel;
+using fusion::AlarmPhase;
+using fusion::AlarmQuantity;
+using fusion::AlarmRule;
+using fusion::parse_level;
+using fusion::parse_phase;
+using fusion::parse_quantity;
+using fusion::to_string;
 
 using SteadyTime = std::chrono::steady_clock::time_point;
 
@@ -31,6 +45,7 @@ struct AttitudeSample {
   float quality = 0.0f;
   std::uint8_t leds[4] = {0, 0, 0, 0};  ///< left, right, up, down
   std::uint8_t led_count = 0;
+  std::uint64_t boot_id = 0;  ///< the boat node's run; seq restarts with a new one
 };
 
 struct NodeStatusInfo {
@@ -40,6 +55,7 @@ struct NodeStatusInfo {
   std::uint32_t sensor_health = 0;
   std::string health_text;
   std::uint64_t samples_published = 0;
+  std::string group;
 };
 
 struct BoatView {
@@ -50,7 +66,15 @@ struct BoatView {
   std::string alarm_state = "normal";
   std::optional<NodeStatusInfo> status;
   std::uint64_t samples_received = 0;
+  /// Arrival (shore clock) minus sample time (boat clock), the smallest over the last 10 s: the
+  /// boat's clock offset plus the least network delay. NaN until the first sample.
+  double clock_offset_ms = 0.0;
+  double window_min_offset_ms = 0.0;
+  SteadyTime window_start{};
 };
+
+/// A boat whose clock is off by more than this is flagged (clock_suspect in the API).
+inline constexpr double kClockSuspectMs = 100.0;
 
 class FleetModel {
  public:
@@ -64,6 +88,9 @@ class FleetModel {
   std::vector<BoatView> sweep(SteadyTime now);
   /// Forces a boat stale now (DDS deadline missed); its view if it just went stale.
   std::optional<BoatView> mark_stale(const std::string& boat_id);
+
+  /// Sets a boat's alarm state ("normal", "warn", "alarm"); its view if the boat is known.
+  std::optional<BoatView> set_alarm_state(const std::string& boat_id, const std::string& state);
 
   [[nodiscard]] std::vector<BoatView> boats() const;
   [[nodiscard]] std::optional<BoatView> boat(const std::string& boat_id) const;

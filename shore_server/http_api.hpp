@@ -1,15 +1,21 @@
 #pragma once
 /// \file
-/// The shore's HTTP face: REST under /api/v1 (SPEC section 6), the live stream (SSE), and the
-/// static dashboard from web/. One class owns the cpp-httplib server and its configuration.
+/// The shore's HTTP face: REST under /api/v1 (SPEC section 6, described in openapi.json), the live
+/// stream (SSE), and the static dashboard from web/. One class owns the cpp-httplib server and its
+/// configuration; the routes live in rest_routes.cpp.
 
 #include <memory>
 #include <string>
 
+#include "alarm_service.hpp"
 #include "auth.hpp"
 #include "fleet.hpp"
 #include "live_hub.hpp"
 #include "store.hpp"
+
+namespace httplib {
+class Server;
+}
 
 namespace telltale::shore {
 
@@ -22,10 +28,18 @@ struct HttpConfig {
   std::size_t max_body_bytes = 1 << 20;
 };
 
+/// What the routes work on.
+struct ShoreContext {
+  FleetModel& fleet;
+  LiveHub& hub;
+  TokenStore& tokens;
+  Store& store;
+  AlarmService& alarms;
+};
+
 class HttpApi {
  public:
-  HttpApi(HttpConfig config, FleetModel& fleet, LiveHub& hub, TokenStore& tokens,
-          SampleStore& store);
+  HttpApi(HttpConfig config, ShoreContext context);
   ~HttpApi();
   HttpApi(const HttpApi&) = delete;
   HttpApi& operator=(const HttpApi&) = delete;
@@ -41,9 +55,11 @@ class HttpApi {
   std::unique_ptr<Impl> impl_;
 };
 
-/// The JSON of one boat as /api/v1/boats and the stream present it.
-[[nodiscard]] std::string boat_json(const BoatView& view);
-/// ISO-8601 UTC with milliseconds for ns since 1970.
-[[nodiscard]] std::string iso8601(std::uint64_t t_utc_ns);
+/// Registers the data routes (boats, sessions, attitude, export, alarms) on `server`.
+void register_rest_routes(httplib::Server& server, ShoreContext& context);
+
+/// The principal of a request; throws HttpError 401 if it has no valid token.
+[[nodiscard]] Principal authenticate(const TokenStore& tokens, const std::string& authorization,
+                                     const std::string& cookie);
 
 }  // namespace telltale::shore

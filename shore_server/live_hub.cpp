@@ -19,11 +19,13 @@ std::string frame(const std::string& type, const std::string& data) {
 LiveHub::LiveHub(std::size_t max_clients, std::size_t max_events)
     : max_clients_(max_clients), max_events_(max_events) {}
 
-std::shared_ptr<LiveHub::Client> LiveHub::connect() {
+std::shared_ptr<LiveHub::Client> LiveHub::connect(std::optional<std::string> only_key) {
   std::lock_guard lock(mutex_);
   if (closed_ || clients_.size() >= max_clients_) return nullptr;
-  clients_.push_back(std::make_shared<Client>());
-  return clients_.back();
+  auto client = std::make_shared<Client>();
+  client->only_key_ = std::move(only_key);
+  clients_.push_back(client);
+  return client;
 }
 
 void LiveHub::disconnect(const std::shared_ptr<Client>& client) {
@@ -35,17 +37,20 @@ void LiveHub::publish_sample(const std::string& key, std::string data) {
   {
     std::lock_guard lock(mutex_);
     if (clients_.empty()) return;
-    for (auto& c : clients_) c->latest_[key] = data;
+    for (auto& c : clients_)
+      if (!c->only_key_ || *c->only_key_ == key) c->latest_[key] = data;
   }
   cv_.notify_all();
 }
 
-void LiveHub::publish_event(const std::string& type, std::string data) {
+void LiveHub::publish_event(const std::string& type, const std::string& data,
+                            const std::string& key) {
   const std::string f = frame(type, data);
   {
     std::lock_guard lock(mutex_);
     if (clients_.empty()) return;
     for (auto& c : clients_) {
+      if (c->only_key_ && *c->only_key_ != key) continue;
       if (c->events_.size() >= max_events_) {
         c->events_.pop_front();
         ++c->dropped_events_;

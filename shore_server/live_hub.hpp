@@ -12,6 +12,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,14 +25,16 @@ class LiveHub {
   /// At most `max_clients` streams at once; at most `max_events` events wait per client.
   LiveHub(std::size_t max_clients, std::size_t max_events);
 
-  /// A new client, or nullptr when the hub is full or closed.
-  std::shared_ptr<Client> connect();
+  /// A new client, or nullptr when the hub is full or closed. With `only_key` set the client gets
+  /// samples and events of that key (boat) alone (an athlete's dashboard).
+  std::shared_ptr<Client> connect(std::optional<std::string> only_key = std::nullopt);
   void disconnect(const std::shared_ptr<Client>& client);
 
   /// Replaces the pending sample of `key` for every client. `data` is the JSON payload.
   void publish_sample(const std::string& key, std::string data);
-  /// Queues an event of SSE type `type` for every client (the oldest is dropped when full).
-  void publish_event(const std::string& type, std::string data);
+  /// Queues an event of SSE type `type` about `key` for every client that may see it (the oldest
+  /// is dropped when a client's queue is full).
+  void publish_event(const std::string& type, const std::string& data, const std::string& key);
 
   /// Waits up to `timeout` for anything pending and returns it as SSE frames; empty on timeout.
   /// Sets `closed` when the hub is shutting down (the stream must end).
@@ -53,6 +56,7 @@ class LiveHub {
 class LiveHub::Client {
  private:
   friend class LiveHub;
+  std::optional<std::string> only_key_;
   std::map<std::string, std::string> latest_;     ///< key -> payload of the newest sample
   std::deque<std::string> events_;                ///< ready SSE frames
   std::size_t dropped_events_ = 0;

@@ -6,11 +6,14 @@
 #include <cstdlib>
 #include <thread>
 
+#include "alarm_service.hpp"
 #include "auth.hpp"
 #include "fleet.hpp"
-#include "fleet_subscriber.hpp"
 #include "http_api.hpp"
+#include "json_views.hpp"
+#include "query.hpp"
 #include "live_hub.hpp"
+#include "shore_dds.hpp"
 #include "shutdown.hpp"
 #include "store.hpp"
 
@@ -18,14 +21,30 @@ namespace {
 
 using namespace telltale::shore;
 
+bool valid_boat(const std::string& id) { return valid_id(id); }
+
 struct Options {
   telltale::dds::DdsOptions dds;
   HttpConfig http;
-  std::string db_path = "telltale.db";
+  StoreConfig store{"telltale.db"};
   std::string coach_token;
+  std::vector<std::string> analyst_tokens;
+  std::vector<std::string> athlete_tokens;  ///< BOAT_ID:TOKEN
   int stale_ms = 2000;
   int commit_ms = 250;
+  int session_gap_s = 60;
 };
+
+void add_tokens(const Options& o, TokenStore& tokens) {
+  tokens.add(o.coach_token, {Role::kCoach, ""});
+  for (const auto& t : o.analyst_tokens) tokens.add(t, {Role::kAnalyst, ""});
+  for (const auto& bt : o.athlete_tokens) {
+    const auto colon = bt.find(':');
+    if (colon == std::string::npos || !valid_boat(bt.substr(0, colon)) || colon + 1 >= bt.size())
+      throw std::invalid_argument("--athlete-token takes BOAT_ID:TOKEN, got '" + bt + "'");
+    tokens.add(bt.substr(colon + 1), {Role::kAthlete, bt.substr(0, colon)});
+  }
+}
 
 void run(Options o, telltale::ShutdownSignal& shutdown) {
   TokenStore tokens;
@@ -36,18 +55,26 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
     o.coach_token = random_token();
     std::printf("shore_server coach token (generated): %s\n", o.coach_token.c_str());
   }
-  tokens.add(o.coach_token, {Role::kCoach, ""});
+  add_tokens(o, tokens);
 
-  SampleStore store(o.db_path, std::chrono::milliseconds(o.commit_ms));
+  o.store.commit_interval = std::chrono::milliseconds(o.commit_ms);
+  o.store.session_gap = std::chrono::seconds(o.session_gap_s);
+  Store store(o.store);
   FleetModel fleet(std::chrono::milliseconds(o.stale_ms));
   LiveHub hub(o.http.max_stream_clients, 256);
+  AlarmService alarms(store, hub, fleet);
 
   FleetCallbacks callbacks;
   callbacks.on_attitude = [&](const AttitudeSample& s) {
     const BoatView view =
         fleet.update(s, std::chrono::steady_clock::now(), telltale::utc_now_ns());
     store.enqueue(s);
+    alarms.on_sample(s, view.status ? view.status->group : std::string());
     hub.publish_sample(s.boat_id, boat_json(view));
+  };
+  callbacks.on_backfill = [&](const AttitudeSample& s) {
+    // Old samples go to the recording only: the live view and the alarms are about now.
+    store.enqueue(s);
   };
   callbacks.on_status = [&](const std::string& id, const NodeStatusInfo& st) {
     fleet.update_status(id, st);
@@ -55,19 +82,25 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
   callbacks.on_deadline_missed = [&](const std::string& id) {
     if (auto v = fleet.mark_stale(id)) hub.publish_sample(id, boat_json(*v));
   };
-  FleetSubscriber subscriber(o.dds, callbacks);
+  ShoreDds dds(o.dds, callbacks);
+  alarms.start({[&](const std::vector<AlarmRule>& rules) { dds.publish_rules(rules); },
+                [&](const AlarmEvent& e) { dds.publish_event(e); }});
 
-  HttpApi api(o.http, fleet, hub, tokens, store);
+  HttpApi api(o.http, {fleet, hub, tokens, store, alarms});
   const int port = api.bind();
   std::thread http_thread([&] { api.serve(); });
   std::printf("shore_server ready: http://%s:%d/ domain=%d db=%s\n", o.http.bind_address.c_str(),
-              port, telltale::dds::resolve_domain(o.dds.domain), o.db_path.c_str());
+              port, dds.domain(), o.store.path.c_str());
   std::fflush(stdout);
 
-  // Stale sweep: a boat silent for stale_ms is marked stale even if DDS never says so.
+  // Stale sweep: a boat silent for stale_ms is marked stale even if DDS never says so. Every
+  // second each boat gets its receipt (what is stored), from which it backfills what is missing.
+  int tick = 0;
   while (!shutdown.wait_for(std::chrono::milliseconds(200))) {
     for (const auto& v : fleet.sweep(std::chrono::steady_clock::now()))
       hub.publish_sample(v.last.boat_id, boat_json(v));
+    if (++tick % 5 == 0)
+      for (const auto& a : store.acks()) dds.publish_ack(a.boat_id, a.boot_id, a.acked_seq);
   }
   hub.close();
   api.stop();
@@ -88,10 +121,19 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--bind", o.http.bind_address, "HTTP listen address (localhost by default)")
       ->capture_default_str();
-  app.add_option("--db", o.db_path, "SQLite database file (created if missing)")
+  app.add_option("--db", o.store.path, "SQLite database file (created if missing)")
       ->capture_default_str();
   app.add_option("--coach-token", o.coach_token,
                  "coach token (default: $TELLTALE_COACH_TOKEN, else a generated one, printed)");
+  app.add_option("--analyst-token", o.analyst_tokens, "an analyst token (read and export); repeatable");
+  app.add_option("--athlete-token", o.athlete_tokens,
+                 "BOAT_ID:TOKEN, an athlete's token for their own boat; repeatable");
+  app.add_option("--session-gap-s", o.session_gap_s,
+                 "a boat silent this long starts a new session when it returns")
+      ->capture_default_str();
+  app.add_option("--retention-days", o.store.retention_days,
+                 "delete samples older than this (0: keep everything)")
+      ->capture_default_str();
   app.add_option("--web-dir", o.http.web_dir, "dashboard files")->capture_default_str();
   app.add_option("--max-streams", o.http.max_stream_clients, "live-stream clients at most")
       ->capture_default_str();

@@ -1,5 +1,9 @@
 #include "store.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
 namespace telltale::shore {
 namespace {
 
@@ -18,9 +22,105 @@ CREATE TABLE IF NOT EXISTS attitude (
   yaw_rate_deg_s REAL,
   accel_weight REAL,
   quality REAL,
+  boot_id INTEGER NOT NULL DEFAULT 0,
   PRIMARY KEY (boat_id, t_utc_ns)
 ) WITHOUT ROWID;
+CREATE TABLE IF NOT EXISTS sessions (
+  id INTEGER PRIMARY KEY AUTOINCREMENT,
+  boat_id TEXT NOT NULL,
+  start_ns INTEGER NOT NULL,
+  end_ns INTEGER NOT NULL,
+  samples INTEGER NOT NULL
+);
+CREATE INDEX IF NOT EXISTS sessions_by_boat ON sessions (boat_id, end_ns);
+CREATE TABLE IF NOT EXISTS alarm_rules (
+  id TEXT PRIMARY KEY,
+  position INTEGER NOT NULL,
+  scope TEXT NOT NULL,
+  quantity TEXT NOT NULL,
+  min_deg REAL NOT NULL,
+  max_deg REAL NOT NULL,
+  hold_s REAL NOT NULL,
+  hysteresis_deg REAL NOT NULL,
+  level TEXT NOT NULL,
+  enabled INTEGER NOT NULL
+);
+CREATE TABLE IF NOT EXISTS alarm_events (
+  id INTEGER PRIMARY KEY,
+  boat_id TEXT NOT NULL,
+  rule_id TEXT NOT NULL,
+  level TEXT NOT NULL,
+  phase TEXT NOT NULL,
+  raised_ns INTEGER NOT NULL,
+  acknowledged_ns INTEGER NOT NULL,
+  silenced_ns INTEGER NOT NULL,
+  cleared_ns INTEGER NOT NULL,
+  value_deg REAL NOT NULL,
+  message TEXT NOT NULL
+);
+CREATE INDEX IF NOT EXISTS alarm_events_by_time ON alarm_events (raised_ns);
 )sql";
+
+/// A prepared statement that finalises itself and throws StoreError on failure.
+class Stmt {
+ public:
+  Stmt(sqlite3* db, const char* sql) : db_(db) {
+    if (sqlite3_prepare_v2(db, sql, -1, &st_, nullptr) != SQLITE_OK)
+      throw StoreError(sqlite3_errmsg(db));
+  }
+  ~Stmt() { sqlite3_finalize(st_); }
+  Stmt(const Stmt&) = delete;
+  Stmt& operator=(const Stmt&) = delete;
+
+  Stmt& bind(int i, std::int64_t v) {
+    sqlite3_bind_int64(st_, i, v);
+    return *this;
+  }
+  Stmt& bind_u(int i, std::uint64_t v) {
+    // Nanoseconds since 1970 fit int64 until 2262.
+    sqlite3_bind_int64(st_, i, static_cast<sqlite3_int64>(std::min<std::uint64_t>(
+                                   v, static_cast<std::uint64_t>(INT64_MAX))));
+    return *this;
+  }
+  Stmt& bind(int i, double v) {
+    if (std::isfinite(v)) {
+      sqlite3_bind_double(st_, i, v);
+    } else {
+      sqlite3_bind_null(st_, i);
+    }
+    return *this;
+  }
+  Stmt& bind(int i, const std::string& v) {
+    sqlite3_bind_text(st_, i, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT);
+    return *this;
+  }
+  /// True on a row, false when done.
+  bool step() {
+    const int rc = sqlite3_step(st_);
+    if (rc == SQLITE_ROW) return true;
+    if (rc == SQLITE_DONE) return false;
+    throw StoreError(sqlite3_errmsg(db_));
+  }
+  void reset() {
+    sqlite3_reset(st_);
+    sqlite3_clear_bindings(st_);
+  }
+  std::int64_t i64(int c) const { return sqlite3_column_int64(st_, c); }
+  std::uint64_t u64(int c) const { return static_cast<std::uint64_t>(sqlite3_column_int64(st_, c)); }
+  double dbl(int c) const {
+    return sqlite3_column_type(st_, c) == SQLITE_NULL ? std::numeric_limits<double>::quiet_NaN()
+                                                      : sqlite3_column_double(st_, c);
+  }
+  std::string text(int c) const {
+    const auto* p = sqlite3_column_text(st_, c);
+    return p ? std::string(reinterpret_cast<const char*>(p)) : std::string();
+  }
+  sqlite3_stmt* get() const { return st_; }
+
+ private:
+  sqlite3* db_;
+  sqlite3_stmt* st_ = nullptr;
+};
 
 void exec(sqlite3* db, const char* sql) {
   char* err = nullptr;
@@ -31,36 +131,81 @@ void exec(sqlite3* db, const char* sql) {
   }
 }
 
-}  // namespace
-
-SampleStore::SampleStore(const std::string& path, std::chrono::milliseconds commit_interval)
-    : commit_interval_(commit_interval) {
-  if (sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE |
-                                              SQLITE_OPEN_FULLMUTEX,
-                      nullptr) != SQLITE_OK) {
-    std::string msg = db_ ? sqlite3_errmsg(db_) : "out of memory";
-    sqlite3_close(db_);
+sqlite3* open_db(const std::string& path, int flags) {
+  sqlite3* db = nullptr;
+  if (sqlite3_open_v2(path.c_str(), &db, flags | SQLITE_OPEN_NOMUTEX, nullptr) != SQLITE_OK) {
+    std::string msg = db ? sqlite3_errmsg(db) : "out of memory";
+    sqlite3_close(db);
     throw StoreError("cannot open database " + path + ": " + msg);
   }
+  sqlite3_busy_timeout(db, 5000);
+  return db;
+}
+
+SessionInfo session_from(const Stmt& s) {
+  return {s.i64(0), s.text(1), s.u64(2), s.u64(3), s.i64(4)};
+}
+
+AttitudeRow row_from(const Stmt& s) {
+  AttitudeRow r;
+  r.t_utc_ns = s.u64(0);
+  r.seq = s.u64(1);
+  r.heel_deg = s.dbl(2);
+  r.pitch_deg = s.dbl(3);
+  r.heading_deg = s.dbl(4);
+  r.heel_rate_deg_s = s.dbl(5);
+  r.pitch_rate_deg_s = s.dbl(6);
+  r.yaw_rate_deg_s = s.dbl(7);
+  r.accel_weight = s.dbl(8);
+  r.quality = s.dbl(9);
+  return r;
+}
+
+AlarmEvent event_from(const Stmt& s) {
+  AlarmEvent e;
+  e.id = s.u64(0);
+  e.boat_id = s.text(1);
+  e.rule_id = s.text(2);
+  e.level = parse_level(s.text(3)).value_or(AlarmLevel::kWarn);
+  e.phase = parse_phase(s.text(4)).value_or(AlarmPhase::kRaised);
+  e.raised_ns = s.u64(5);
+  e.acknowledged_ns = s.u64(6);
+  e.silenced_ns = s.u64(7);
+  e.cleared_ns = s.u64(8);
+  e.value_deg = s.dbl(9);
+  e.message = s.text(10);
+  return e;
+}
+
+constexpr const char* kSessionColumns = "id, boat_id, start_ns, end_ns, samples";
+constexpr const char* kEventColumns =
+    "id, boat_id, rule_id, level, phase, raised_ns, acknowledged_ns, silenced_ns, cleared_ns, "
+    "value_deg, message";
+
+}  // namespace
+
+Store::Store(StoreConfig config) : config_(std::move(config)) {
+  db_ = open_db(config_.path, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
   try {
-    sqlite3_busy_timeout(db_, 5000);
     exec(db_, kSchema);
+    reader_ = open_db(config_.path, SQLITE_OPEN_READONLY);
     if (sqlite3_prepare_v2(db_,
                            "INSERT OR IGNORE INTO attitude (boat_id, t_utc_ns, seq, heel_deg, "
                            "pitch_deg, heading_deg, heel_rate_deg_s, pitch_rate_deg_s, "
-                           "yaw_rate_deg_s, accel_weight, quality) "
-                           "VALUES (?,?,?,?,?,?,?,?,?,?,?)",
+                           "yaw_rate_deg_s, accel_weight, quality, boot_id) "
+                           "VALUES (?,?,?,?,?,?,?,?,?,?,?,?)",
                            -1, &insert_, nullptr) != SQLITE_OK)
       throw StoreError(sqlite3_errmsg(db_));
   } catch (const StoreError& e) {
-    sqlite3_finalize(insert_);
+    sqlite3_close(reader_);
     sqlite3_close(db_);
-    throw StoreError("database " + path + ": " + e.what());
+    throw StoreError("database " + config_.path + ": " + e.what());
   }
+  next_retention_ = std::chrono::steady_clock::now();
   writer_ = std::thread([this] { writer_loop(); });
 }
 
-SampleStore::~SampleStore() {
+Store::~Store() {
   {
     std::lock_guard lock(mutex_);
     stopping_ = true;
@@ -68,34 +213,57 @@ SampleStore::~SampleStore() {
   cv_.notify_all();
   writer_.join();
   sqlite3_finalize(insert_);
-  sqlite3_close(db_);
+  sqlite3_close(reader_);
+  sqlite3_close(db_);  // the last connection checkpoints and removes the WAL
 }
 
-void SampleStore::enqueue(const AttitudeSample& sample) {
+void Store::enqueue(const AttitudeSample& sample) {
   std::lock_guard lock(mutex_);
   queue_.push_back(sample);
+  ++enqueued_;
 }
 
-void SampleStore::writer_loop() {
+void Store::flush() {
+  std::unique_lock lock(mutex_);
+  const std::uint64_t target = enqueued_;
+  cv_.notify_all();
+  flushed_cv_.wait_for(lock, std::chrono::seconds(10),
+                       [&] { return processed_ >= target || stopping_; });
+}
+
+void Store::writer_loop() {
   std::vector<AttitudeSample> batch;
   for (;;) {
     bool stop = false;
     {
       std::unique_lock lock(mutex_);
-      cv_.wait_for(lock, commit_interval_, [this] { return stopping_; });
+      cv_.wait_for(lock, config_.commit_interval, [this] { return stopping_; });
       stop = stopping_;
       batch.swap(queue_);
     }
-    if (!batch.empty()) commit(batch);
+    if (!batch.empty() && commit(batch)) {
+      std::lock_guard lock(mutex_);
+      processed_ += batch.size();
+    }
+    flushed_cv_.notify_all();
     batch.clear();
+    if (config_.retention_days > 0.0 && std::chrono::steady_clock::now() >= next_retention_) {
+      apply_retention();
+      next_retention_ = std::chrono::steady_clock::now() + std::chrono::hours(1);
+    }
     if (stop) return;
   }
 }
 
-void SampleStore::commit(std::vector<AttitudeSample>& batch) {
+bool Store::commit(std::vector<AttitudeSample>& batch) {
   std::lock_guard db_lock(db_mutex_);
+  std::uint64_t inserted = 0;
   try {
     exec(db_, "BEGIN");
+    // In time order per boat, so sessions grow forward.
+    std::sort(batch.begin(), batch.end(), [](const AttitudeSample& a, const AttitudeSample& b) {
+      return a.boat_id != b.boat_id ? a.boat_id < b.boat_id : a.t_utc_ns < b.t_utc_ns;
+    });
     for (const auto& s : batch) {
       sqlite3_reset(insert_);
       sqlite3_bind_text(insert_, 1, s.boat_id.c_str(), static_cast<int>(s.boat_id.size()),
@@ -104,46 +272,305 @@ void SampleStore::commit(std::vector<AttitudeSample>& batch) {
       sqlite3_bind_int64(insert_, 3, static_cast<sqlite3_int64>(s.seq));
       sqlite3_bind_double(insert_, 4, s.heel_deg);
       sqlite3_bind_double(insert_, 5, s.pitch_deg);
-      // SQLite stores NaN as NULL: no heading source.
-      sqlite3_bind_double(insert_, 6, s.heading_deg);
+      if (std::isfinite(s.heading_deg)) {
+        sqlite3_bind_double(insert_, 6, s.heading_deg);
+      } else {
+        sqlite3_bind_null(insert_, 6);
+      }
       sqlite3_bind_double(insert_, 7, s.heel_rate_deg_s);
       sqlite3_bind_double(insert_, 8, s.pitch_rate_deg_s);
       sqlite3_bind_double(insert_, 9, s.yaw_rate_deg_s);
       sqlite3_bind_double(insert_, 10, static_cast<double>(s.accel_weight));
       sqlite3_bind_double(insert_, 11, static_cast<double>(s.quality));
+      // Boot ids are random 64-bit numbers: stored as their two's-complement int64.
+      sqlite3_bind_int64(insert_, 12, static_cast<sqlite3_int64>(s.boot_id));
       if (sqlite3_step(insert_) != SQLITE_DONE) throw StoreError(sqlite3_errmsg(db_));
+      if (sqlite3_changes(db_) == 1) {  // a duplicate (re-sent sample) changes nothing
+        ++inserted;
+        extend_session(s.boat_id, s.t_utc_ns);
+      }
     }
+    Stmt up(db_, "UPDATE sessions SET start_ns = ?, end_ns = ?, samples = ? WHERE id = ?");
+    for (const auto& boat : dirty_sessions_) {
+      const SessionInfo& sess = open_sessions_.at(boat);
+      up.reset();
+      up.bind_u(1, sess.start_ns).bind_u(2, sess.end_ns).bind(3, sess.samples).bind(4, sess.id);
+      up.step();
+    }
+    dirty_sessions_.clear();
     exec(db_, "COMMIT");
+    // On disk now: these samples may be acknowledged to their boats.
+    for (const auto& s : batch) track_receipt(s);
     std::lock_guard lock(mutex_);
-    committed_ += batch.size();
+    committed_ += inserted;
     last_error_.clear();
+    return true;
   } catch (const StoreError& e) {
     sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    open_sessions_.clear();  // reload from disk: the rolled-back changes are gone
+    dirty_sessions_.clear();
     // Keep the batch for the next attempt (disk full, locked): nothing already received is lost
     // while the process lives.
     std::lock_guard lock(mutex_);
     last_error_ = e.what();
     queue_.insert(queue_.begin(), batch.begin(), batch.end());
+    return false;
   }
 }
 
-std::int64_t SampleStore::count(const std::string& boat_id) {
-  std::lock_guard db_lock(db_mutex_);
-  sqlite3_stmt* st = nullptr;
-  sqlite3_prepare_v2(db_, "SELECT COUNT(*) FROM attitude WHERE boat_id = ?", -1, &st, nullptr);
-  sqlite3_bind_text(st, 1, boat_id.c_str(), static_cast<int>(boat_id.size()), SQLITE_TRANSIENT);
-  std::int64_t n = -1;
-  if (sqlite3_step(st) == SQLITE_ROW) n = sqlite3_column_int64(st, 0);
-  sqlite3_finalize(st);
-  return n;
+void Store::extend_session(const std::string& boat_id, std::uint64_t t_ns) {
+  const auto gap = static_cast<std::uint64_t>(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(config_.session_gap).count());
+  auto it = open_sessions_.find(boat_id);
+  if (it == open_sessions_.end()) {
+    Stmt q(db_, "SELECT id, boat_id, start_ns, end_ns, samples FROM sessions WHERE boat_id = ? "
+                "ORDER BY end_ns DESC LIMIT 1");
+    q.bind(1, boat_id);
+    if (q.step()) it = open_sessions_.emplace(boat_id, session_from(q)).first;
+  }
+  if (it != open_sessions_.end()) {
+    SessionInfo& s = it->second;
+    if (t_ns + gap >= s.start_ns && t_ns <= s.end_ns + gap) {
+      s.start_ns = std::min(s.start_ns, t_ns);
+      s.end_ns = std::max(s.end_ns, t_ns);
+      ++s.samples;
+      dirty_sessions_.insert(boat_id);
+      return;
+    }
+    if (t_ns < s.start_ns) {
+      // Backfill older than the latest session: extend the session it belongs to, if any.
+      Stmt q(db_, "UPDATE sessions SET start_ns = MIN(start_ns, ?1), end_ns = MAX(end_ns, ?1), "
+                  "samples = samples + 1 WHERE id = (SELECT id FROM sessions WHERE boat_id = ?2 "
+                  "AND start_ns <= ?1 + ?3 AND end_ns + ?3 >= ?1 LIMIT 1)");
+      q.bind_u(1, t_ns).bind(2, boat_id).bind_u(3, gap);
+      q.step();
+      if (sqlite3_changes(db_) == 1) return;
+      Stmt ins(db_, "INSERT INTO sessions (boat_id, start_ns, end_ns, samples) VALUES (?,?,?,1)");
+      ins.bind(1, boat_id).bind_u(2, t_ns).bind_u(3, t_ns);
+      ins.step();
+      return;
+    }
+  }
+  Stmt ins(db_, "INSERT INTO sessions (boat_id, start_ns, end_ns, samples) VALUES (?,?,?,0)");
+  ins.bind(1, boat_id).bind_u(2, t_ns).bind_u(3, t_ns);
+  ins.step();
+  open_sessions_[boat_id] = {sqlite3_last_insert_rowid(db_), boat_id, t_ns, t_ns, 1};
+  dirty_sessions_.insert(boat_id);
 }
 
-std::uint64_t SampleStore::committed() const {
+void Store::track_receipt(const AttitudeSample& s) {
+  if (s.seq == 0) return;
+  std::lock_guard lock(receipts_mutex_);
+  Receipt& r = receipts_[s.boat_id];
+  if (r.boot_id != s.boot_id || !r.known) {
+    // A run not seen since this shore started: what is already stored counts (restart).
+    r = Receipt{};
+    r.known = true;
+    r.boot_id = s.boot_id;
+    Stmt q(db_, "SELECT seq FROM attitude WHERE boat_id = ? AND boot_id = ? ORDER BY seq");
+    q.bind(1, s.boat_id).bind(2, static_cast<std::int64_t>(s.boot_id));
+    while (q.step()) {
+      const std::uint64_t seq = q.u64(0);
+      if (seq == r.acked + 1) {
+        r.acked = seq;
+      } else if (seq > r.acked + 1) {
+        r.ahead.insert(seq);
+      }
+    }
+  }
+  if (s.seq <= r.acked) return;
+  r.ahead.insert(s.seq);
+  while (!r.ahead.empty() && *r.ahead.begin() <= r.acked + 1) {
+    r.acked = std::max(r.acked, *r.ahead.begin());
+    r.ahead.erase(r.ahead.begin());
+  }
+}
+
+std::vector<Store::Ack> Store::acks() const {
+  std::lock_guard lock(receipts_mutex_);
+  std::vector<Ack> out;
+  for (const auto& [boat, r] : receipts_) out.push_back({boat, r.boot_id, r.acked});
+  return out;
+}
+
+void Store::apply_retention() {
+  const double now_s = std::chrono::duration<double>(
+                           std::chrono::system_clock::now().time_since_epoch())
+                           .count();
+  const double cutoff_s = now_s - config_.retention_days * 86400.0;
+  if (cutoff_s <= 0) return;
+  const auto cutoff = static_cast<std::uint64_t>(cutoff_s * 1e9);
+  std::lock_guard db_lock(db_mutex_);
+  try {
+    Stmt a(db_, "DELETE FROM attitude WHERE t_utc_ns < ?");
+    a.bind_u(1, cutoff).step();
+    Stmt s(db_, "DELETE FROM sessions WHERE end_ns < ?");
+    s.bind_u(1, cutoff).step();
+    Stmt e(db_, "DELETE FROM alarm_events WHERE phase = 'cleared' AND cleared_ns < ?");
+    e.bind_u(1, cutoff).step();
+    open_sessions_.clear();
+    dirty_sessions_.clear();
+  } catch (const StoreError& e) {
+    std::lock_guard lock(mutex_);
+    last_error_ = std::string("retention: ") + e.what();
+  }
+}
+
+std::vector<SessionInfo> Store::sessions(const std::optional<std::string>& boat_id,
+                                         std::uint64_t from_ns, std::uint64_t to_ns) {
+  std::lock_guard lock(reader_mutex_);
+  const std::string sql = std::string("SELECT ") + kSessionColumns +
+                          " FROM sessions WHERE (?1 IS NULL OR boat_id = ?1) AND end_ns >= ?2 "
+                          "AND start_ns <= ?3 ORDER BY start_ns DESC LIMIT 10000";
+  Stmt q(reader_, sql.c_str());
+  if (boat_id) q.bind(1, *boat_id);
+  q.bind_u(2, from_ns).bind_u(3, to_ns);
+  std::vector<SessionInfo> out;
+  while (q.step()) out.push_back(session_from(q));
+  return out;
+}
+
+std::optional<SessionInfo> Store::session(std::int64_t id) {
+  std::lock_guard lock(reader_mutex_);
+  const std::string sql = std::string("SELECT ") + kSessionColumns + " FROM sessions WHERE id = ?";
+  Stmt q(reader_, sql.c_str());
+  q.bind(1, id);
+  if (!q.step()) return std::nullopt;
+  return session_from(q);
+}
+
+bool Store::knows_boat(const std::string& boat_id) {
+  std::lock_guard lock(reader_mutex_);
+  Stmt q(reader_, "SELECT 1 FROM sessions WHERE boat_id = ? LIMIT 1");
+  q.bind(1, boat_id);
+  return q.step();
+}
+
+std::vector<AttitudeRow> Store::attitude_page(const std::string& boat_id, std::uint64_t after_ns,
+                                              std::uint64_t to_ns, std::size_t limit) {
+  std::lock_guard lock(reader_mutex_);
+  Stmt q(reader_,
+         "SELECT t_utc_ns, seq, heel_deg, pitch_deg, heading_deg, heel_rate_deg_s, "
+         "pitch_rate_deg_s, yaw_rate_deg_s, accel_weight, quality FROM attitude "
+         "WHERE boat_id = ? AND t_utc_ns > ? AND t_utc_ns <= ? ORDER BY t_utc_ns LIMIT ?");
+  q.bind(1, boat_id).bind_u(2, after_ns).bind_u(3, to_ns).bind(4, static_cast<std::int64_t>(limit));
+  std::vector<AttitudeRow> out;
+  out.reserve(limit);
+  while (q.step()) out.push_back(row_from(q));
+  return out;
+}
+
+void Store::visit_attitude(const std::string& boat_id, std::uint64_t from_ns, std::uint64_t to_ns,
+                           const std::function<bool(const AttitudeRow&)>& visit, std::size_t page) {
+  if (from_ns > to_ns) return;
+  // attitude_page is exclusive of its start: step back one ns (times are > 0).
+  std::uint64_t after = from_ns == 0 ? 0 : from_ns - 1;
+  for (;;) {
+    const auto rows = attitude_page(boat_id, after, to_ns, page);
+    for (const auto& r : rows)
+      if (!visit(r)) return;
+    if (rows.size() < page) return;
+    after = rows.back().t_utc_ns;
+  }
+}
+
+std::int64_t Store::count(const std::string& boat_id) {
+  std::lock_guard lock(reader_mutex_);
+  Stmt q(reader_, "SELECT COUNT(*) FROM attitude WHERE boat_id = ?");
+  q.bind(1, boat_id);
+  return q.step() ? q.i64(0) : 0;
+}
+
+void Store::save_rules(const std::vector<AlarmRule>& rules) {
+  std::lock_guard db_lock(db_mutex_);
+  try {
+    exec(db_, "BEGIN IMMEDIATE");
+    exec(db_, "DELETE FROM alarm_rules");
+    Stmt ins(db_, "INSERT INTO alarm_rules (id, position, scope, quantity, min_deg, max_deg, "
+                  "hold_s, hysteresis_deg, level, enabled) VALUES (?,?,?,?,?,?,?,?,?,?)");
+    std::int64_t pos = 0;
+    for (const auto& r : rules) {
+      ins.reset();
+      ins.bind(1, r.id).bind(2, pos++).bind(3, r.scope).bind(4, std::string(to_string(r.quantity)));
+      ins.bind(5, r.min_deg).bind(6, r.max_deg).bind(7, r.hold_s).bind(8, r.hysteresis_deg);
+      ins.bind(9, std::string(to_string(r.level))).bind(10, std::int64_t{r.enabled ? 1 : 0});
+      ins.step();
+    }
+    exec(db_, "COMMIT");
+  } catch (const StoreError&) {
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    throw;
+  }
+}
+
+std::vector<AlarmRule> Store::load_rules() {
+  std::lock_guard lock(reader_mutex_);
+  Stmt q(reader_, "SELECT id, scope, quantity, min_deg, max_deg, hold_s, hysteresis_deg, level, "
+                  "enabled FROM alarm_rules ORDER BY position");
+  std::vector<AlarmRule> out;
+  while (q.step()) {
+    AlarmRule r;
+    r.id = q.text(0);
+    r.scope = q.text(1);
+    r.quantity = parse_quantity(q.text(2)).value_or(AlarmQuantity::kHeel);
+    r.min_deg = q.dbl(3);
+    r.max_deg = q.dbl(4);
+    r.hold_s = q.dbl(5);
+    r.hysteresis_deg = q.dbl(6);
+    r.level = parse_level(q.text(7)).value_or(AlarmLevel::kWarn);
+    r.enabled = q.i64(8) != 0;
+    out.push_back(r);
+  }
+  return out;
+}
+
+void Store::save_event(const AlarmEvent& e) {
+  std::lock_guard db_lock(db_mutex_);
+  Stmt q(db_, "INSERT OR REPLACE INTO alarm_events (id, boat_id, rule_id, level, phase, raised_ns, "
+              "acknowledged_ns, silenced_ns, cleared_ns, value_deg, message) "
+              "VALUES (?,?,?,?,?,?,?,?,?,?,?)");
+  q.bind_u(1, e.id).bind(2, e.boat_id).bind(3, e.rule_id).bind(4, std::string(to_string(e.level)));
+  q.bind(5, std::string(to_string(e.phase))).bind_u(6, e.raised_ns).bind_u(7, e.acknowledged_ns);
+  q.bind_u(8, e.silenced_ns).bind_u(9, e.cleared_ns).bind(10, e.value_deg).bind(11, e.message);
+  q.step();
+}
+
+std::vector<AlarmEvent> Store::events(const EventFilter& f) {
+  std::lock_guard lock(reader_mutex_);
+  const std::string sql = std::string("SELECT ") + kEventColumns +
+                          " FROM alarm_events WHERE (?1 IS NULL OR boat_id = ?1) AND raised_ns "
+                          ">= ?2 AND raised_ns <= ?3 AND (?4 = 0 OR phase != 'cleared') "
+                          "ORDER BY raised_ns DESC, id DESC LIMIT ?5";
+  Stmt q(reader_, sql.c_str());
+  if (f.boat_id) q.bind(1, *f.boat_id);
+  q.bind_u(2, f.from_ns).bind_u(3, f.to_ns).bind(4, std::int64_t{f.active_only ? 1 : 0});
+  q.bind(5, static_cast<std::int64_t>(f.limit));
+  std::vector<AlarmEvent> out;
+  while (q.step()) out.push_back(event_from(q));
+  return out;
+}
+
+std::optional<AlarmEvent> Store::event(std::uint64_t id) {
+  std::lock_guard lock(reader_mutex_);
+  const std::string sql = std::string("SELECT ") + kEventColumns + " FROM alarm_events WHERE id = ?";
+  Stmt q(reader_, sql.c_str());
+  q.bind_u(1, id);
+  if (!q.step()) return std::nullopt;
+  return event_from(q);
+}
+
+std::uint64_t Store::max_event_id() {
+  std::lock_guard lock(reader_mutex_);
+  Stmt q(reader_, "SELECT COALESCE(MAX(id), 0) FROM alarm_events");
+  return q.step() ? q.u64(0) : 0;
+}
+
+std::uint64_t Store::committed() const {
   std::lock_guard lock(mutex_);
   return committed_;
 }
 
-std::string SampleStore::last_error() const {
+std::string Store::last_error() const {
   std::lock_guard lock(mutex_);
   return last_error_;
 }

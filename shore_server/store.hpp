@@ -1,22 +1,36 @@
 #pragma once
 /// \file
-/// The shore's recording: every attitude sample into SQLite (WAL). Samples are queued by the DDS
-/// listener and committed by one writer thread in batches. Durability window: a sample is on disk
-/// at most `commit_interval` after it arrived (default 250 ms); a crash loses at most that window,
-/// which the boats' backfill refills. A sample already stored (same boat, same UTC time) is kept
-/// once (INSERT OR IGNORE), so re-sent samples merge without duplicates.
+/// The shore's recording in SQLite (WAL): attitude samples, sessions, alarm rules and events.
+///
+/// Writes: the DDS listener queues samples (never blocks on disk); one writer thread commits them
+/// in batches. Durability window: a sample is on disk at most `commit_interval` after it arrived
+/// (default 250 ms); a crash loses at most that window, which the boats' backfill refills. A
+/// sample already stored (same boat, same UTC time) is kept once (INSERT OR IGNORE), so re-sent
+/// samples merge without duplicates. Alarm rules and events are written synchronously: an
+/// acknowledgement is on disk before the request that made it is answered.
+///
+/// Sessions: continuous activity of one boat. A sample within `session_gap` of a boat's session
+/// extends it; otherwise it starts a new one.
+///
+/// Reads go through a second, read-only connection, so a long export never blocks ingest; range
+/// reads page through the data (keyset on time), so memory does not grow with the range.
 
 #include <sqlite3.h>
 
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
+#include <map>
 #include <mutex>
+#include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "telltale/fusion/alarm_engine.hpp"
 #include "fleet.hpp"
 
 namespace telltale::shore {
@@ -26,37 +40,129 @@ class StoreError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-class SampleStore {
+struct StoreConfig {
+  std::string path;
+  std::chrono::milliseconds commit_interval{250};
+  std::chrono::seconds session_gap{60};
+  double retention_days = 0.0;  ///< 0: keep everything
+};
+
+struct SessionInfo {
+  std::int64_t id = 0;
+  std::string boat_id;
+  std::uint64_t start_ns = 0;
+  std::uint64_t end_ns = 0;
+  std::int64_t samples = 0;
+};
+
+struct AttitudeRow {
+  std::uint64_t t_utc_ns = 0;
+  std::uint64_t seq = 0;
+  double heel_deg = 0.0;
+  double pitch_deg = 0.0;
+  double heading_deg = 0.0;  ///< NaN when absent
+  double heel_rate_deg_s = 0.0;
+  double pitch_rate_deg_s = 0.0;
+  double yaw_rate_deg_s = 0.0;
+  double accel_weight = 0.0;
+  double quality = 0.0;
+};
+
+struct EventFilter {
+  std::optional<std::string> boat_id;
+  std::uint64_t from_ns = 0;
+  std::uint64_t to_ns = UINT64_MAX;
+  bool active_only = false;
+  std::size_t limit = 1000;
+};
+
+class Store {
  public:
   /// Opens or creates the database and its schema. Throws StoreError.
-  SampleStore(const std::string& path, std::chrono::milliseconds commit_interval);
-  /// Commits what is queued, then closes.
-  ~SampleStore();
-  SampleStore(const SampleStore&) = delete;
-  SampleStore& operator=(const SampleStore&) = delete;
+  explicit Store(StoreConfig config);
+  /// Commits what is queued, then closes (a clean close leaves no -wal/-shm files).
+  ~Store();
+  Store(const Store&) = delete;
+  Store& operator=(const Store&) = delete;
 
-  /// Queues one sample (never blocks on disk).
+  /// Queues one sample for the next batch (never blocks on disk).
   void enqueue(const AttitudeSample& sample);
-  /// Samples stored for a boat (committed ones), for tests and the health check.
+  /// Waits (up to 10 s) until everything queued before the call is committed.
+  void flush();
+
+  // --- reads -------------------------------------------------------------------------------
+  [[nodiscard]] std::vector<SessionInfo> sessions(const std::optional<std::string>& boat_id,
+                                                  std::uint64_t from_ns, std::uint64_t to_ns);
+  [[nodiscard]] std::optional<SessionInfo> session(std::int64_t id);
+  /// True if the boat has any stored session.
+  [[nodiscard]] bool knows_boat(const std::string& boat_id);
+  /// Calls `visit` for every stored sample of the boat in [from_ns, to_ns], in time order, until
+  /// it returns false. Pages through the data `page` rows at a time.
+  void visit_attitude(const std::string& boat_id, std::uint64_t from_ns, std::uint64_t to_ns,
+                      const std::function<bool(const AttitudeRow&)>& visit,
+                      std::size_t page = 2000);
+  /// One page of samples after `after_ns` (exclusive) up to `to_ns`: for streamed exports.
+  [[nodiscard]] std::vector<AttitudeRow> attitude_page(const std::string& boat_id,
+                                                       std::uint64_t after_ns,
+                                                       std::uint64_t to_ns, std::size_t limit);
   [[nodiscard]] std::int64_t count(const std::string& boat_id);
+
+  // --- alarms (synchronous) ----------------------------------------------------------------
+  void save_rules(const std::vector<AlarmRule>& rules);
+  [[nodiscard]] std::vector<AlarmRule> load_rules();
+  void save_event(const AlarmEvent& event);
+  [[nodiscard]] std::vector<AlarmEvent> events(const EventFilter& filter);
+  [[nodiscard]] std::optional<AlarmEvent> event(std::uint64_t id);
+  [[nodiscard]] std::uint64_t max_event_id();
+
+  /// Per boat: its latest run and the highest seq of that run with every sample up to it stored.
+  struct Ack {
+    std::string boat_id;
+    std::uint64_t boot_id;
+    std::uint64_t acked_seq;
+  };
+  [[nodiscard]] std::vector<Ack> acks() const;
+
   [[nodiscard]] std::uint64_t committed() const;
   /// Last error of the writer thread, empty if none.
   [[nodiscard]] std::string last_error() const;
 
  private:
   void writer_loop();
-  void commit(std::vector<AttitudeSample>& batch);
+  /// Commits a batch; on failure puts it back in the queue and returns false.
+  bool commit(std::vector<AttitudeSample>& batch);
+  void extend_session(const std::string& boat_id, std::uint64_t t_ns);
+  void apply_retention();
+  void track_receipt(const AttitudeSample& sample);
 
-  sqlite3* db_ = nullptr;
+  struct Receipt {
+    bool known = false;
+    std::uint64_t boot_id = 0;
+    std::uint64_t acked = 0;
+    std::set<std::uint64_t> ahead;  ///< stored seqs beyond a gap
+  };
+  mutable std::mutex receipts_mutex_;
+  std::map<std::string, Receipt> receipts_;
+
+  StoreConfig config_;
+  sqlite3* db_ = nullptr;       ///< writer connection (samples, sessions, alarms)
+  sqlite3* reader_ = nullptr;   ///< read-only connection for queries
   sqlite3_stmt* insert_ = nullptr;
-  std::chrono::milliseconds commit_interval_;
-  mutable std::mutex mutex_;
+  std::mutex db_mutex_;         ///< serialises use of db_
+  std::mutex reader_mutex_;     ///< serialises use of reader_
+  std::map<std::string, SessionInfo> open_sessions_;  ///< latest session per boat (writer only)
+  std::set<std::string> dirty_sessions_;              ///< open sessions changed in this batch
+
+  mutable std::mutex mutex_;    ///< guards the queue and the counters
   std::condition_variable cv_;
+  std::condition_variable flushed_cv_;
   std::vector<AttitudeSample> queue_;
-  bool stopping_ = false;
+  std::uint64_t enqueued_ = 0;
+  std::uint64_t processed_ = 0;  ///< enqueued samples the writer has dealt with
   std::uint64_t committed_ = 0;
+  bool stopping_ = false;
   std::string last_error_;
-  std::mutex db_mutex_;  ///< serialises use of db_ between the writer and readers
+  std::chrono::steady_clock::time_point next_retention_;
   std::thread writer_;
 };
 

@@ -15,5 +15,6 @@ class UsageError : public std::runtime_error {
 };
 
 void register_attitude(CLI::App& app);
+void register_heading(CLI::App& app);
 
 }  // namespace telltale::cli

@@ -58,6 +58,7 @@ Participant::Participant(const DdsOptions& options, const std::string& name)
       ReturnCode_t::RETCODE_OK)
     throw DdsError("no participant profile '" + options.participant_profile + "' in " + profiles);
   qos.name(name);
+  if (options.customize) options.customize(qos);
   participant_ = factory->create_participant(static_cast<fdds::DomainId_t>(domain_), qos);
   if (!participant_) throw DdsError("cannot create DDS participant on domain " +
                                     std::to_string(domain_));

@@ -13,6 +13,7 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
+#include <functional>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -26,6 +27,8 @@ inline constexpr const char* kTopicNodeStatus = "telltale_node_status";
 inline constexpr const char* kTopicAlarmRules = "telltale_alarm_rules";
 inline constexpr const char* kTopicAlarmEvents = "telltale_alarm_events";
 inline constexpr const char* kTopicWearableMotion = "telltale_wearable_motion";
+inline constexpr const char* kTopicBoatBackfill = "telltale_boat_backfill";
+inline constexpr const char* kTopicShoreAck = "telltale_shore_ack";
 
 /// Setup failure (profile file, participant, topic, entity): main() prints it and exits non-zero.
 class DdsError : public std::runtime_error {
@@ -38,6 +41,8 @@ struct DdsOptions {
   std::optional<int> domain;            ///< flag; else TELLTALE_DOMAIN; else an error
   std::string profiles_file;            ///< flag; else TELLTALE_DDS_PROFILES; else the build's
   std::string participant_profile = "telltale_loopback";
+  /// Applied to the participant QoS after the profile (fault injection in tests).
+  std::function<void(eprosima::fastdds::dds::DomainParticipantQos&)> customize;
 };
 
 /// The domain id from the flag or TELLTALE_DOMAIN. Throws DdsError if neither is set or the value

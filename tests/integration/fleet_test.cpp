@@ -12,7 +12,7 @@
 #include <regex>
 #include <thread>
 
-#include "process.hpp"
+#include "shore_fixture.hpp"
 
 namespace telltale::testing {
 namespace {
@@ -20,58 +20,7 @@ namespace {
 using nlohmann::json;
 using namespace std::chrono_literals;
 
-constexpr const char* kToken = "integration-coach-token";
-
-class FleetTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = make_temp_dir();
-    domain_ = unique_domain();
-    shore_ = std::make_unique<Process>(std::vector<std::string>{
-        bin_dir() + "/shore_server", "--domain", std::to_string(domain_), "--http-port", "0",
-        "--db", dir_ + "/fleet.db", "--coach-token", kToken});
-    const auto ready = shore_->wait_for_line("shore_server ready: ", 20s);
-    ASSERT_TRUE(ready) << "shore did not start: " << shore_->output();
-    std::smatch m;
-    ASSERT_TRUE(std::regex_search(*ready, m, std::regex(R"(http://127\.0\.0\.1:(\d+)/)")));
-    port_ = std::stoi(m[1]);
-  }
-  void TearDown() override {
-    boats_.clear();
-    shore_.reset();
-    std::filesystem::remove_all(dir_);
-  }
-
-  Process& start_boat(const std::string& id) {
-    boats_.push_back(std::make_unique<Process>(std::vector<std::string>{
-        bin_dir() + "/boat_node", "--domain", std::to_string(domain_), "--boat-id", id}));
-    EXPECT_TRUE(boats_.back()->wait_for_line("boat_node ready: ", 20s))
-        << boats_.back()->output();
-    return *boats_.back();
-  }
-
-  httplib::Client client() const {
-    httplib::Client c("127.0.0.1", port_);
-    c.set_connection_timeout(2);
-    c.set_read_timeout(5);
-    return c;
-  }
-
-  std::map<std::string, json> boats_by_id() const {
-    auto c = client();
-    auto res = c.Get("/api/v1/boats", {{"Authorization", std::string("Bearer ") + kToken}});
-    std::map<std::string, json> out;
-    if (!res || res->status != 200) return out;
-    for (const auto& b : json::parse(res->body)) out[b["id"].get<std::string>()] = b;
-    return out;
-  }
-
-  std::string dir_;
-  int domain_ = 0;
-  int port_ = 0;
-  std::unique_ptr<Process> shore_;
-  std::vector<std::unique_ptr<Process>> boats_;
-};
+using FleetTest = ShoreFixture;
 
 // Given a shore and two boats on a private domain, when a few seconds pass, then both boats are
 // listed over HTTP with finite heel and pitch that change between two reads.
@@ -123,7 +72,7 @@ TEST_F(FleetTest, StreamDeliversSamplesAndMarksSilentBoatStale) {
   c.set_read_timeout(20);
   std::string buffer;
   auto res = c.Get(
-      "/api/v1/stream", {{"Authorization", std::string("Bearer ") + kToken}},
+      "/api/v1/stream", {{"Authorization", std::string("Bearer ") + kCoachToken}},
       [&](const char* data, std::size_t len) {
         buffer.append(data, len);
         std::size_t end;
@@ -174,13 +123,13 @@ TEST_F(FleetTest, AuthAndOpenEndpoints) {
     EXPECT_EQ(res->status, 401);
     EXPECT_TRUE(json::parse(res->body).contains("error"));
   }
-  auto missing = c.Get("/api/v1/nothing-here", {{"Authorization", std::string("Bearer ") + kToken}});
+  auto missing = c.Get("/api/v1/nothing-here", {{"Authorization", std::string("Bearer ") + kCoachToken}});
   ASSERT_TRUE(missing);
   EXPECT_EQ(missing->status, 404);
   EXPECT_TRUE(json::parse(missing->body).contains("error"));
 
   // Login exchanges the bearer token for an HttpOnly cookie that then authorises requests.
-  auto login = c.Post("/api/v1/login", {{"Authorization", std::string("Bearer ") + kToken}}, "",
+  auto login = c.Post("/api/v1/login", {{"Authorization", std::string("Bearer ") + kCoachToken}}, "",
                       "text/plain");
   ASSERT_TRUE(login);
   EXPECT_EQ(login->status, 200);
@@ -210,11 +159,11 @@ TEST_F(FleetTest, CleanShutdownKeepsTheRecording) {
   std::this_thread::sleep_for(500ms);
   EXPECT_EQ(shore_->stop(SIGTERM), 0) << shore_->output();
   // A clean close checkpoints the WAL and removes it: no stale state left behind.
-  EXPECT_FALSE(std::filesystem::exists(dir_ + "/fleet.db-wal"));
-  EXPECT_FALSE(std::filesystem::exists(dir_ + "/fleet.db-shm"));
+  EXPECT_FALSE(std::filesystem::exists(db_path() + "-wal"));
+  EXPECT_FALSE(std::filesystem::exists(db_path() + "-shm"));
 
   sqlite3* db = nullptr;
-  ASSERT_EQ(sqlite3_open_v2((dir_ + "/fleet.db").c_str(), &db, SQLITE_OPEN_READONLY, nullptr),
+  ASSERT_EQ(sqlite3_open_v2((db_path()).c_str(), &db, SQLITE_OPEN_READONLY, nullptr),
             SQLITE_OK);
   sqlite3_stmt* st = nullptr;
   sqlite3_prepare_v2(db, "SELECT COUNT(*), MAX(seq) FROM attitude WHERE boat_id = 'echo'", -1, &st,

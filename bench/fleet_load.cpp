@@ -1,0 +1,205 @@
+// Load generator: N simulated boats x R Hz into a running shore over real DDS, with SSE clients
+// measuring delivery latency (boat write -> SSE event), and the shore's CPU and RSS from /proc.
+//
+//   build/bin/fleet_load --domain D --shore-url http://127.0.0.1:PORT --token T
+//       --shore-pid PID --boats 200 --rate-hz 25 --seconds 300 --sse-clients 1
+//
+// Prints one JSON object: samples written, samples the shore committed, latency percentiles,
+// shore CPU (% of one core) and peak RSS.
+#include <CLI/CLI.hpp>
+#include <httplib.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+#include "dds_participant.hpp"
+#include "shutdown.hpp"
+#include "telltalePubSubTypes.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using nlohmann::json;
+
+struct ProcStat {
+  double cpu_s = 0;
+  long rss_kb = 0;
+};
+
+ProcStat read_proc(int pid) {
+  ProcStat p;
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string line;
+  if (std::getline(stat, line)) {
+    // Fields after the command name (which may contain spaces) start after the last ')'.
+    std::istringstream rest(line.substr(line.rfind(')') + 2));
+    std::vector<std::string> f;
+    std::string tok;
+    while (rest >> tok) f.push_back(tok);
+    if (f.size() > 13) {
+      const double ticks = static_cast<double>(sysconf(_SC_CLK_TCK));
+      p.cpu_s = (std::stod(f[11]) + std::stod(f[12])) / ticks;  // utime + stime
+    }
+  }
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  while (std::getline(status, line))
+    if (line.rfind("VmRSS:", 0) == 0) p.rss_kb = std::stol(line.substr(6));
+  return p;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  telltale::ShutdownSignal shutdown;
+  telltale::dds::DdsOptions dds;
+  int domain = -1;
+  std::string url = "http://127.0.0.1:8080";
+  std::string token;
+  int shore_pid = 0;
+  int boats = 200;
+  double rate_hz = 25;
+  double seconds = 300;
+  int sse_clients = 1;
+  CLI::App app{"Telltale fleet load generator"};
+  app.add_option("--domain", domain, "DDS domain")->required();
+  app.add_option("--shore-url", url, "shore base URL")->required();
+  app.add_option("--token", token, "coach token")->required();
+  app.add_option("--shore-pid", shore_pid, "shore process id (CPU and RSS)");
+  app.add_option("--boats", boats)->capture_default_str();
+  app.add_option("--rate-hz", rate_hz)->capture_default_str();
+  app.add_option("--seconds", seconds)->capture_default_str();
+  app.add_option("--sse-clients", sse_clients, "SSE clients held open (the first measures latency)")
+      ->capture_default_str();
+  app.add_option("--dds-profiles", dds.profiles_file);
+  CLI11_PARSE(app, argc, argv);
+  dds.domain = domain;
+
+  std::smatch m;
+  if (!std::regex_match(url, m, std::regex(R"(http://([^:/]+):(\d+)/?)"))) {
+    std::fprintf(stderr, "fleet_load: --shore-url must be http://HOST:PORT\n");
+    return 2;
+  }
+  const std::string host = m[1];
+  const int port = std::stoi(m[2]);
+
+  // SSE clients: the first records latency of every sample event it receives.
+  std::atomic<bool> stop{false};
+  std::mutex lat_mutex;
+  std::vector<double> latencies_ms;
+  std::atomic<long> sse_events{0};
+  std::vector<std::thread> clients;
+  for (int i = 0; i < sse_clients; ++i) {
+    clients.emplace_back([&, i] {
+      httplib::Client c(host, port);
+      c.set_read_timeout(30);
+      std::string buf;
+      c.Get("/api/v1/stream", {{"Authorization", "Bearer " + token}},
+            [&](const char* data, std::size_t len) {
+              buf.append(data, len);
+              std::size_t end;
+              while ((end = buf.find("\n\n")) != std::string::npos) {
+                const std::string frame = buf.substr(0, end);
+                buf.erase(0, end + 2);
+                if (i != 0 || frame.rfind("event: sample", 0) != 0) continue;
+                const auto pos = frame.find("\"t_utc_ns\":");
+                if (pos == std::string::npos) continue;
+                const double sent = std::stod(frame.substr(pos + 11));
+                const double now = static_cast<double>(telltale::utc_now_ns());
+                std::lock_guard lock(lat_mutex);
+                latencies_ms.push_back((now - sent) * 1e-6);
+                ++sse_events;
+              }
+              return !stop.load();
+            });
+    });
+  }
+
+  telltale::dds::Participant participant(dds, "fleet_load");
+  auto* writer = participant.writer(
+      participant.topic(telltale::dds::kTopicBoatAttitude,
+                        eprosima::fastdds::dds::TypeSupport(
+                            new telltale::msg::BoatAttitudePubSubType())),
+      "attitude_writer");
+  std::this_thread::sleep_for(std::chrono::seconds(3));  // discovery
+  // The first seconds of latencies include discovery; count from here.
+  {
+    std::lock_guard lock(lat_mutex);
+    latencies_ms.clear();
+  }
+
+  const ProcStat before = shore_pid ? read_proc(shore_pid) : ProcStat{};
+  long peak_rss = before.rss_kb;
+  std::vector<telltale::msg::BoatAttitude> samples(static_cast<std::size_t>(boats));
+  for (int b = 0; b < boats; ++b) {
+    char id[32];
+    std::snprintf(id, sizeof id, "load-%03d", b);
+    samples[static_cast<std::size_t>(b)].boat_id(id);
+  }
+  const auto period = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(1.0 / rate_hz));
+  const auto start = Clock::now();
+  auto tick = start;
+  long written = 0;
+  long failed = 0;
+  std::uint64_t seq = 0;
+  while (!shutdown.stop_requested() &&
+         std::chrono::duration<double>(Clock::now() - start).count() < seconds) {
+    ++seq;
+    for (auto& s : samples) {
+      s.seq(seq);
+      s.t_utc_ns(telltale::utc_now_ns());
+      s.heel_deg(10.0 * std::sin(static_cast<double>(seq) * 0.05));
+      s.pitch_deg(2.0);
+      s.heading_deg(std::nan(""));
+      if (writer->write(&s)) {
+        ++written;
+      } else {
+        ++failed;
+      }
+    }
+    if (shore_pid && seq % 25 == 0) peak_rss = std::max(peak_rss, read_proc(shore_pid).rss_kb);
+    tick += period;
+    std::this_thread::sleep_until(tick);
+  }
+  const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+  const ProcStat after = shore_pid ? read_proc(shore_pid) : ProcStat{};
+  std::this_thread::sleep_for(std::chrono::seconds(2));  // let the shore commit
+  stop = true;
+
+  httplib::Client c(host, port);
+  auto health = c.Get("/healthz");
+  const long committed = health ? json::parse(health->body)["samples_committed"].get<long>() : -1;
+  for (auto& t : clients) t.join();  // each returns on its next event (the shore keeps streaming)
+
+  std::sort(latencies_ms.begin(), latencies_ms.end());
+  const auto pct = [&](double p) {
+    if (latencies_ms.empty()) return -1.0;
+    return latencies_ms[static_cast<std::size_t>(p * static_cast<double>(latencies_ms.size() - 1))];
+  };
+  json out = {{"boats", boats},
+              {"rate_hz", rate_hz},
+              {"seconds", elapsed},
+              {"samples_written", written},
+              {"write_failures", failed},
+              {"samples_committed_by_shore", committed},
+              {"sse_clients", sse_clients},
+              {"sse_sample_events_measured", sse_events.load()},
+              {"latency_ms_p50", pct(0.50)},
+              {"latency_ms_p99", pct(0.99)},
+              {"latency_ms_max", latencies_ms.empty() ? -1.0 : latencies_ms.back()}};
+  if (shore_pid) {
+    out["shore_cpu_percent_of_one_core"] = 100.0 * (after.cpu_s - before.cpu_s) / elapsed;
+    out["shore_rss_mb_peak"] = static_cast<double>(peak_rss) / 1024.0;
+  }
+  std::printf("%s\n", out.dump(1).c_str());
+  return 0;
+}

@@ -1,0 +1,79 @@
+#include "backfill.hpp"
+
+#include <algorithm>
+
+namespace telltale::boat {
+
+Backfiller::Backfiller(BackfillConfig config, SessionLogReader reader,
+                       std::function<bool(const LogRecord&)> send)
+    : config_(config), reader_(std::move(reader)), send_(std::move(send)) {
+  thread_ = std::thread([this] { run(); });
+}
+
+Backfiller::~Backfiller() {
+  stop_.store(true);
+  cv_.notify_all();
+  thread_.join();
+}
+
+void Backfiller::on_ack(std::uint64_t boot_id, std::uint64_t acked_seq) {
+  if (boot_id != config_.boot_id) return;  // a receipt for an earlier run of this boat
+  shore_seen_.store(true);
+  std::uint64_t prev = acked_.load();
+  while (acked_seq > prev && !acked_.compare_exchange_weak(prev, acked_seq)) {
+  }
+  cv_.notify_all();
+}
+
+void Backfiller::send_range(std::uint64_t first, std::uint64_t last) {
+  constexpr std::uint64_t kChunk = 250;
+  const auto chunk_period = std::chrono::milliseconds(
+      static_cast<long>(1000 * kChunk / std::max<std::size_t>(config_.max_per_second, 1)));
+  for (std::uint64_t from = first; from <= last && !stop_.load(); from += kChunk) {
+    const auto started = std::chrono::steady_clock::now();
+    for (const auto& r : reader_.read(from, std::min(last, from + kChunk - 1))) {
+      if (!send_(r)) return;  // the shore went away again: the next receipt decides
+      resent_.fetch_add(1);
+    }
+    std::unique_lock lock(mutex_);
+    cv_.wait_until(lock, started + chunk_period, [this] { return stop_.load(); });
+  }
+}
+
+void Backfiller::run() {
+  while (!stop_.load()) {
+    {
+      std::unique_lock lock(mutex_);
+      cv_.wait_for(lock, std::chrono::milliseconds(200), [this] { return stop_.load(); });
+    }
+    if (stop_.load() || !shore_seen_.load()) continue;
+    if (force_resend_.exchange(false)) sent_through_ = 0;
+    const std::uint64_t published = published_.load();
+    const std::uint64_t acked = acked_.load();
+    const std::uint64_t lag = draining_.load() ? 0 : config_.lag;
+    if (published <= acked + lag) continue;
+    const std::uint64_t last = published - lag;
+    // Do not resend a range still on its way unless the receipt has stalled for a while.
+    std::uint64_t first = acked + 1;
+    const auto now = std::chrono::steady_clock::now();
+    if (sent_through_ >= first && now - sent_at_ < config_.resend_after) {
+      first = sent_through_ + 1;
+      if (first > last) continue;
+    }
+    send_range(first, last);
+    sent_through_ = last;
+    sent_at_ = now;
+  }
+}
+
+bool Backfiller::drain(std::chrono::milliseconds timeout) {
+  draining_.store(true);
+  force_resend_.store(true);  // the run thread may resend at once
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  std::unique_lock lock(mutex_);
+  return cv_.wait_until(lock, deadline, [this] {
+    return shore_seen_.load() && acked_.load() >= published_.load();
+  });
+}
+
+}  // namespace telltale::boat

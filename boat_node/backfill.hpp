@@ -1,0 +1,68 @@
+#pragma once
+/// \file
+/// Backfill: resends from the session log what the shore's receipts say it does not have.
+///
+/// The shore acknowledges, per boat run, the highest seq up to which every sample is stored.
+/// When the node is more than `lag` samples ahead of that receipt (the newest samples may still
+/// be in flight), a thread of its own reads the missing range from the log and writes it on the
+/// reliable backfill topic at a bounded rate; the same range is sent again only if the receipt
+/// has not moved past it within `resend_after`. At shutdown `drain()` sends up to the last
+/// sample and waits for the receipt. The sensor loop only stores an atomic counter.
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <functional>
+#include <mutex>
+#include <thread>
+
+#include "session_log.hpp"
+
+namespace telltale::boat {
+
+struct BackfillConfig {
+  std::uint64_t boot_id = 0;
+  std::uint64_t lag = 50;                 ///< samples left to the live path (2 s at 25 Hz)
+  std::size_t max_per_second = 2500;      ///< resend rate limit
+  std::chrono::milliseconds resend_after{5000};
+};
+
+class Backfiller {
+ public:
+  /// `send` writes one record on the backfill topic (returns false if it could not).
+  Backfiller(BackfillConfig config, SessionLogReader reader,
+             std::function<bool(const LogRecord&)> send);
+  ~Backfiller();
+
+  void on_published(std::uint64_t seq) { published_.store(seq); }
+  void on_ack(std::uint64_t boot_id, std::uint64_t acked_seq);
+  /// Sends everything up to the last published sample and waits for the shore's receipt, at
+  /// most `timeout`. True if the shore has it all.
+  bool drain(std::chrono::milliseconds timeout);
+
+  [[nodiscard]] std::uint64_t acked() const { return acked_.load(); }
+  [[nodiscard]] std::uint64_t resent() const { return resent_.load(); }
+  [[nodiscard]] bool shore_seen() const { return shore_seen_.load(); }
+
+ private:
+  void run();
+  void send_range(std::uint64_t first, std::uint64_t last);
+
+  BackfillConfig config_;
+  SessionLogReader reader_;
+  std::function<bool(const LogRecord&)> send_;
+  std::atomic<std::uint64_t> published_{0};
+  std::atomic<std::uint64_t> acked_{0};
+  std::atomic<std::uint64_t> resent_{0};
+  std::atomic<bool> shore_seen_{false};
+  std::atomic<bool> draining_{false};
+  std::atomic<bool> force_resend_{false};
+  std::atomic<bool> stop_{false};
+  std::uint64_t sent_through_ = 0;
+  std::chrono::steady_clock::time_point sent_at_{};
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::thread thread_;
+};
+
+}  // namespace telltale::boat

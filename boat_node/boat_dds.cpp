@@ -1,0 +1,102 @@
+#include "boat_dds.hpp"
+
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <map>
+#include <mutex>
+
+#include "telltalePubSubTypes.h"
+
+namespace telltale::boat {
+
+namespace fdds = eprosima::fastdds::dds;
+using eprosima::fastrtps::types::ReturnCode_t;
+
+class BoatDds::Listener : public fdds::DataReaderListener {
+ public:
+  Listener(const std::string& boat_id, const BoatDdsCallbacks& cb) : boat_id_(boat_id), cb_(cb) {}
+
+  void on_data_available(fdds::DataReader* reader) override {
+    fdds::SampleInfo info;
+    const std::string& topic = reader->get_topicdescription()->get_name();
+    if (topic == dds::kTopicShoreAck) {
+      msg::ShoreAck m;
+      while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK)
+        if (info.valid_data && m.boat_id().to_string() == boat_id_ && cb_.on_ack)
+          cb_.on_ack(m.boot_id(), m.acked_seq());
+    } else if (topic == dds::kTopicAlarmRules) {
+      msg::AlarmRule m;
+      bool changed = false;
+      while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
+        changed = true;
+        const std::string id = m.rule_id().to_string();
+        if (!info.valid_data) {  // disposed: the shore removed the rule
+          rules_.erase(id);
+          continue;
+        }
+        fusion::AlarmRule r;
+        r.id = id;
+        r.scope = m.scope().to_string();
+        r.quantity = m.quantity() == msg::ALARM_QUANTITY_PITCH ? fusion::AlarmQuantity::kPitch
+                                                               : fusion::AlarmQuantity::kHeel;
+        r.min_deg = m.min_deg();
+        r.max_deg = m.max_deg();
+        r.hold_s = m.hold_s();
+        r.hysteresis_deg = m.hysteresis_deg();
+        r.level = m.level() == msg::ALARM_LEVEL_ALARM ? fusion::AlarmLevel::kAlarm
+                                                      : fusion::AlarmLevel::kWarn;
+        r.enabled = m.enabled();
+        if (r.validate().empty()) rules_[id] = r;  // a malformed rule from the wire is ignored
+      }
+      if (changed && cb_.on_rules) {
+        std::vector<fusion::AlarmRule> all;
+        for (const auto& [id, r] : rules_) all.push_back(r);
+        cb_.on_rules(std::move(all));
+      }
+    } else if (topic == dds::kTopicAlarmEvents) {
+      msg::AlarmEvent m;
+      while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK)
+        if (info.valid_data && m.boat_id().to_string() == boat_id_ && cb_.on_event)
+          cb_.on_event(m);
+    }
+  }
+
+ private:
+  std::string boat_id_;
+  const BoatDdsCallbacks& cb_;
+  std::map<std::string, fusion::AlarmRule> rules_;  ///< listener thread only
+};
+
+BoatDds::BoatDds(const dds::DdsOptions& options, const std::string& boat_id,
+                 BoatDdsCallbacks callbacks)
+    : boat_id_(boat_id),
+      callbacks_(std::move(callbacks)),
+      listener_(std::make_unique<Listener>(boat_id_, callbacks_)) {
+  participant_ = std::make_unique<dds::Participant>(options, "boat_node " + boat_id);
+  auto* attitude = participant_->topic(dds::kTopicBoatAttitude,
+                                       fdds::TypeSupport(new msg::BoatAttitudePubSubType()));
+  attitude_writer_ = participant_->writer(attitude, "attitude_writer");
+  backfill_writer_ = participant_->writer(
+      participant_->topic(dds::kTopicBoatBackfill,
+                          fdds::TypeSupport(new msg::BoatAttitudePubSubType())),
+      "backfill_writer");
+  status_writer_ = participant_->writer(
+      participant_->topic(dds::kTopicNodeStatus, fdds::TypeSupport(new msg::NodeStatusPubSubType())),
+      "status_writer");
+  participant_->reader(
+      participant_->topic(dds::kTopicShoreAck, fdds::TypeSupport(new msg::ShoreAckPubSubType())),
+      "ack_reader", listener_.get());
+  participant_->reader(
+      participant_->topic(dds::kTopicAlarmRules, fdds::TypeSupport(new msg::AlarmRulePubSubType())),
+      "alarm_reader", listener_.get());
+  participant_->reader(participant_->topic(dds::kTopicAlarmEvents,
+                                           fdds::TypeSupport(new msg::AlarmEventPubSubType())),
+                       "alarm_reader", listener_.get());
+}
+
+BoatDds::~BoatDds() { participant_.reset(); }
+
+bool BoatDds::publish(msg::BoatAttitude& sample) { return attitude_writer_->write(&sample); }
+bool BoatDds::backfill(msg::BoatAttitude& sample) { return backfill_writer_->write(&sample); }
+bool BoatDds::publish(msg::NodeStatus& status) { return status_writer_->write(&status); }
+
+}  // namespace telltale::boat

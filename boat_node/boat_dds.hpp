@@ -1,0 +1,52 @@
+#pragma once
+/// \file
+/// The boat node's DDS role. Publishes BoatAttitude (live, best effort: the write never blocks
+/// the sensor loop), backfill (reliable, from the backfill thread only) and NodeStatus; listens to
+/// the shore's receipts for this boat and to the alarm rules and events the shore pushes.
+/// Constructor creates the entities and throws DdsError; destructor deletes them.
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "dds_participant.hpp"
+#include "telltale.h"
+#include "telltale/fusion/alarm_engine.hpp"
+
+namespace telltale::boat {
+
+struct BoatDdsCallbacks {
+  /// The shore's receipt for this boat (any run; the caller checks boot_id).
+  std::function<void(std::uint64_t boot_id, std::uint64_t acked_seq)> on_ack;
+  /// The complete current rule set, whenever it changes.
+  std::function<void(std::vector<fusion::AlarmRule>)> on_rules;
+  /// An alarm event about this boat changed phase on the shore.
+  std::function<void(const msg::AlarmEvent&)> on_event;
+};
+
+class BoatDds {
+ public:
+  BoatDds(const dds::DdsOptions& options, const std::string& boat_id, BoatDdsCallbacks callbacks);
+  ~BoatDds();
+  BoatDds(const BoatDds&) = delete;
+  BoatDds& operator=(const BoatDds&) = delete;
+
+  bool publish(msg::BoatAttitude& sample);
+  /// Reliable; may block up to the profile's max_blocking_time when the shore is slow.
+  bool backfill(msg::BoatAttitude& sample);
+  bool publish(msg::NodeStatus& status);
+  [[nodiscard]] int domain() const { return participant_->domain(); }
+
+ private:
+  class Listener;
+  std::string boat_id_;
+  BoatDdsCallbacks callbacks_;
+  std::unique_ptr<Listener> listener_;
+  std::unique_ptr<dds::Participant> participant_;
+  eprosima::fastdds::dds::DataWriter* attitude_writer_ = nullptr;
+  eprosima::fastdds::dds::DataWriter* backfill_writer_ = nullptr;
+  eprosima::fastdds::dds::DataWriter* status_writer_ = nullptr;
+};
+
+}  // namespace telltale::boat

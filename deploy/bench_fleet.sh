@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Load benchmark (issue 7): N boats x R Hz for S seconds through real DDS into one shore, with
+# SSE clients connected; optionally wrk against GET /api/v1/boats meanwhile. Loopback only.
+#   deploy/bench_fleet.sh [BOATS] [SECONDS] [SSE_CLIENTS] [WRK_SECONDS]
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+bin="$root/build/bin"
+boats=${1:-200}; seconds=${2:-300}; sse=${3:-1}; wrk_s=${4:-0}
+domain=$((150 + $$ % 50))
+dir=$(mktemp -d)
+token=bench-token
+"$bin/shore_server" --domain "$domain" --http-port 0 --db "$dir/bench.db" --coach-token "$token" \
+  --max-streams $((sse + 8)) >"$dir/shore.log" 2>&1 &
+shore=$!
+trap 'kill -INT $shore 2>/dev/null || true; wait $shore 2>/dev/null || true; rm -rf "$dir"' EXIT
+for _ in $(seq 100); do grep -q ready "$dir/shore.log" && break; sleep 0.1; done
+url=$(grep -o 'http://[^ /]*' "$dir/shore.log")
+"$bin/fleet_load" --domain "$domain" --shore-url "$url" --token "$token" --shore-pid "$shore" \
+  --boats "$boats" --seconds "$seconds" --sse-clients "$sse" >"$dir/load.json" &
+load=$!
+if [ "$wrk_s" -gt 0 ]; then
+  sleep 8
+  echo "wrk: GET /api/v1/boats with $sse SSE clients and $boats boats x 25 Hz streaming"
+  wrk -t2 -c16 -d"${wrk_s}s" --latency -H "Authorization: Bearer $token" "$url/api/v1/boats" |
+    grep -E "Requests/sec|Latency|50%|99%|requests in"
+fi
+wait $load
+cat "$dir/load.json"
+echo "stored in SQLite: $(sqlite3 "$dir/bench.db" 'SELECT COUNT(*) FROM attitude')"

@@ -1,0 +1,150 @@
+#include "json_views.hpp"
+
+#include <cmath>
+#include <ctime>
+#include <set>
+
+#include "query.hpp"
+
+namespace telltale::shore {
+
+using nlohmann::json;
+
+std::string iso8601(std::uint64_t t_utc_ns) {
+  const auto secs = static_cast<std::time_t>(t_utc_ns / 1000000000ULL);
+  const auto ms = static_cast<unsigned>((t_utc_ns / 1000000ULL) % 1000ULL);
+  std::tm tm{};
+  gmtime_r(&secs, &tm);
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02d.%03uZ", tm.tm_year + 1900,
+                tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, ms);
+  return buf;
+}
+
+json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json boat_object(const BoatView& v) {
+  const AttitudeSample& s = v.last;
+  json j = {
+      {"id", s.boat_id},
+      {"kind", "boat"},
+      {"group", v.status ? v.status->group : std::string()},
+      {"seq", s.seq},
+      {"t_utc_ns", s.t_utc_ns},
+      {"last_sample_time", iso8601(s.t_utc_ns)},
+      {"heel_deg", finite_or_null(s.heel_deg)},
+      {"pitch_deg", finite_or_null(s.pitch_deg)},
+      {"heading_deg", finite_or_null(s.heading_deg)},
+      {"heel_rate_deg_s", finite_or_null(s.heel_rate_deg_s)},
+      {"pitch_rate_deg_s", finite_or_null(s.pitch_rate_deg_s)},
+      {"yaw_rate_deg_s", finite_or_null(s.yaw_rate_deg_s)},
+      {"accel_weight", finite_or_null(static_cast<double>(s.accel_weight))},
+      {"quality", finite_or_null(static_cast<double>(s.quality))},
+      {"leds",
+       {{"left", s.leds[0]}, {"right", s.leds[1]}, {"up", s.leds[2]}, {"down", s.leds[3]},
+        {"count", s.led_count}}},
+      {"alarm_state", v.alarm_state},
+      {"stale", v.stale},
+      {"samples_received", v.samples_received},
+      {"clock_offset_ms", finite_or_null(v.clock_offset_ms)},
+      {"clock_suspect", std::abs(v.clock_offset_ms) > kClockSuspectMs},
+  };
+  if (v.status) {
+    j["status"] = {{"software_version", v.status->software_version},
+                   {"uptime_s", v.status->uptime_s},
+                   {"sensor_health", v.status->sensor_health},
+                   {"health_text", v.status->health_text}};
+  }
+  return j;
+}
+
+std::string boat_json(const BoatView& view) { return boat_object(view).dump(); }
+
+json rule_object(const AlarmRule& r) {
+  return {{"id", r.id},
+          {"scope", r.scope},
+          {"quantity", to_string(r.quantity)},
+          {"min_deg", r.min_deg},
+          {"max_deg", r.max_deg},
+          {"hold_s", r.hold_s},
+          {"hysteresis_deg", r.hysteresis_deg},
+          {"level", to_string(r.level)},
+          {"enabled", r.enabled}};
+}
+
+namespace {
+template <class T>
+T field(const json& j, const char* name, const T& fallback, bool required) {
+  if (!j.contains(name)) {
+    if (required) throw HttpError(400, std::string("rule: missing field '") + name + "'");
+    return fallback;
+  }
+  const json& v = j.at(name);
+  if constexpr (std::is_same_v<T, double>) {
+    if (!v.is_number()) throw HttpError(400, std::string("rule: '") + name + "' must be a number");
+    const double d = v.get<double>();
+    if (!std::isfinite(d)) throw HttpError(400, std::string("rule: '") + name + "' must be finite");
+    return d;
+  } else if constexpr (std::is_same_v<T, bool>) {
+    if (!v.is_boolean()) throw HttpError(400, std::string("rule: '") + name + "' must be true/false");
+    return v.get<bool>();
+  } else {
+    if (!v.is_string()) throw HttpError(400, std::string("rule: '") + name + "' must be a string");
+    return v.get<std::string>();
+  }
+}
+}  // namespace
+
+AlarmRule rule_from_json(const json& j) {
+  if (!j.is_object()) throw HttpError(400, "rule: expected an object");
+  static const std::set<std::string> kKnown = {"id",     "scope",          "quantity", "min_deg",
+                                               "max_deg", "hold_s", "hysteresis_deg", "level",
+                                               "enabled"};
+  for (const auto& [key, value] : j.items())
+    if (!kKnown.count(key)) throw HttpError(400, "rule: unknown field '" + key + "'");
+  AlarmRule r;
+  r.id = field<std::string>(j, "id", "", true);
+  r.scope = field<std::string>(j, "scope", "fleet", false);
+  const auto q = parse_quantity(field<std::string>(j, "quantity", "", true));
+  if (!q) throw HttpError(400, "rule: quantity must be heel or pitch");
+  r.quantity = *q;
+  r.min_deg = field<double>(j, "min_deg", -90.0, false);
+  r.max_deg = field<double>(j, "max_deg", 90.0, false);
+  r.hold_s = field<double>(j, "hold_s", 0.0, false);
+  r.hysteresis_deg = field<double>(j, "hysteresis_deg", 0.0, false);
+  const auto level = parse_level(field<std::string>(j, "level", "warn", false));
+  if (!level) throw HttpError(400, "rule: level must be warn or alarm");
+  r.level = *level;
+  r.enabled = field<bool>(j, "enabled", true, false);
+  if (const std::string why = r.validate(); !why.empty()) throw HttpError(400, "rule: " + why);
+  return r;
+}
+
+json event_object(const AlarmEvent& e) {
+  json j = {{"id", e.id},
+            {"boat_id", e.boat_id},
+            {"rule_id", e.rule_id},
+            {"level", to_string(e.level)},
+            {"phase", to_string(e.phase)},
+            {"raised_at", iso8601(e.raised_ns)},
+            {"raised_t_s", static_cast<double>(e.raised_ns) * 1e-9},
+            {"value_deg", finite_or_null(e.value_deg)},
+            {"message", e.message}};
+  j["acknowledged_at"] = e.acknowledged_ns ? json(iso8601(e.acknowledged_ns)) : json(nullptr);
+  j["silenced_at"] = e.silenced_ns ? json(iso8601(e.silenced_ns)) : json(nullptr);
+  j["cleared_at"] = e.cleared_ns ? json(iso8601(e.cleared_ns)) : json(nullptr);
+  return j;
+}
+
+json session_object(const SessionInfo& s) {
+  return {{"id", s.id},
+          {"boat_id", s.boat_id},
+          {"start", iso8601(s.start_ns)},
+          {"end", iso8601(s.end_ns)},
+          {"start_t_s", static_cast<double>(s.start_ns) * 1e-9},
+          {"end_t_s", static_cast<double>(s.end_ns) * 1e-9},
+          {"duration_s", static_cast<double>(s.end_ns - s.start_ns) * 1e-9},
+          {"samples", s.samples}};
+}
+
+}  // namespace telltale::shore

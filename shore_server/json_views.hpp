@@ -1,0 +1,29 @@
+#pragma once
+/// \file
+/// The JSON shapes of the REST API and the live stream (described in openapi.json), in one place.
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "telltale/fusion/alarm_engine.hpp"
+#include "fleet.hpp"
+#include "store.hpp"
+
+namespace telltale::shore {
+
+/// ISO-8601 UTC with milliseconds for ns since 1970.
+[[nodiscard]] std::string iso8601(std::uint64_t t_utc_ns);
+/// A number, or null when it is not finite.
+[[nodiscard]] nlohmann::json finite_or_null(double v);
+
+[[nodiscard]] nlohmann::json boat_object(const BoatView& view);
+[[nodiscard]] std::string boat_json(const BoatView& view);
+[[nodiscard]] nlohmann::json rule_object(const AlarmRule& rule);
+/// A rule from its JSON; throws HttpError 400 naming the field that is wrong.
+[[nodiscard]] AlarmRule rule_from_json(const nlohmann::json& j);
+[[nodiscard]] nlohmann::json event_object(const AlarmEvent& event);
+[[nodiscard]] nlohmann::json session_object(const SessionInfo& session);
+
+}  // namespace telltale::shore

@@ -1,0 +1,462 @@
+// The data routes of the REST API: boats, sessions, attitude ranges, exports, alarms.
+// Every input is parsed strictly (query.hpp); every failure is an HttpError with its 4xx.
+#include <httplib.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "http_api.hpp"
+#include "json_views.hpp"
+#include "query.hpp"
+#include "shutdown.hpp"
+
+namespace telltale::shore {
+namespace {
+
+using nlohmann::json;
+
+constexpr std::int64_t kMaxPointsLimit = 100000;
+constexpr std::size_t kMaxRules = 200;
+
+Principal who(const ShoreContext& ctx, const httplib::Request& req) {
+  return authenticate(ctx.tokens, req.get_header_value("Authorization"),
+                      req.get_header_value("Cookie"));
+}
+
+void require_coach(const Principal& p) {
+  if (p.role != Role::kCoach) throw HttpError(403, "only a coach may do this");
+}
+
+void require_boat(const Principal& p, const std::string& boat_id) {
+  if (p.role == Role::kAthlete && p.boat_id != boat_id)
+    throw HttpError(403, "an athlete sees only their own boat");
+}
+
+/// The query parameters a route accepts; any other is a 400 (a typo must not be ignored).
+void allow_params(const httplib::Request& req, std::initializer_list<const char*> allowed) {
+  for (const auto& [name, value] : req.params) {
+    if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return name == a; }))
+      throw HttpError(400, "unknown parameter '" + name + "'");
+    if (req.get_param_value_count(name) > 1)
+      throw HttpError(400, "parameter '" + name + "' given more than once");
+  }
+}
+
+const std::string* param(const httplib::Request& req, const char* name) {
+  auto it = req.params.find(name);
+  return it == req.params.end() ? nullptr : &it->second;
+}
+
+std::string path_id(const httplib::Request& req, const char* what) {
+  const std::string id = req.matches[1];
+  if (!valid_id(id)) throw HttpError(400, std::string(what) + " id must be 1-32 of [A-Za-z0-9_-]");
+  return id;
+}
+
+std::int64_t path_number(const httplib::Request& req, const char* what) {
+  const auto n = parse_int(req.matches[1], 1, INT64_MAX);
+  if (!n) throw HttpError(400, std::string(what) + " id must be a positive integer");
+  return *n;
+}
+
+enum class Format { kJson, kCsv };
+Format format_of(const httplib::Request& req) {
+  const std::string* f = param(req, "format");
+  if (!f || *f == "json") return Format::kJson;
+  if (*f == "csv") return Format::kCsv;
+  throw HttpError(400, "format must be json or csv");
+}
+
+std::optional<std::size_t> max_points_of(const httplib::Request& req) {
+  const std::string* m = param(req, "max_points");
+  if (!m) return std::nullopt;
+  const auto n = parse_int(*m, 4, kMaxPointsLimit);
+  if (!n) throw HttpError(400, "max_points must be an integer in 4.." + std::to_string(kMaxPointsLimit));
+  return static_cast<std::size_t>(*n);
+}
+
+std::string csv_number(double v) {
+  if (!std::isfinite(v)) return "";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+constexpr const char* kCsvHeader =
+    "time_utc,t_s,seq,heel_deg,pitch_deg,heading_deg,heel_rate_deg_s,pitch_rate_deg_s,"
+    "yaw_rate_deg_s,accel_weight,quality\n";
+
+std::string csv_row(const AttitudeRow& r) {
+  char t[32];
+  std::snprintf(t, sizeof t, "%.3f", static_cast<double>(r.t_utc_ns) * 1e-9);
+  return iso8601(r.t_utc_ns) + "," + t + "," + std::to_string(r.seq) + "," +
+         csv_number(r.heel_deg) + "," + csv_number(r.pitch_deg) + "," +
+         csv_number(r.heading_deg) + "," + csv_number(r.heel_rate_deg_s) + "," +
+         csv_number(r.pitch_rate_deg_s) + "," + csv_number(r.yaw_rate_deg_s) + "," +
+         csv_number(r.accel_weight) + "," + csv_number(r.quality) + "\n";
+}
+
+json row_object(const AttitudeRow& r) {
+  return {{"time_utc", iso8601(r.t_utc_ns)},
+          {"t_s", static_cast<double>(r.t_utc_ns) * 1e-9},
+          {"seq", r.seq},
+          {"heel_deg", finite_or_null(r.heel_deg)},
+          {"pitch_deg", finite_or_null(r.pitch_deg)},
+          {"heading_deg", finite_or_null(r.heading_deg)},
+          {"heel_rate_deg_s", finite_or_null(r.heel_rate_deg_s)},
+          {"pitch_rate_deg_s", finite_or_null(r.pitch_rate_deg_s)},
+          {"yaw_rate_deg_s", finite_or_null(r.yaw_rate_deg_s)},
+          {"accel_weight", finite_or_null(r.accel_weight)},
+          {"quality", finite_or_null(r.quality)}};
+}
+
+/// Streams every stored sample of a boat in [from, to] as CSV or JSON, a page at a time: a long
+/// session is never held in memory whole.
+void stream_rows(httplib::Response& res, Store& store, const std::string& boat_id,
+                 std::uint64_t from_ns, std::uint64_t to_ns, Format format, json head,
+                 const std::string& filename) {
+  if (!filename.empty())
+    res.set_header("Content-Disposition", "attachment; filename=\"" + filename + "\"");
+  struct Cursor {
+    std::uint64_t after;
+    bool started = false;
+    bool first_row = true;
+    bool done = false;
+  };
+  auto cursor = std::make_shared<Cursor>(Cursor{from_ns == 0 ? 0 : from_ns - 1});
+  res.set_chunked_content_provider(
+      format == Format::kCsv ? "text/csv" : "application/json",
+      [&store, boat_id, to_ns, format, cursor, head = std::move(head)](std::size_t,
+                                                                        httplib::DataSink& sink) {
+        std::string out;
+        if (!cursor->started) {
+          cursor->started = true;
+          if (format == Format::kCsv) {
+            out = kCsvHeader;
+          } else {
+            std::string h = head.dump();
+            h.pop_back();  // reopen the object to append the samples array
+            out = h + (head.empty() ? "" : ",") + "\"samples\":[";
+          }
+        }
+        if (cursor->done) {
+          sink.done();
+          return true;
+        }
+        constexpr std::size_t kPage = 2000;
+        const auto rows = store.attitude_page(boat_id, cursor->after, to_ns, kPage);
+        for (const auto& r : rows) {
+          if (format == Format::kCsv) {
+            out += csv_row(r);
+          } else {
+            if (!cursor->first_row) out += ",";
+            out += row_object(r).dump();
+            cursor->first_row = false;
+          }
+        }
+        if (!rows.empty()) cursor->after = rows.back().t_utc_ns;
+        if (rows.size() < kPage) {
+          cursor->done = true;
+          if (format == Format::kJson) out += "]}";
+        }
+        return out.empty() || sink.write(out.data(), out.size());
+      });
+}
+
+/// Column arrays for charts. Beyond max_points, each time bucket keeps the samples with the
+/// smallest and largest heel and pitch, so peaks survive downsampling (at most 4 per bucket).
+json attitude_columns(Store& store, const std::string& boat_id, std::uint64_t from_ns,
+                      std::uint64_t to_ns, std::optional<std::size_t> max_points) {
+  std::vector<AttitudeRow> rows;
+  std::size_t count = 0;
+  std::uint64_t first_ns = 0;
+  std::uint64_t last_ns = 0;
+  // First pass: count and time span (cheap: the primary key orders by time).
+  store.visit_attitude(boat_id, from_ns, to_ns, [&](const AttitudeRow& r) {
+    if (count == 0) first_ns = r.t_utc_ns;
+    last_ns = r.t_utc_ns;
+    ++count;
+    if (!max_points || count <= *max_points) rows.push_back(r);
+    return true;
+  });
+  const bool downsample = max_points && count > *max_points;
+  if (downsample) {
+    rows.clear();
+    const std::size_t buckets = *max_points / 4;
+    const double span = static_cast<double>(last_ns - first_ns) + 1.0;
+    std::vector<std::array<AttitudeRow, 4>> extremes(buckets);
+    std::vector<bool> used(buckets, false);
+    store.visit_attitude(boat_id, from_ns, to_ns, [&](const AttitudeRow& r) {
+      auto b = static_cast<std::size_t>(static_cast<double>(r.t_utc_ns - first_ns) / span *
+                                        static_cast<double>(buckets));
+      b = std::min(b, buckets - 1);
+      auto& e = extremes[b];
+      if (!used[b]) {
+        e = {r, r, r, r};
+        used[b] = true;
+        return true;
+      }
+      if (r.heel_deg < e[0].heel_deg) e[0] = r;
+      if (r.heel_deg > e[1].heel_deg) e[1] = r;
+      if (r.pitch_deg < e[2].pitch_deg) e[2] = r;
+      if (r.pitch_deg > e[3].pitch_deg) e[3] = r;
+      return true;
+    });
+    for (std::size_t b = 0; b < buckets; ++b) {
+      if (!used[b]) continue;
+      auto e = extremes[b];
+      std::sort(e.begin(), e.end(),
+                [](const AttitudeRow& x, const AttitudeRow& y) { return x.t_utc_ns < y.t_utc_ns; });
+      for (std::size_t i = 0; i < e.size(); ++i)
+        if (i == 0 || e[i].t_utc_ns != e[i - 1].t_utc_ns) rows.push_back(e[i]);
+    }
+  }
+  json t = json::array(), heel = json::array(), pitch = json::array(), heading = json::array();
+  for (const auto& r : rows) {
+    t.push_back(static_cast<double>(r.t_utc_ns) * 1e-9);
+    heel.push_back(finite_or_null(r.heel_deg));
+    pitch.push_back(finite_or_null(r.pitch_deg));
+    heading.push_back(finite_or_null(r.heading_deg));
+  }
+  return {{"boat_id", boat_id},
+          {"count", count},
+          {"downsampled", downsample},
+          {"points", rows.size()},
+          {"t_s", std::move(t)},
+          {"heel_deg", std::move(heel)},
+          {"pitch_deg", std::move(pitch)},
+          {"heading_deg", std::move(heading)}};
+}
+
+/// Seconds spent in each 5-degree heel band over a session (a gap counts at most 1 s).
+json heel_bands(Store& store, const SessionInfo& s) {
+  static constexpr std::array<double, 13> kEdges = {-90, -25, -20, -15, -10, -5, 0,
+                                                    5,   10,  15,  20,  25,  90};
+  std::array<double, kEdges.size() - 1> seconds{};
+  std::optional<AttitudeRow> prev;
+  const auto add = [&](const AttitudeRow& r, double dt) {
+    for (std::size_t i = 0; i + 1 < kEdges.size(); ++i) {
+      if (r.heel_deg >= kEdges[i] && (r.heel_deg < kEdges[i + 1] || i + 2 == kEdges.size())) {
+        seconds[i] += dt;
+        return;
+      }
+    }
+  };
+  store.visit_attitude(s.boat_id, s.start_ns, s.end_ns, [&](const AttitudeRow& r) {
+    if (prev) add(*prev, std::min(1.0, static_cast<double>(r.t_utc_ns - prev->t_utc_ns) * 1e-9));
+    prev = r;
+    return true;
+  });
+  json bands = json::array();
+  for (std::size_t i = 0; i + 1 < kEdges.size(); ++i)
+    bands.push_back({{"from_deg", kEdges[i]}, {"to_deg", kEdges[i + 1]}, {"seconds", seconds[i]}});
+  return bands;
+}
+
+std::string safe_filename(const std::string& boat_id, std::int64_t session_id, Format f) {
+  return "telltale_" + boat_id + "_session" + std::to_string(session_id) +
+         (f == Format::kCsv ? ".csv" : ".json");
+}
+
+}  // namespace
+
+void register_rest_routes(httplib::Server& server, ShoreContext& ctx) {
+  server.Get("/api/v1/boats", [&ctx](const httplib::Request& req, httplib::Response& res) {
+    const Principal p = who(ctx, req);
+    allow_params(req, {});
+    json arr = json::array();
+    for (const auto& b : ctx.fleet.boats())
+      if (p.role != Role::kAthlete || b.last.boat_id == p.boat_id) arr.push_back(boat_object(b));
+    res.set_content(arr.dump(), "application/json");
+  });
+
+  server.Get(R"(/api/v1/boats/([^/]+))", [&ctx](const httplib::Request& req,
+                                                 httplib::Response& res) {
+    const Principal p = who(ctx, req);
+    allow_params(req, {});
+    const std::string id = path_id(req, "boat");
+    require_boat(p, id);
+    const auto view = ctx.fleet.boat(id);
+    if (!view) throw HttpError(404, "unknown boat '" + id + "'");
+    res.set_content(boat_json(*view), "application/json");
+  });
+
+  server.Get(R"(/api/v1/boats/([^/]+)/attitude)", [&ctx](const httplib::Request& req,
+                                                          httplib::Response& res) {
+    const Principal p = who(ctx, req);
+    allow_params(req, {"from", "to", "max_points", "format"});
+    const std::string id = path_id(req, "boat");
+    require_boat(p, id);
+    const TimeRange range = parse_range(param(req, "from"), param(req, "to"));
+    const Format format = format_of(req);
+    const auto max_points = max_points_of(req);
+    if (!ctx.fleet.boat(id) && !ctx.store.knows_boat(id))
+      throw HttpError(404, "unknown boat '" + id + "'");
+    if (format == Format::kCsv) {
+      if (max_points) throw HttpError(400, "max_points applies to JSON only");
+      stream_rows(res, ctx.store, id, range.from_ns, range.to_ns, format, json::object(), "");
+      return;
+    }
+    json j = attitude_columns(ctx.store, id, range.from_ns, range.to_ns, max_points);
+    j["from"] = range.from_ns ? json(iso8601(range.from_ns)) : json(nullptr);
+    j["to"] = range.to_ns != UINT64_MAX ? json(iso8601(range.to_ns)) : json(nullptr);
+    res.set_content(j.dump(), "application/json");
+  });
+
+  server.Get("/api/v1/sessions", [&ctx](const httplib::Request& req, httplib::Response& res) {
+    const Principal p = who(ctx, req);
+    allow_params(req, {"boat", "from", "to"});
+    std::optional<std::string> boat;
+    if (const std::string* b = param(req, "boat")) {
+      if (!valid_id(*b)) throw HttpError(400, "boat id must be 1-32 of [A-Za-z0-9_-]");
+      boat = *b;
+    }
+    if (p.role == Role::kAthlete) {
+      if (boat && *boat != p.boat_id) throw HttpError(403, "an athlete sees only their own boat");
+      boat = p.boat_id;
+    }
+    const TimeRange range = parse_range(param(req, "from"), param(req, "to"));
+    json arr = json::array();
+    for (const auto& s : ctx.store.sessions(boat, range.from_ns, range.to_ns))
+      arr.push_back(session_object(s));
+    res.set_content(arr.dump(), "application/json");
+  });
+
+  const auto session_or_404 = [&ctx](const httplib::Request& req, const Principal& p) {
+    const std::int64_t id = path_number(req, "session");
+    auto s = ctx.store.session(id);
+    if (!s) throw HttpError(404, "unknown session " + std::to_string(id));
+    require_boat(p, s->boat_id);
+    return *s;
+  };
+
+  server.Get(R"(/api/v1/sessions/([^/]+))", [&ctx, session_or_404](const httplib::Request& req,
+                                                                    httplib::Response& res) {
+    const Principal p = who(ctx, req);
+    allow_params(req, {});
+    const SessionInfo s = session_or_404(req, p);
+    json j = session_object(s);
+    j["heel_bands"] = heel_bands(ctx.store, s);
+    EventFilter f;
+    f.boat_id = s.boat_id;
+    f.from_ns = s.start_ns;
+    f.to_ns = s.end_ns;
+    f.limit = 10000;
+    json events = json::array();
+    for (const auto& e : ctx.store.events(f)) events.push_back(event_object(e));
+    j["alarm_events"] = std::move(events);
+    res.set_content(j.dump(), "application/json");
+  });
+
+  server.Get(R"(/api/v1/sessions/([^/]+)/attitude)",
+             [&ctx, session_or_404](const httplib::Request& req, httplib::Response& res) {
+               const Principal p = who(ctx, req);
+               allow_params(req, {"max_points"});
+               const SessionInfo s = session_or_404(req, p);
+               json j = attitude_columns(ctx.store, s.boat_id, s.start_ns, s.end_ns,
+                                         max_points_of(req));
+               j["session_id"] = s.id;
+               res.set_content(j.dump(), "application/json");
+             });
+
+  server.Get(R"(/api/v1/sessions/([^/]+)/export)",
+             [&ctx, session_or_404](const httplib::Request& req, httplib::Response& res) {
+               const Principal p = who(ctx, req);
+               allow_params(req, {"format"});
+               if (!param(req, "format")) throw HttpError(400, "format is required: csv or json");
+               const Format format = format_of(req);
+               const SessionInfo s = session_or_404(req, p);
+               stream_rows(res, ctx.store, s.boat_id, s.start_ns, s.end_ns, format,
+                           {{"session", session_object(s)}}, safe_filename(s.boat_id, s.id, format));
+             });
+
+  server.Get("/api/v1/alarms/rules", [&ctx](const httplib::Request& req, httplib::Response& res) {
+    (void)who(ctx, req);
+    allow_params(req, {});
+    json arr = json::array();
+    for (const auto& r : ctx.alarms.rules()) arr.push_back(rule_object(r));
+    res.set_content(arr.dump(), "application/json");
+  });
+
+  server.Put("/api/v1/alarms/rules", [&ctx](const httplib::Request& req, httplib::Response& res) {
+    require_coach(who(ctx, req));
+    allow_params(req, {});
+    const std::string type = req.get_header_value("Content-Type");
+    if (type.rfind("application/json", 0) != 0)
+      throw HttpError(415, "body must be application/json");
+    json body;
+    try {
+      body = json::parse(req.body);
+    } catch (const json::parse_error&) {
+      throw HttpError(400, "body is not valid JSON");
+    }
+    if (!body.is_array()) throw HttpError(400, "body must be a JSON array of rules");
+    if (body.size() > kMaxRules)
+      throw HttpError(400, "at most " + std::to_string(kMaxRules) + " rules");
+    std::vector<AlarmRule> rules;
+    std::set<std::string> ids;
+    for (const auto& j : body) {
+      rules.push_back(rule_from_json(j));
+      if (!ids.insert(rules.back().id).second)
+        throw HttpError(400, "duplicate rule id '" + rules.back().id + "'");
+    }
+    ctx.alarms.put_rules(std::move(rules), utc_now_ns());
+    json arr = json::array();
+    for (const auto& r : ctx.alarms.rules()) arr.push_back(rule_object(r));
+    res.set_content(arr.dump(), "application/json");
+  });
+
+  server.Get("/api/v1/alarms/events", [&ctx](const httplib::Request& req, httplib::Response& res) {
+    const Principal p = who(ctx, req);
+    allow_params(req, {"boat", "from", "to", "active", "limit"});
+    EventFilter f;
+    if (const std::string* b = param(req, "boat")) {
+      if (!valid_id(*b)) throw HttpError(400, "boat id must be 1-32 of [A-Za-z0-9_-]");
+      f.boat_id = *b;
+    }
+    if (p.role == Role::kAthlete) {
+      if (f.boat_id && *f.boat_id != p.boat_id)
+        throw HttpError(403, "an athlete sees only their own boat");
+      f.boat_id = p.boat_id;
+    }
+    const TimeRange range = parse_range(param(req, "from"), param(req, "to"));
+    f.from_ns = range.from_ns;
+    f.to_ns = range.to_ns;
+    if (const std::string* a = param(req, "active")) {
+      if (*a != "true" && *a != "false") throw HttpError(400, "active must be true or false");
+      f.active_only = *a == "true";
+    }
+    if (const std::string* l = param(req, "limit")) {
+      const auto n = parse_int(*l, 1, 10000);
+      if (!n) throw HttpError(400, "limit must be an integer in 1..10000");
+      f.limit = static_cast<std::size_t>(*n);
+    }
+    json arr = json::array();
+    for (const auto& e : ctx.store.events(f)) arr.push_back(event_object(e));
+    res.set_content(arr.dump(), "application/json");
+  });
+
+  const auto event_action = [&ctx](bool acknowledge) {
+    return [&ctx, acknowledge](const httplib::Request& req, httplib::Response& res) {
+      require_coach(who(ctx, req));
+      allow_params(req, {});
+      const auto id = parse_int(req.matches[1], 1, INT64_MAX);
+      if (!id) throw HttpError(400, "event id must be a positive integer");
+      const auto ev_id = static_cast<std::uint64_t>(*id);
+      const auto e = acknowledge ? ctx.alarms.acknowledge(ev_id, utc_now_ns())
+                                 : ctx.alarms.silence(ev_id, utc_now_ns());
+      if (!e) {
+        if (ctx.store.event(ev_id)) throw HttpError(409, "event already cleared");
+        throw HttpError(404, "unknown event " + std::to_string(ev_id));
+      }
+      res.set_content(event_object(*e).dump(), "application/json");
+    };
+  };
+  server.Post(R"(/api/v1/alarms/events/([^/]+)/ack)", event_action(true));
+  server.Post(R"(/api/v1/alarms/events/([^/]+)/silence)", event_action(false));
+}
+
+}  // namespace telltale::shore

@@ -1,0 +1,59 @@
+#pragma once
+/// \file
+/// The shore's DDS role: subscribes to the whole fleet (attitude, node status) and hands every
+/// sample to the callbacks, on Fast DDS's listener thread (callbacks must be quick and must not
+/// throw: they update the fleet model, the live hub and the store queue); publishes the alarm
+/// rules and events to the boats (reliable, transient local: a boat that joins late gets them).
+
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <vector>
+#include <string>
+
+#include "dds_participant.hpp"
+#include "telltale/fusion/alarm_engine.hpp"
+#include "fleet.hpp"
+
+namespace telltale::shore {
+
+struct FleetCallbacks {
+  /// Live samples (best effort topic).
+  std::function<void(const AttitudeSample&)> on_attitude;
+  /// Samples a boat resends from its session log (reliable backfill topic).
+  std::function<void(const AttitudeSample&)> on_backfill;
+  std::function<void(const std::string& node_id, const NodeStatusInfo&)> on_status;
+  /// A boat missed its DDS deadline (no sample within the deadline period).
+  std::function<void(const std::string& boat_id)> on_deadline_missed;
+};
+
+class ShoreDds {
+ public:
+  /// Creates the participant, readers and writers (throws dds::DdsError).
+  ShoreDds(const dds::DdsOptions& options, FleetCallbacks callbacks);
+  ~ShoreDds();
+  ShoreDds(const ShoreDds&) = delete;
+  ShoreDds& operator=(const ShoreDds&) = delete;
+
+  /// Publishes the whole rule set; rules no longer in it are disposed. Thread-safe.
+  void publish_rules(const std::vector<AlarmRule>& rules);
+  /// Publishes one event's current phase. Thread-safe.
+  void publish_event(const AlarmEvent& event);
+  /// Tells a boat that every sample of run `boot_id` up to `acked_seq` is stored. Thread-safe.
+  void publish_ack(const std::string& boat_id, std::uint64_t boot_id, std::uint64_t acked_seq);
+  [[nodiscard]] int domain() const { return participant_->domain(); }
+
+ private:
+  class Listener;
+  FleetCallbacks callbacks_;
+  std::unique_ptr<Listener> listener_;
+  std::unique_ptr<dds::Participant> participant_;
+  eprosima::fastdds::dds::DataWriter* rule_writer_ = nullptr;
+  eprosima::fastdds::dds::DataWriter* event_writer_ = nullptr;
+  eprosima::fastdds::dds::DataWriter* ack_writer_ = nullptr;
+  std::mutex write_mutex_;
+  std::vector<std::string> published_rule_ids_;
+  std::uint64_t rule_revision_ = 0;
+};
+
+}  // namespace telltale::shore

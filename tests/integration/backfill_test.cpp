@@ -1,0 +1,102 @@
+// Losing nothing on a flaky link (issue 6): a boat sails through a shore crash and through a cut
+// link; afterwards the shore's recording holds every sample the boat published, with no gap
+// longer than two publish periods. Real processes, real DDS, real SQLite.
+#include <signal.h>
+#include <sqlite3.h>
+
+#include "shore_fixture.hpp"
+
+namespace telltale::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+class BackfillTest : public ShoreFixture {
+ protected:
+  /// Stops the boat (it drains its backlog) and returns how many samples it published.
+  long stop_boat(Process& boat) {
+    EXPECT_EQ(boat.stop(SIGINT, 15s), 0) << boat.output();
+    const auto line = boat.wait_for_line("boat_node stopped: ", 1s);
+    EXPECT_TRUE(line) << boat.output();
+    std::smatch m;
+    if (!line || !std::regex_search(*line, m, std::regex(R"(published=(\d+))"))) return -1;
+    EXPECT_NE(line->find("shore_has_all=yes"), std::string::npos) << *line;
+    return std::stol(m[1]);
+  }
+
+  /// Every seq 1..published stored once, and the largest time step between stored samples.
+  void expect_complete(const std::string& boat_id, long published) {
+    std::this_thread::sleep_for(600ms);  // the shore's commit interval
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open_v2(db_path().c_str(), &db, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
+    sqlite3_stmt* st = nullptr;
+    sqlite3_prepare_v2(db, "SELECT seq, t_utc_ns FROM attitude WHERE boat_id = ? ORDER BY t_utc_ns",
+                       -1, &st, nullptr);
+    sqlite3_bind_text(st, 1, boat_id.c_str(), -1, SQLITE_TRANSIENT);
+    long count = 0;
+    long expected_seq = 1;
+    bool in_order = true;
+    sqlite3_int64 prev_t = 0;
+    sqlite3_int64 max_step = 0;
+    while (sqlite3_step(st) == SQLITE_ROW) {
+      const long seq = sqlite3_column_int64(st, 0);
+      const sqlite3_int64 t = sqlite3_column_int64(st, 1);
+      if (seq != expected_seq) in_order = false;
+      if (count > 0) max_step = std::max(max_step, t - prev_t);
+      prev_t = t;
+      ++expected_seq;
+      ++count;
+    }
+    sqlite3_finalize(st);
+    sqlite3_close(db);
+    EXPECT_EQ(count, published) << "stored vs published";
+    EXPECT_TRUE(in_order) << "seqs 1..N each once, in time order";
+    // 25 Hz: a publish period is 40 ms; no gap longer than two periods.
+    EXPECT_LE(max_step, 80'000'000 + 1'000'000) << "largest gap " << max_step / 1000000 << " ms";
+  }
+};
+
+// Given a boat sailing, when the shore is killed (SIGKILL) for 16 s and restarted on the same
+// database, then after the boat stops the session holds every sample it published.
+TEST_F(BackfillTest, ShoreKilledAndRestartedLosesNothing) {
+  Process& boat = start_boat("bf1", {"--log-dir", dir_ + "/boatlog"});
+  std::this_thread::sleep_for(4s);
+  ASSERT_EQ(shore_->stop(SIGKILL), 128 + SIGKILL);
+  std::this_thread::sleep_for(16s);
+  start_shore();
+  // The boat backfills the outage while it keeps sailing.
+  ASSERT_TRUE(eventually([&] { return !boats_by_id().empty(); }, 15s));
+  std::this_thread::sleep_for(6s);
+  const long published = stop_boat(boat);
+  ASSERT_GT(published, 25 * 20);
+  expect_complete("bf1", published);
+}
+
+// Given a boat whose every outgoing packet is dropped for 15 s (Fast DDS's test transport), when
+// the link returns, then the shore marked it stale meanwhile and the session is complete after.
+TEST_F(BackfillTest, CutLinkIsBackfilled) {
+  Process& boat =
+      start_boat("bf2", {"--log-dir", dir_ + "/boatlog", "--fault-drop-link", "3:15"});
+  ASSERT_TRUE(eventually([&] { return boats_by_id().count("bf2") == 1; }, 10s));
+  // During the cut the boat goes stale on the shore.
+  ASSERT_TRUE(eventually(
+      [&] {
+        const auto boats = boats_by_id();
+        return boats.count("bf2") && boats.at("bf2")["stale"].get<bool>();
+      },
+      10s));
+  // After it, live again.
+  ASSERT_TRUE(eventually(
+      [&] {
+        const auto boats = boats_by_id();
+        return boats.count("bf2") && !boats.at("bf2")["stale"].get<bool>();
+      },
+      25s));
+  std::this_thread::sleep_for(5s);
+  const long published = stop_boat(boat);
+  ASSERT_GT(published, 25 * 20);
+  expect_complete("bf2", published);
+}
+
+}  // namespace
+}  // namespace telltale::testing

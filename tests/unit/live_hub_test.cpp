@@ -1,0 +1,67 @@
+#include "live_hub.hpp"
+
+#include <gtest/gtest.h>
+
+namespace telltale::shore {
+namespace {
+
+using namespace std::chrono_literals;
+
+int count(const std::string& s, const std::string& what) {
+  int n = 0;
+  for (std::size_t p = s.find(what); p != std::string::npos; p = s.find(what, p + 1)) ++n;
+  return n;
+}
+
+// A slow client that has not read for a while gets only the latest sample per boat, and every
+// event (up to the bound), never a backlog of samples.
+TEST(LiveHub, SlowClientGetsLatestPerBoat) {
+  LiveHub hub(4, 3);
+  auto c = hub.connect();
+  ASSERT_TRUE(c);
+  for (int i = 0; i < 100; ++i) {
+    hub.publish_sample("A", "{\"v\":" + std::to_string(i) + "}");
+    hub.publish_sample("B", "{\"w\":" + std::to_string(i) + "}");
+  }
+  hub.publish_event("alarm", "{\"e\":1}", "A");
+  bool closed = false;
+  const std::string out = hub.wait(*c, 10ms, closed);
+  EXPECT_FALSE(closed);
+  EXPECT_EQ(count(out, "event: sample"), 2);
+  EXPECT_NE(out.find("{\"v\":99}"), std::string::npos);
+  EXPECT_NE(out.find("{\"w\":99}"), std::string::npos);
+  EXPECT_EQ(count(out, "event: alarm"), 1);
+  EXPECT_TRUE(hub.wait(*c, 1ms, closed).empty());
+}
+
+TEST(LiveHub, EventOverflowIsReported) {
+  LiveHub hub(4, 3);
+  auto c = hub.connect();
+  for (int i = 0; i < 5; ++i) hub.publish_event("alarm", std::to_string(i), "A");
+  bool closed = false;
+  const std::string out = hub.wait(*c, 10ms, closed);
+  EXPECT_EQ(count(out, "event: alarm"), 3);
+  EXPECT_NE(out.find("event: overflow\ndata: {\"dropped_events\":2}"), std::string::npos);
+  EXPECT_EQ(out.find("data: 0\n"), std::string::npos);  // the oldest were dropped
+}
+
+TEST(LiveHub, BoundedClientsFilterAndClose) {
+  LiveHub hub(2, 8);
+  auto athlete = hub.connect(std::string("A"));
+  auto coach = hub.connect();
+  EXPECT_FALSE(hub.connect());  // full
+  hub.publish_sample("B", "{}");
+  hub.publish_event("alarm", "{}", "B");
+  bool closed = false;
+  EXPECT_TRUE(hub.wait(*athlete, 1ms, closed).empty());
+  EXPECT_EQ(count(hub.wait(*coach, 1ms, closed), "event:"), 2);
+  hub.disconnect(coach);
+  EXPECT_TRUE(hub.connect());
+  hub.close();
+  hub.wait(*athlete, 1s, closed);
+  EXPECT_TRUE(closed);
+  EXPECT_FALSE(hub.connect());
+}
+
+}  // namespace
+}  // namespace telltale::shore
