@@ -49,7 +49,7 @@ test('an alarm shows in the fleet view within 2 s of the boat crossing the thres
     const s = await page.evaluate(() => window.__samples.at(-1));
     return s.heel < threshold - 0.3;
   }, { timeoutMs: 8000, intervalMs: 20, what: 'heel below the threshold' });
-  const rule = { id: 1, scope: 'boat:ILCA-1', quantity: 'heel', min_deg: -90, max_deg: threshold, hold_s: 0,
+  const rule = { id: 'ilca1-heel', scope: 'boat:ILCA-1', quantity: 'heel', min_deg: -90, max_deg: threshold, hold_s: 0,
     hysteresis_deg: 0.2, level: 'alarm', enabled: true };
   const armedMs = Date.now();
   await fleet.rest('/alarms/rules', { method: 'PUT', body: JSON.stringify([rule]), headers: { 'Content-Type': 'application/json' } });

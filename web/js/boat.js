@@ -198,11 +198,15 @@ async function rulesEditor(box, boatId, role) {
     return tr;
   };
   rules.forEach((r) => tbody.append(row(r)));
-  const nextId = () => {
-    const ids = [...tbody.children].map((tr) => Number(tr._rule.id)).filter(Number.isFinite);
-    return (ids.length ? Math.max(...ids) : 0) + 1;
+  // Rule ids are strings chosen by the editor: the scope and a free number.
+  const nextId = (scope) => {
+    const taken = new Set([...tbody.children].map((tr) => String(tr._rule.id)));
+    const base = scope.replace(/[^A-Za-z0-9_-]+/g, '-');
+    let n = 1;
+    while (taken.has(`${base}-${n}`)) n++;
+    return `${base}-${n}`;
   };
-  const add = (scope) => tbody.append(row({ id: nextId(), scope, quantity: 'heel', min_deg: -25,
+  const add = (scope) => tbody.append(row({ id: nextId(scope), scope, quantity: 'heel', min_deg: -25,
     max_deg: 25, hold_s: 2, hysteresis_deg: 1, level: 'alarm', enabled: true }));
   const collect = () => [...tbody.children].map((tr) => {
     const r = { ...tr._rule };

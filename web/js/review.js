@@ -54,8 +54,9 @@ export function mountReview(container, { query, navigate }) {
         api(`/sessions/${sid}`),
         api(`/sessions/${sid}/attitude${q({ max_points: MAX_POINTS })}`),
       ]);
-      let events = [];
-      if (has('/alarms/events')) {
+      // The session detail lists its alarm events; older servers only count them.
+      let events = Array.isArray(detail.alarm_events) ? detail.alarm_events : [];
+      if (!Array.isArray(detail.alarm_events) && has('/alarms/events')) {
         events = await api(`/alarms/events${q({ boat: detail.boat_id, from: detail.start_t_s, to: detail.end_t_s + 1 })}`);
       }
       return { detail, data, events };
@@ -109,7 +110,7 @@ function render(body, uPlot, main, vs) {
     el('span', { class: 'swatch', style: `background:${color}` }),
     `${name(d)} · ${d.detail.start.slice(0, 19).replace('T', ' ')} UTC · ${duration(d.detail.duration_s)} · ` +
     `${d.detail.samples} samples${d.data.downsampled ? ` (drawn: ${d.data.t_s.length} points, peaks kept)` : ''}` +
-    ` · ${d.detail.alarm_events ?? d.events.length} alarm events `, ...exportLinks(d));
+    ` · ${d.events.length} alarm events `, ...exportLinks(d));
 
   const chartsBox = el('section', { class: 'charts', 'aria-label': 'session charts' });
   const scrub = el('input', { type: 'range', id: 'scrubber', min: 0, max: Math.ceil(m.duration_s), step: 0.1, value: 0,
