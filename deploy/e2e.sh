@@ -3,23 +3,18 @@
 # (150-199) and free loopback ports, Debian's chromium driven headless by playwright-core.
 # Installs what they need first: chromium (deploy/packages-browser.txt, only when missing) and
 # the npm packages of web/ (only when stale). Fails, never skips, when any of that is missing.
-#   deploy/e2e.sh [--bin-dir DIR] [--all] [TEST_FILE...]
-#   --all also runs the tests listed as pending below.
+#   deploy/e2e.sh [--bin-dir DIR] [TEST_FILE...]      (default: every tests/e2e/*.test.mjs)
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 bin=${TELLTALE_BIN_DIR:-$root/build/bin}
-# Every file here must pass. Pending files need shore endpoints that are not in this build yet.
-tests=(fleet.test.mjs)
-pending=(alarm.test.mjs review.test.mjs)
 files=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --bin-dir) bin=$2; shift 2 ;;
-    --all) tests+=("${pending[@]}"); shift ;;
     *) files+=("$1"); shift ;;
   esac
 done
-[ ${#files[@]} -gt 0 ] || files=("${tests[@]/#/$root/tests/e2e/}")
+[ ${#files[@]} -gt 0 ] || files=("$root"/tests/e2e/*.test.mjs)
 
 chromium=${TELLTALE_CHROMIUM:-/usr/bin/chromium}
 # Idempotent and quick when everything is there; a failure shows in the check below.

@@ -9,7 +9,10 @@ let browser;
 let page;
 
 before(async () => {
-  fleet = await startFleet({ domain: domainFor(0), boats: ['ILCA-1', 'ILCA-2', 'ILCA-3'] });
+  fleet = await startFleet({ domain: domainFor(0) });
+  await fleet.addBoat('ILCA-1', ['--group', 'ILCA7']);
+  await fleet.addBoat('ILCA-2', ['--group', 'ILCA7']);
+  await fleet.addBoat('ILCA-3', ['--group', 'ILCA6']);
   browser = await startBrowser();
   page = await browser.page();
 });
@@ -60,8 +63,14 @@ test('fleet view: sorting by heel orders the cards by |heel|', async () => {
   for (let i = 0; i < 3; i++) assert.ok(Math.abs(shown[i] - order[i]) < 15, `shown ${shown} sorted ${order}`);
   await page.selectOption('#sort', 'id');
   assert.deepEqual(await page.$$eval('.card', (cs) => cs.map((c) => c.dataset.boat)), ['ILCA-1', 'ILCA-2', 'ILCA-3']);
+  // Grouping by the boat's group (sent in its 1 Hz status).
+  await eventually(async () => (await fleet.json('/boats')).every((b) => b.group), { what: 'groups known' });
   await page.check('#group');
-  await page.waitForSelector('.group .card[data-boat="ILCA-1"]');
+  await page.waitForSelector('.group[data-group="ILCA7"] .card[data-boat="ILCA-2"]');
+  assert.deepEqual(await page.$$eval('.group', (gs) => gs.map((g) =>
+    `${g.dataset.group}:${[...g.querySelectorAll('.card')].map((c) => c.dataset.boat).join(',')}`)),
+  ['ILCA6:ILCA-3', 'ILCA7:ILCA-1,ILCA-2']);
+  await screenshots(page, 'fleet-grouped');
   await page.uncheck('#group');
 });
 
@@ -96,7 +105,7 @@ test('boat view: live heel, pitch and heading charts draw and move', async () =>
 test('review and wearable views open without errors', async () => {
   await page.evaluate(() => { location.hash = '#/review'; });
   await page.waitForSelector('[data-view="review"] .toolbar, [data-view="review"] .message', { timeout: 5000 });
-  await screenshots(page, 'review-empty');
+  await screenshots(page, 'review-latest');
   await page.evaluate(() => { location.hash = '#/wearables'; });
   await page.waitForSelector('[data-view="wearables"] .empty, [data-view="wearables"] .message, [data-view="wearables"] .card',
     { timeout: 5000 });
