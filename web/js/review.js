@@ -141,7 +141,10 @@ function render(body, uPlot, main, vs) {
       cursor: { sync: { key: sync.key, setSeries: false }, drag: { x: true, y: false } },
       series: [{ label: 'Time', value: (u, v) => (v === null ? '–' : `${fmtRel(v)} (${clock(t0 + v)} UTC)`) },
         ...seriesFor(idx, `${label} °`)],
-      axes: [{ values: (u, vals) => vals.map(fmtRel) }, { size: 50 }],
+      axes: [{ values: (u, vals) => {
+        const step = vals.length > 1 ? vals[1] - vals[0] : 1;
+        return vals.map((v) => (step < 1 ? `${v.toFixed(1)} s` : fmtRel(v)));
+      } }, { size: 50 }],
       plugins: [markersPlugin(() => markers)],
       hooks: {
         setCursor: [(u) => {
@@ -245,7 +248,7 @@ function histogram(list) {
     return [svg('line', { class: 'tick', x1: x, y1: H, x2: x, y2: H + 4 }),
       svg('text', { x, y: H + 16, 'text-anchor': 'middle' }, document.createTextNode(`${d}°`))];
   }).flat();
-  return svg('svg', { class: 'histogram', viewBox: `0 0 ${W} ${H + 20}`, role: 'img',
+  return svg('svg', { class: 'histogram', viewBox: `-16 0 ${W + 32} ${H + 20}`, role: 'img',
     'aria-label': 'heel distribution, port to starboard' }, svg('line', { class: 'axis', x1: 0, y1: H, x2: W, y2: H }), ...bars, ...ticks);
 }
 
@@ -268,7 +271,8 @@ function bandsTable(list, name) {
     all.map((bands) => {
       const total = bands.reduce((a, x) => a + x.seconds, 0) || 1;
       const x = bands[i] ?? { seconds: 0 };
-      return el('td', { text: `${duration(x.seconds)} (${((x.seconds / total) * 100).toFixed(0)} %)` });
+      const time = x.seconds < 60 ? `${x.seconds.toFixed(1)} s` : duration(x.seconds);
+      return el('td', { text: `${time} (${((x.seconds / total) * 100).toFixed(0)} %)` });
     })));
   return el('div', { class: 'table-wrap' }, el('table', { class: 'bands' },
     el('thead', {}, el('tr', {}, el('th', { text: 'Heel band' }), list.map((d) => el('th', { text: name(d) })))),
