@@ -116,12 +116,13 @@ function render(body, uPlot, main, vs) {
   const scrub = el('input', { type: 'range', id: 'scrubber', min: 0, max: Math.ceil(m.duration_s), step: 0.1, value: 0,
     'aria-label': 'time scrubber' });
   const readout = el('output', { class: 'scrub-readout', for: 'scrubber' });
-  body.append(
+  body.append(...[
     summary(main, COLORS[0]), vs ? summary(vs, COLORS[1]) : null,
     vs ? el('p', { class: 'hint', text: overlap ? 'Overlay aligned on clock time.' : 'Overlay aligned on session start.' }) : null,
     chartsBox,
     el('div', { class: 'scrub' }, el('label', { for: 'scrubber', text: 'Time' }), scrub, readout,
-      el('button', { type: 'button', id: 'reset-zoom', text: 'Reset zoom', onclick: () => charts.forEach((u) => u.setScale('x', { min: data[0][0], max: data[0][data[0].length - 1] })) })));
+      el('button', { type: 'button', id: 'reset-zoom', text: 'Reset zoom', onclick: () => charts.forEach((u) => u.setScale('x', { min: data[0][0], max: data[0][data[0].length - 1] })) }))]
+    .filter(Boolean));
 
   const charts = [];
   const sync = uPlot.sync('review');
