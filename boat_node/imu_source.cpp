@@ -5,6 +5,7 @@
 
 #include "csv.hpp"
 #include "sim_source.hpp"
+#include "witmotion_feed.hpp"
 
 namespace telltale::boat {
 namespace {
@@ -67,10 +68,32 @@ class ReplayImuSource : public ImuSource {
   std::uint64_t in_pass_ = 0;
 };
 
+/// A WitMotion/JY901 module on a serial port; the device paces the node.
+class WitMotionImuSource : public ImuSource {
+ public:
+  WitMotionImuSource(std::string spec, const std::function<bool()>& stop)
+      : spec_(std::move(spec)), feed_(spec_), stop_(stop) {}
+  std::optional<fusion::ImuSample> next() override {
+    const auto w = feed_.next(stop_);
+    if (!w) return std::nullopt;
+    return w->imu;
+  }
+  bool real_time() const override { return false; }
+  std::string describe() const override { return "witmotion:" + spec_; }
+
+ private:
+  std::string spec_;
+  WitMotionFeed feed_;
+  std::function<bool()> stop_;
+};
+
 }  // namespace
 
 std::unique_ptr<ImuSource> make_imu_source(const std::string& spec, std::uint64_t seed,
-                                           double sim_rate_hz, const ReplayOptions& replay) {
+                                           double sim_rate_hz, const ReplayOptions& replay,
+                                           const std::function<bool()>& stop) {
+  if (spec.rfind("witmotion:", 0) == 0 && spec.size() > 10)
+    return std::make_unique<WitMotionImuSource>(spec.substr(10), stop);
   if (spec == "sim") return std::make_unique<SimImuSource>(seed, sim_rate_hz);
   if (spec.rfind("replay:", 0) == 0 && spec.size() > 7)
     return std::make_unique<ReplayImuSource>(spec.substr(7), replay);

@@ -4,6 +4,7 @@
 /// node paces itself on `t_s` when the source is real time.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -28,9 +29,11 @@ struct ReplayOptions {
   bool loop = false;  ///< start again at the end (time keeps increasing)
 };
 
-/// "sim", "sim:SCENARIO" or "replay:FILE.csv". Throws std::invalid_argument for an unknown
-/// source, io::CsvError for an unreadable replay file.
+/// "sim", "replay:FILE.csv" or "witmotion:DEVICE[@BAUD]". Throws std::invalid_argument for an
+/// unknown source, io::CsvError for an unreadable replay file, std::system_error for a device.
+/// `stop` ends a wait for a device.
 std::unique_ptr<ImuSource> make_imu_source(const std::string& spec, std::uint64_t seed,
-                                           double sim_rate_hz, const ReplayOptions& replay);
+                                           double sim_rate_hz, const ReplayOptions& replay,
+                                           const std::function<bool()>& stop);
 
 }  // namespace telltale::boat

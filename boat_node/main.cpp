@@ -135,7 +135,8 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
     throw std::invalid_argument("--calibrate-s needs --mount-file to store the offsets");
 
   const std::uint64_t seed = o.seed ? o.seed : std::hash<std::string>{}(o.boat_id);
-  auto source = telltale::boat::make_imu_source(o.source, seed, o.imu_rate_hz, o.replay);
+  auto source = telltale::boat::make_imu_source(o.source, seed, o.imu_rate_hz, o.replay,
+                                                [&] { return shutdown.stop_requested(); });
   std::unique_ptr<telltale::boat::HeadingInput> heading;
   if (!o.headings.empty())
     heading = std::make_unique<telltale::boat::HeadingInput>(o.headings, o.variation_deg);
@@ -374,7 +375,8 @@ int main(int argc, char** argv) {
   app.add_option("--boat-id", o.boat_id, "fleet-unique boat id, 1-32 of [A-Za-z0-9_-]")
       ->required();
   app.add_option("--group", o.group, "fleet group or class (alarm rules can target it)");
-  app.add_option("--source", o.source, "IMU: sim | replay:FILE.csv")->capture_default_str();
+  app.add_option("--source", o.source, "IMU: sim | replay:FILE.csv | witmotion:DEVICE[@BAUD]")
+      ->capture_default_str();
   app.add_option("--heading", o.headings,
                  "heading sensor, repeatable: nmea:DEVICE[@BAUD] | nmea:udp:[ADDR:]PORT");
   app.add_option("--variation-deg", o.variation_deg,

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The demo: a shore server, four simulated boats on a private DDS domain (loopback only) and the
-# dashboard. Prints the dashboard link with its token; Ctrl-C stops everything cleanly.
+# The demo: a shore server, four simulated boats and a wearable on a private DDS domain (loopback
+# only) and the dashboard. Prints the dashboard link with its token; Ctrl-C stops everything cleanly.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 echo "building (log: $root/build/build.log)..."
@@ -29,11 +29,14 @@ pids+=($!)
 for _ in $(seq 100); do grep -q "ready" "$log/shore" && break; sleep 0.1; done
 grep -q "ready" "$log/shore" || { cat "$log/shore"; exit 1; }
 for boat in ILCA-1 ILCA-2 ILCA-3 ILCA-4; do
-  "$bin/boat_node" --boat-id "$boat" >"$log/$boat" 2>&1 &
+  "$bin/boat_node" --boat-id "$boat" --group ILCA7 --log-dir "$root/build/demo_boat_log" \
+    >"$log/$boat" 2>&1 &
   pids+=($!)
 done
+"$bin/wearable_node" --athlete-id athlete-1 --source sim >"$log/athlete-1" 2>&1 &
+pids+=($!)
 url=$(grep -o 'http://[^ ]*' "$log/shore")
-echo "Telltale demo on DDS domain $TELLTALE_DOMAIN: shore + 4 boats"
+echo "Telltale demo on DDS domain $TELLTALE_DOMAIN: shore + 4 boats + 1 wearable"
 echo "Dashboard: ${url}#token=${token}"
 echo "Coach token: ${token}   (curl -H 'Authorization: Bearer ${token}' ${url}api/v1/boats)"
 echo "Ctrl-C to stop."

@@ -87,4 +87,41 @@ std::optional<BoatView> FleetModel::boat(const std::string& boat_id) const {
   return it->second;
 }
 
+AthleteView FleetModel::update(const WearableSample& sample, SteadyTime arrival) {
+  std::lock_guard lock(mutex_);
+  AthleteView& a = athletes_[sample.athlete_id];
+  a.last = sample;
+  a.last_arrival = arrival;
+  a.stale = false;
+  return a;
+}
+
+std::vector<AthleteView> FleetModel::sweep_athletes(SteadyTime now) {
+  std::vector<AthleteView> out;
+  std::lock_guard lock(mutex_);
+  for (auto& entry : athletes_) {
+    AthleteView& a = entry.second;
+    // Wearables publish at a few Hz: stale after twice the boats' limit.
+    if (!a.stale && now - a.last_arrival > 2 * stale_after_) {
+      a.stale = true;
+      out.push_back(a);
+    }
+  }
+  return out;
+}
+
+std::vector<AthleteView> FleetModel::athletes() const {
+  std::lock_guard lock(mutex_);
+  std::vector<AthleteView> out;
+  for (const auto& [id, a] : athletes_) out.push_back(a);
+  return out;
+}
+
+std::optional<AthleteView> FleetModel::athlete(const std::string& athlete_id) const {
+  std::lock_guard lock(mutex_);
+  auto it = athletes_.find(athlete_id);
+  if (it == athletes_.end()) return std::nullopt;
+  return it->second;
+}
+
 }  // namespace telltale::shore

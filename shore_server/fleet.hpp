@@ -73,6 +73,27 @@ struct BoatView {
   SteadyTime window_start{};
 };
 
+/// One athlete's latest wearable motion, in wire units.
+struct WearableSample {
+  std::string athlete_id;
+  std::uint64_t seq = 0;
+  std::uint64_t t_utc_ns = 0;
+  std::uint32_t steps = 0;
+  double cadence_spm = 0.0;
+  std::string gait;  ///< "still", "slow_walk", "walk", "fast_walk", "jog", "run", "unknown"
+  std::string pose;  ///< "hand_held", "phone_call", "pocket", "arm_swing", "foot", "unknown"
+  double x_m = 0.0;  ///< east of the start
+  double y_m = 0.0;  ///< north of the start
+  double heading_deg = 0.0;
+  double distance_m = 0.0;
+};
+
+struct AthleteView {
+  WearableSample last;
+  SteadyTime last_arrival{};
+  bool stale = false;
+};
+
 /// A boat whose clock is off by more than this is flagged (clock_suspect in the API).
 inline constexpr double kClockSuspectMs = 100.0;
 
@@ -95,7 +116,14 @@ class FleetModel {
   [[nodiscard]] std::vector<BoatView> boats() const;
   [[nodiscard]] std::optional<BoatView> boat(const std::string& boat_id) const;
 
+  AthleteView update(const WearableSample& sample, SteadyTime arrival);
+  /// Athletes silent for longer than stale_after that just went stale.
+  std::vector<AthleteView> sweep_athletes(SteadyTime now);
+  [[nodiscard]] std::vector<AthleteView> athletes() const;
+  [[nodiscard]] std::optional<AthleteView> athlete(const std::string& athlete_id) const;
+
  private:
+  std::map<std::string, AthleteView> athletes_;
   std::chrono::milliseconds stale_after_;
   mutable std::mutex mutex_;
   std::map<std::string, BoatView> boats_;

@@ -147,4 +147,22 @@ json session_object(const SessionInfo& s) {
           {"samples", s.samples}};
 }
 
+json athlete_object(const AthleteView& v) {
+  const WearableSample& w = v.last;
+  return {{"id", w.athlete_id},
+          {"kind", "wearable"},
+          {"seq", w.seq},
+          {"t_utc_ns", w.t_utc_ns},
+          {"last_sample_time", iso8601(w.t_utc_ns)},
+          {"steps", w.steps},
+          {"cadence_spm", finite_or_null(w.cadence_spm)},
+          {"gait", w.gait},
+          {"pose", w.pose},
+          {"x_m", finite_or_null(w.x_m)},
+          {"y_m", finite_or_null(w.y_m)},
+          {"heading_deg", finite_or_null(w.heading_deg)},
+          {"distance_m", finite_or_null(w.distance_m)},
+          {"stale", v.stale}};
+}
+
 }  // namespace telltale::shore

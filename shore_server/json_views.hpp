@@ -25,5 +25,6 @@ namespace telltale::shore {
 [[nodiscard]] AlarmRule rule_from_json(const nlohmann::json& j);
 [[nodiscard]] nlohmann::json event_object(const AlarmEvent& event);
 [[nodiscard]] nlohmann::json session_object(const SessionInfo& session);
+[[nodiscard]] nlohmann::json athlete_object(const AthleteView& view);
 
 }  // namespace telltale::shore

@@ -76,6 +76,11 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
     // Old samples go to the recording only: the live view and the alarms are about now.
     store.enqueue(s);
   };
+  callbacks.on_wearable = [&](const WearableSample& w) {
+    const AthleteView view = fleet.update(w, std::chrono::steady_clock::now());
+    store.enqueue(w);
+    hub.publish_event("wearable", athlete_object(view).dump(), w.athlete_id);
+  };
   callbacks.on_status = [&](const std::string& id, const NodeStatusInfo& st) {
     fleet.update_status(id, st);
   };
@@ -99,6 +104,8 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
   while (!shutdown.wait_for(std::chrono::milliseconds(200))) {
     for (const auto& v : fleet.sweep(std::chrono::steady_clock::now()))
       hub.publish_sample(v.last.boat_id, boat_json(v));
+    for (const auto& a : fleet.sweep_athletes(std::chrono::steady_clock::now()))
+      hub.publish_event("wearable", athlete_object(a).dump(), a.last.athlete_id);
     if (++tick % 5 == 0)
       for (const auto& a : store.acks()) dds.publish_ack(a.boat_id, a.boot_id, a.acked_seq);
   }

@@ -306,6 +306,38 @@ void register_rest_routes(httplib::Server& server, ShoreContext& ctx) {
     res.set_content(j.dump(), "application/json");
   });
 
+  server.Get("/api/v1/athletes", [&ctx](const httplib::Request& req, httplib::Response& res) {
+    const Principal p = who(ctx, req);
+    if (p.role == Role::kAthlete) throw HttpError(403, "an athlete sees only their own boat");
+    allow_params(req, {});
+    json arr = json::array();
+    for (const auto& a : ctx.fleet.athletes()) arr.push_back(athlete_object(a));
+    res.set_content(arr.dump(), "application/json");
+  });
+
+  server.Get(R"(/api/v1/athletes/([^/]+)/track)", [&ctx](const httplib::Request& req,
+                                                          httplib::Response& res) {
+    const Principal p = who(ctx, req);
+    if (p.role == Role::kAthlete) throw HttpError(403, "an athlete sees only their own boat");
+    allow_params(req, {"from", "to"});
+    const std::string id = path_id(req, "athlete");
+    const TimeRange range = parse_range(param(req, "from"), param(req, "to"));
+    if (!ctx.fleet.athlete(id)) {
+      if (ctx.store.wearable_track(id, 0, UINT64_MAX, 1).empty())
+        throw HttpError(404, "unknown athlete '" + id + "'");
+    }
+    json t = json::array(), x = json::array(), y = json::array(), steps = json::array();
+    for (const auto& w : ctx.store.wearable_track(id, range.from_ns, range.to_ns, 200000)) {
+      t.push_back(static_cast<double>(w.t_utc_ns) * 1e-9);
+      x.push_back(finite_or_null(w.x_m));
+      y.push_back(finite_or_null(w.y_m));
+      steps.push_back(w.steps);
+    }
+    res.set_content(json{{"athlete_id", id}, {"t_s", t}, {"x_m", x}, {"y_m", y}, {"steps", steps}}
+                        .dump(),
+                    "application/json");
+  });
+
   server.Get("/api/v1/sessions", [&ctx](const httplib::Request& req, httplib::Response& res) {
     const Principal p = who(ctx, req);
     allow_params(req, {"boat", "from", "to"});

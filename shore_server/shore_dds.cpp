@@ -46,6 +46,44 @@ const char* kind_name(msg::NodeKind kind) {
   return "unknown";
 }
 
+const char* gait_name(msg::Gait g) {
+  switch (g) {
+    case msg::GAIT_STILL:
+      return "still";
+    case msg::GAIT_SLOW_WALK:
+      return "slow_walk";
+    case msg::GAIT_WALK:
+      return "walk";
+    case msg::GAIT_FAST_WALK:
+      return "fast_walk";
+    case msg::GAIT_JOG:
+      return "jog";
+    case msg::GAIT_RUN:
+      return "run";
+    case msg::GAIT_UNKNOWN:
+      break;
+  }
+  return "unknown";
+}
+
+const char* pose_name(msg::Pose p) {
+  switch (p) {
+    case msg::POSE_HAND_HELD:
+      return "hand_held";
+    case msg::POSE_PHONE_CALL:
+      return "phone_call";
+    case msg::POSE_POCKET:
+      return "pocket";
+    case msg::POSE_ARM_SWING:
+      return "arm_swing";
+    case msg::POSE_FOOT:
+      return "foot";
+    case msg::POSE_UNKNOWN:
+      break;
+  }
+  return "unknown";
+}
+
 }  // namespace
 
 class ShoreDds::Listener : public fdds::DataReaderListener {
@@ -62,6 +100,24 @@ class ShoreDds::Listener : public fdds::DataReaderListener {
       msg::BoatAttitude m;
       while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
         if (info.valid_data && sink) sink(from_wire(m));
+      }
+    } else if (topic == dds::kTopicWearableMotion) {
+      msg::WearableMotion m;
+      while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
+        if (!info.valid_data || !cb_.on_wearable) continue;
+        WearableSample w;
+        w.athlete_id = m.athlete_id().to_string();
+        w.seq = m.seq();
+        w.t_utc_ns = m.t_utc_ns();
+        w.steps = m.steps();
+        w.cadence_spm = m.cadence_spm();
+        w.gait = gait_name(m.gait());
+        w.pose = pose_name(m.pose());
+        w.x_m = m.x_m();
+        w.y_m = m.y_m();
+        w.heading_deg = m.heading_deg();
+        w.distance_m = m.distance_m();
+        cb_.on_wearable(w);
       }
     } else if (topic == dds::kTopicNodeStatus) {
       msg::NodeStatus m;
@@ -106,6 +162,9 @@ ShoreDds::ShoreDds(const dds::DdsOptions& options, FleetCallbacks callbacks)
   participant_->reader(participant_->topic(dds::kTopicBoatBackfill,
                                            fdds::TypeSupport(new msg::BoatAttitudePubSubType())),
                        "backfill_reader", listener_.get());
+  participant_->reader(participant_->topic(dds::kTopicWearableMotion,
+                                           fdds::TypeSupport(new msg::WearableMotionPubSubType())),
+                       "wearable_reader", listener_.get());
   participant_->reader(
       participant_->topic(dds::kTopicNodeStatus, fdds::TypeSupport(new msg::NodeStatusPubSubType())),
       "status_reader", listener_.get());

@@ -23,6 +23,8 @@ struct FleetCallbacks {
   /// Samples a boat resends from its session log (reliable backfill topic).
   std::function<void(const AttitudeSample&)> on_backfill;
   std::function<void(const std::string& node_id, const NodeStatusInfo&)> on_status;
+  /// An athlete's wearable motion.
+  std::function<void(const WearableSample&)> on_wearable;
   /// A boat missed its DDS deadline (no sample within the deadline period).
   std::function<void(const std::string& boat_id)> on_deadline_missed;
 };

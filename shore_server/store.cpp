@@ -25,6 +25,20 @@ CREATE TABLE IF NOT EXISTS attitude (
   boot_id INTEGER NOT NULL DEFAULT 0,
   PRIMARY KEY (boat_id, t_utc_ns)
 ) WITHOUT ROWID;
+CREATE TABLE IF NOT EXISTS wearable (
+  athlete_id TEXT NOT NULL,
+  t_utc_ns INTEGER NOT NULL,
+  seq INTEGER NOT NULL,
+  steps INTEGER NOT NULL,
+  cadence_spm REAL,
+  gait TEXT NOT NULL,
+  pose TEXT NOT NULL,
+  x_m REAL,
+  y_m REAL,
+  heading_deg REAL,
+  distance_m REAL,
+  PRIMARY KEY (athlete_id, t_utc_ns)
+) WITHOUT ROWID;
 CREATE TABLE IF NOT EXISTS sessions (
   id INTEGER PRIMARY KEY AUTOINCREMENT,
   boat_id TEXT NOT NULL,
@@ -223,6 +237,60 @@ void Store::enqueue(const AttitudeSample& sample) {
   ++enqueued_;
 }
 
+void Store::enqueue(const WearableSample& sample) {
+  std::lock_guard lock(mutex_);
+  wearable_queue_.push_back(sample);
+}
+
+void Store::commit_wearable(const std::vector<WearableSample>& batch) {
+  std::lock_guard db_lock(db_mutex_);
+  try {
+    exec(db_, "BEGIN");
+    Stmt ins(db_, "INSERT OR IGNORE INTO wearable (athlete_id, t_utc_ns, seq, steps, cadence_spm, "
+                  "gait, pose, x_m, y_m, heading_deg, distance_m) VALUES (?,?,?,?,?,?,?,?,?,?,?)");
+    for (const auto& w : batch) {
+      ins.reset();
+      ins.bind(1, w.athlete_id).bind_u(2, w.t_utc_ns).bind_u(3, w.seq);
+      ins.bind(4, static_cast<std::int64_t>(w.steps)).bind(5, w.cadence_spm).bind(6, w.gait);
+      ins.bind(7, w.pose).bind(8, w.x_m).bind(9, w.y_m).bind(10, w.heading_deg);
+      ins.bind(11, w.distance_m);
+      ins.step();
+    }
+    exec(db_, "COMMIT");
+  } catch (const StoreError& e) {
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    std::lock_guard lock(mutex_);
+    last_error_ = std::string("wearable: ") + e.what();
+  }
+}
+
+std::vector<WearableSample> Store::wearable_track(const std::string& athlete_id,
+                                                  std::uint64_t from_ns, std::uint64_t to_ns,
+                                                  std::size_t limit) {
+  std::lock_guard lock(reader_mutex_);
+  Stmt q(reader_, "SELECT t_utc_ns, seq, steps, cadence_spm, gait, pose, x_m, y_m, heading_deg, "
+                  "distance_m FROM wearable WHERE athlete_id = ? AND t_utc_ns >= ? AND "
+                  "t_utc_ns <= ? ORDER BY t_utc_ns LIMIT ?");
+  q.bind(1, athlete_id).bind_u(2, from_ns).bind_u(3, to_ns).bind(4, static_cast<std::int64_t>(limit));
+  std::vector<WearableSample> out;
+  while (q.step()) {
+    WearableSample w;
+    w.athlete_id = athlete_id;
+    w.t_utc_ns = q.u64(0);
+    w.seq = q.u64(1);
+    w.steps = static_cast<std::uint32_t>(q.i64(2));
+    w.cadence_spm = q.dbl(3);
+    w.gait = q.text(4);
+    w.pose = q.text(5);
+    w.x_m = q.dbl(6);
+    w.y_m = q.dbl(7);
+    w.heading_deg = q.dbl(8);
+    w.distance_m = q.dbl(9);
+    out.push_back(std::move(w));
+  }
+  return out;
+}
+
 void Store::flush() {
   std::unique_lock lock(mutex_);
   const std::uint64_t target = enqueued_;
@@ -233,6 +301,7 @@ void Store::flush() {
 
 void Store::writer_loop() {
   std::vector<AttitudeSample> batch;
+  std::vector<WearableSample> wearable;
   for (;;) {
     bool stop = false;
     {
@@ -240,7 +309,10 @@ void Store::writer_loop() {
       cv_.wait_for(lock, config_.commit_interval, [this] { return stopping_; });
       stop = stopping_;
       batch.swap(queue_);
+      wearable.swap(wearable_queue_);
     }
+    if (!wearable.empty()) commit_wearable(wearable);
+    wearable.clear();
     if (!batch.empty() && commit(batch)) {
       std::lock_guard lock(mutex_);
       processed_ += batch.size();

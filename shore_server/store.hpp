@@ -87,6 +87,12 @@ class Store {
 
   /// Queues one sample for the next batch (never blocks on disk).
   void enqueue(const AttitudeSample& sample);
+  /// Queues one wearable sample (committed with the next batch).
+  void enqueue(const WearableSample& sample);
+  /// An athlete's stored track in [from_ns, to_ns], oldest first, at most `limit` samples.
+  [[nodiscard]] std::vector<WearableSample> wearable_track(const std::string& athlete_id,
+                                                           std::uint64_t from_ns,
+                                                           std::uint64_t to_ns, std::size_t limit);
   /// Waits (up to 10 s) until everything queued before the call is committed.
   void flush();
 
@@ -131,6 +137,7 @@ class Store {
   void writer_loop();
   /// Commits a batch; on failure puts it back in the queue and returns false.
   bool commit(std::vector<AttitudeSample>& batch);
+  void commit_wearable(const std::vector<WearableSample>& batch);
   void extend_session(const std::string& boat_id, std::uint64_t t_ns);
   void apply_retention();
   void track_receipt(const AttitudeSample& sample);
@@ -157,6 +164,7 @@ class Store {
   std::condition_variable cv_;
   std::condition_variable flushed_cv_;
   std::vector<AttitudeSample> queue_;
+  std::vector<WearableSample> wearable_queue_;
   std::uint64_t enqueued_ = 0;
   std::uint64_t processed_ = 0;  ///< enqueued samples the writer has dealt with
   std::uint64_t committed_ = 0;

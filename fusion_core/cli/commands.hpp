@@ -16,5 +16,8 @@ class UsageError : public std::runtime_error {
 
 void register_attitude(CLI::App& app);
 void register_heading(CLI::App& app);
+void register_steps(CLI::App& app);  // steps, pdr
+void register_gait_sim(CLI::App& app);
+void register_steps_eval(CLI::App& app);
 
 }  // namespace telltale::cli

@@ -10,6 +10,9 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   telltale::cli::register_attitude(app);
   telltale::cli::register_heading(app);
+  telltale::cli::register_steps(app);
+  telltale::cli::register_gait_sim(app);
+  telltale::cli::register_steps_eval(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -101,6 +101,32 @@ TEST_F(FleetTest, StreamDeliversSamplesAndMarksSilentBoatStale) {
   EXPECT_LT(std::chrono::steady_clock::now() - stop_time, 3500ms);
 }
 
+// A wearable node's athlete appears beside the boats with steps that grow.
+TEST_F(FleetTest, WearableAthleteAppearsAndWalks) {
+  Process walker({bin_dir() + "/wearable_node", "--domain", std::to_string(domain_),
+                  "--athlete-id", "ann"});
+  ASSERT_TRUE(walker.wait_for_line("wearable_node ready: ", 20s)) << walker.output();
+  nlohmann::json first;
+  ASSERT_TRUE(eventually(
+      [&] {
+        first = get_json("/api/v1/athletes");
+        return first.is_array() && first.size() == 1;
+      },
+      15s));
+  EXPECT_EQ(first[0]["id"], "ann");
+  EXPECT_EQ(first[0]["kind"], "wearable");
+  ASSERT_TRUE(eventually(
+      [&] {
+        const auto now = get_json("/api/v1/athletes");
+        return now.is_array() && now.size() == 1 &&
+               now[0]["steps"].get<int>() > first[0]["steps"].get<int>() + 3;
+      },
+      15s));
+  const auto track = get_json("/api/v1/athletes/ann/track");
+  EXPECT_GE(track["x_m"].size(), 4u);
+  EXPECT_EQ(walker.stop(SIGINT), 0);
+}
+
 TEST_F(FleetTest, AuthAndOpenEndpoints) {
   auto c = client();
   auto health = c.Get("/healthz");

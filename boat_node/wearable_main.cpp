@@ -1,0 +1,282 @@
+// wearable_node: an athlete's phone or foot IMU on land -> step detection and dead reckoning
+// (fusion_core PDR) -> WearableMotion over the same DDS as the boats.
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <regex>
+
+#include "csv.hpp"
+#include "dds_participant.hpp"
+#include "shutdown.hpp"
+#include "telltale/fusion/pdr.hpp"
+#include "telltale/fusion/sim/gait_sim.hpp"
+#include "telltalePubSubTypes.h"
+#include "witmotion_feed.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+namespace fusion = telltale::fusion;
+
+struct Options {
+  telltale::dds::DdsOptions dds;
+  std::string athlete_id;
+  std::string source = "sim";
+  std::string mount = "phone";
+  double height_m = 1.75;
+  double rate_hz = 2.0;
+  std::uint64_t seed = 1;
+  bool replay_fast = false;
+};
+
+struct Sample {
+  fusion::ImuSample imu;
+  Eigen::Vector3d mag_uT;
+};
+
+/// Samples from the chosen source, in time order; nothing at the end.
+class WearableSource {
+ public:
+  virtual ~WearableSource() = default;
+  virtual std::optional<Sample> next(telltale::ShutdownSignal& shutdown) = 0;
+  virtual bool real_time() const = 0;
+};
+
+/// The gait simulator, walk after walk (each with its own seed), time continuing.
+class SimWearable : public WearableSource {
+ public:
+  SimWearable(std::string scenario, std::uint64_t seed) : scenario_(std::move(scenario)), seed_(seed) {
+    if (!fusion::sim::make_gait_scenario(scenario_, seed_))
+      throw std::invalid_argument("unknown gait scenario '" + scenario_ + "'");
+  }
+  std::optional<Sample> next(telltale::ShutdownSignal&) override {
+    if (i_ >= run_.samples.size()) {
+      const auto sc = fusion::sim::make_gait_scenario(scenario_, seed_);
+      offset_s_ = run_.samples.empty() ? 0.0 : run_.samples.back().imu.t_s + offset_s_ + 0.02;
+      run_ = fusion::sim::simulate_gait(*sc, fusion::sim::random_person(seed_), seed_);
+      ++seed_;
+      i_ = 0;
+      if (run_.samples.empty()) return std::nullopt;
+    }
+    const auto& g = run_.samples[i_++];
+    Sample s{g.imu, g.mag_uT};
+    s.imu.t_s += offset_s_;
+    return s;
+  }
+  bool real_time() const override { return true; }
+
+ private:
+  std::string scenario_;
+  std::uint64_t seed_;
+  fusion::sim::GaitRun run_;
+  std::size_t i_ = 0;
+  double offset_s_ = 0.0;
+};
+
+/// An IMU CSV (SPEC section 6): gyro and magnetometer columns optional.
+class ReplayWearable : public WearableSource {
+ public:
+  ReplayWearable(const std::string& path, bool fast)
+      : reader_(path,
+                {{"t_s"}, {"ax_m_s2"}, {"ay_m_s2"}, {"az_m_s2"}, {"gx_rad_s", false, false},
+                 {"gy_rad_s", false, false}, {"gz_rad_s", false, false}, {"mx_uT", false, false},
+                 {"my_uT", false, false}, {"mz_uT", false, false}},
+                "t_s"),
+        fast_(fast) {}
+  std::optional<Sample> next(telltale::ShutdownSignal&) override {
+    if (!reader_.next(row_)) return std::nullopt;
+    Sample s;
+    s.imu.t_s = row_[0];
+    s.imu.acc_body_m_s2 = {row_[1], row_[2], row_[3]};
+    s.imu.gyro_body_rad_s = {row_[4], row_[5], row_[6]};  // NaN when absent: "no gyro"
+    s.mag_uT = {row_[7], row_[8], row_[9]};
+    return s;
+  }
+  bool real_time() const override { return !fast_; }
+
+ private:
+  telltale::io::CsvReader reader_;
+  std::vector<double> row_;
+  bool fast_;
+};
+
+/// A WitMotion/JY901 module on a serial port (the module of paper 004).
+class WitMotionWearable : public WearableSource {
+ public:
+  explicit WitMotionWearable(const std::string& device_and_baud) : feed_(device_and_baud) {}
+  std::optional<Sample> next(telltale::ShutdownSignal& shutdown) override {
+    const auto w = feed_.next([&] { return shutdown.stop_requested(); });
+    if (!w) return std::nullopt;
+    return Sample{w->imu, w->has_mag ? w->mag_uT
+                                     : Eigen::Vector3d::Constant(
+                                           std::numeric_limits<double>::quiet_NaN())};
+  }
+  bool real_time() const override { return false; }  // the device paces itself
+
+ private:
+  telltale::boat::WitMotionFeed feed_;
+};
+
+std::unique_ptr<WearableSource> make_source(const Options& o) {
+  if (o.source == "sim") return std::make_unique<SimWearable>("phone-switch", o.seed);
+  if (o.source.rfind("sim:", 0) == 0) return std::make_unique<SimWearable>(o.source.substr(4), o.seed);
+  if (o.source.rfind("replay:", 0) == 0)
+    return std::make_unique<ReplayWearable>(o.source.substr(7), o.replay_fast);
+  if (o.source.rfind("witmotion:", 0) == 0)
+    return std::make_unique<WitMotionWearable>(o.source.substr(10));
+  throw std::invalid_argument("unknown --source '" + o.source +
+                              "' (sim, sim:SCENARIO, replay:FILE.csv, witmotion:DEVICE[@BAUD])");
+}
+
+telltale::msg::Gait gait_of(const fusion::PdrOutput& p) {
+  if (p.cadence_spm <= 0.0) return telltale::msg::GAIT_STILL;
+  switch (p.gait) {
+    case 0:
+      return telltale::msg::GAIT_SLOW_WALK;
+    case 1:
+      return telltale::msg::GAIT_WALK;
+    case 2:
+      return telltale::msg::GAIT_FAST_WALK;
+    case 3:
+      return telltale::msg::GAIT_JOG;
+    case 4:
+      return telltale::msg::GAIT_RUN;
+    default:
+      return telltale::msg::GAIT_UNKNOWN;
+  }
+}
+
+telltale::msg::Pose pose_of(const fusion::PdrOutput& p, bool foot) {
+  if (foot) return telltale::msg::POSE_FOOT;
+  switch (p.pose) {
+    case fusion::PhonePose::kHandHeld:
+      return telltale::msg::POSE_HAND_HELD;
+    case fusion::PhonePose::kCall:
+      return telltale::msg::POSE_PHONE_CALL;
+    case fusion::PhonePose::kPocket:
+      return telltale::msg::POSE_POCKET;
+    case fusion::PhonePose::kArmSwing:
+      return telltale::msg::POSE_ARM_SWING;
+  }
+  return telltale::msg::POSE_UNKNOWN;
+}
+
+void run(const Options& o, telltale::ShutdownSignal& shutdown) {
+  static const std::regex kId("[A-Za-z0-9_-]{1,32}");
+  if (!std::regex_match(o.athlete_id, kId))
+    throw std::invalid_argument("athlete id must be 1-32 of [A-Za-z0-9_-]");
+  if (!(o.height_m >= 1.0 && o.height_m <= 2.5))
+    throw std::invalid_argument("--height-m must be in 1.0..2.5");
+  if (!(o.rate_hz > 0 && o.rate_hz <= 50)) throw std::invalid_argument("--rate-hz in (0, 50]");
+  if (o.mount != "phone" && o.mount != "foot")
+    throw std::invalid_argument("--mount is phone or foot");
+  const bool foot = o.mount == "foot";
+  auto source = make_source(o);
+  fusion::PdrParams params;
+  params.mount = foot ? fusion::StepMount::kFoot : fusion::StepMount::kBody;
+  params.height_m = o.height_m;
+  auto pdr = std::make_unique<fusion::Pdr>(params);  // 110 kB: not on the stack
+
+  telltale::dds::Participant participant(o.dds, "wearable_node " + o.athlete_id);
+  namespace fdds = eprosima::fastdds::dds;
+  auto* motion_writer = participant.writer(
+      participant.topic(telltale::dds::kTopicWearableMotion,
+                        fdds::TypeSupport(new telltale::msg::WearableMotionPubSubType())),
+      "wearable_writer");
+  auto* status_writer = participant.writer(
+      participant.topic(telltale::dds::kTopicNodeStatus,
+                        fdds::TypeSupport(new telltale::msg::NodeStatusPubSubType())),
+      "status_writer");
+  telltale::msg::WearableMotion m;
+  m.athlete_id(o.athlete_id);
+  telltale::msg::NodeStatus status;
+  status.node_id(o.athlete_id);
+  status.kind(telltale::msg::NODE_KIND_WEARABLE);
+  status.software_version(TELLTALE_VERSION);
+
+  std::printf("wearable_node ready: athlete=%s domain=%d source=%s\n", o.athlete_id.c_str(),
+              participant.domain(), o.source.c_str());
+  std::fflush(stdout);
+
+  const auto start = Clock::now();
+  const unsigned long long start_utc = telltale::utc_now_ns();
+  double first_t = std::numeric_limits<double>::quiet_NaN();
+  double next_publish = 0.0;
+  auto next_status = start;
+  std::uint64_t seq = 0;
+  while (!shutdown.stop_requested()) {
+    const auto s = source->next(shutdown);
+    if (!s) break;
+    if (std::isnan(first_t)) first_t = s->imu.t_s;
+    const double t = s->imu.t_s - first_t;
+    if (source->real_time()) {
+      const auto due = start + std::chrono::duration_cast<Clock::duration>(
+                                   std::chrono::duration<double>(t));
+      if (shutdown.wait_for(due - Clock::now())) break;
+    }
+    const fusion::PdrOutput& p = pdr->update(s->imu, s->mag_uT);
+    if (t >= next_publish) {
+      next_publish = t + 1.0 / o.rate_hz;
+      m.seq(++seq);
+      m.t_utc_ns(start_utc + static_cast<unsigned long long>(t * 1e9));
+      m.steps(static_cast<std::uint32_t>(p.steps));
+      m.cadence_spm(p.cadence_spm);
+      m.gait(gait_of(p));
+      m.pose(pose_of(p, foot));
+      m.x_m(p.x_m);
+      m.y_m(p.y_m);
+      m.heading_deg(p.heading_deg);
+      m.distance_m(p.distance_m);
+      motion_writer->write(&m);
+    }
+    if (Clock::now() >= next_status) {
+      next_status += std::chrono::seconds(1);
+      const auto& d = pdr->diagnostics();
+      status.t_utc_ns(telltale::utc_now_ns());
+      status.uptime_s(std::chrono::duration<double>(Clock::now() - start).count());
+      status.samples_published(seq);
+      status.sensor_health(d.rejected_non_finite ? telltale::msg::SENSOR_NON_FINITE
+                                                 : telltale::msg::SENSOR_OK);
+      status.health_text(d.rejected_non_finite ? "non-finite samples rejected" : "ok");
+      status_writer->write(&status);
+    }
+  }
+  std::printf("wearable_node stopped: athlete=%s published=%llu\n", o.athlete_id.c_str(),
+              static_cast<unsigned long long>(seq));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  telltale::ShutdownSignal shutdown;
+  Options o;
+  int domain = -1;
+  CLI::App app{"Telltale wearable node: phone/foot IMU -> steps and dead reckoning -> DDS"};
+  app.set_config("--config", "", "read options from this file (INI/TOML: key = value)");
+  app.add_option("--domain", domain, "DDS domain id (default: $TELLTALE_DOMAIN)");
+  app.add_option("--athlete-id", o.athlete_id, "athlete id, 1-32 of [A-Za-z0-9_-]")->required();
+  app.add_option("--source", o.source,
+                 "sim | sim:SCENARIO | replay:FILE.csv | witmotion:DEVICE[@BAUD]")
+      ->capture_default_str();
+  app.add_option("--mount", o.mount, "phone (carried) or foot (toe-mounted module)")
+      ->capture_default_str();
+  app.add_option("--height-m", o.height_m, "athlete's height (step length model)")
+      ->capture_default_str();
+  app.add_option("--rate-hz", o.rate_hz, "publish rate")->capture_default_str();
+  app.add_option("--seed", o.seed, "simulator seed")->capture_default_str();
+  app.add_flag("--replay-fast", o.replay_fast, "replay as fast as possible");
+  app.add_option("--dds-profiles", o.dds.profiles_file, "Fast DDS profiles XML");
+  app.add_option("--dds-participant", o.dds.participant_profile, "participant profile")
+      ->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  if (domain >= 0) o.dds.domain = domain;
+  try {
+    run(o, shutdown);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "wearable_node: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

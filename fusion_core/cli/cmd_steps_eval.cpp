@@ -1,0 +1,222 @@
+// fusion_cli steps-eval: the accuracy tables of issue 5 (simulated gaits x methods, Oxford phone
+// traces, pose classification on held-out people, PDR closed loops).
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "gait_io.hpp"
+#include "telltale/fusion/sim/gait_sim.hpp"
+#include "telltale/fusion/sim/pose_dataset.hpp"
+#include "telltale/fusion/steps.hpp"
+
+namespace telltale::cli {
+namespace {
+
+namespace sim = fusion::sim;
+
+struct EvalOptions {
+  int people = 10;
+  std::string oxford_dir;
+  std::string tables = "gait,oxford,pose,pdr";
+  int loops = 40;
+};
+
+double count_accuracy(std::size_t counted, std::size_t truth) {
+  if (truth == 0) return counted == 0 ? 1.0 : 0.0;
+  return 1.0 - std::abs(static_cast<double>(counted) - static_cast<double>(truth)) /
+                   static_cast<double>(truth);
+}
+
+std::size_t count_steps(fusion::StepDetector& d, const std::vector<fusion::ImuSample>& samples) {
+  d.reset();
+  std::size_t n = 0;
+  fusion::StepEvent ev;
+  for (const auto& s : samples) n += d.update(s, ev) ? 1u : 0u;
+  return n;
+}
+
+void progress(const char* what, int i, int n) {
+  if (isatty(2)) std::fprintf(stderr, "\r%s %d/%d", what, i, n);
+  if (isatty(2) && i == n) std::fprintf(stderr, "\n");
+}
+
+void gait_table(const EvalOptions& o) {
+  const auto names = fusion::step_detector_names();
+  for (const std::string site : {"foot", "body"}) {
+    const auto mount = site == "foot" ? fusion::StepMount::kFoot : fusion::StepMount::kBody;
+    std::printf(
+        "\n## Step count accuracy, %s-mounted sensor, %d simulated people "
+        "(mean / worst person, %%)\n\n| gait |",
+        site.c_str(), o.people);
+    for (auto n : names) std::printf(" %.*s |", static_cast<int>(n.size()), n.data());
+    std::printf("\n|---|");
+    for (std::size_t i = 0; i < names.size(); ++i) std::printf("---|");
+    std::printf("\n");
+    std::vector<std::string> gaits;
+    for (int g = 0; g < sim::kGaitCount; ++g)
+      gaits.emplace_back(sim::gait_name(static_cast<sim::Gait>(g)));
+    gaits.emplace_back("mixed");
+    for (const auto& g : gaits) {
+      std::vector<double> sum(names.size(), 0.0), worst(names.size(), 1.0);
+      for (int p = 0; p < o.people; ++p) {
+        const auto seed = static_cast<std::uint64_t>(p + 1);
+        const auto sc = sim::make_gait_scenario(site + "-" + g, seed);
+        const auto run = sim::simulate_gait(*sc, sim::random_person(seed), seed);
+        std::vector<fusion::ImuSample> samples;
+        for (const auto& s : run.samples) samples.push_back(s.imu);
+        const std::size_t truth =
+            site == "foot" ? run.foot_step_times_s.size() : run.step_times_s.size();
+        for (std::size_t m = 0; m < names.size(); ++m) {
+          auto d = fusion::make_step_detector(names[m], mount);
+          const double acc = count_accuracy(count_steps(*d, samples), truth);
+          sum[m] += acc;
+          worst[m] = std::min(worst[m], acc);
+        }
+      }
+      std::printf("| %s |", g.c_str());
+      for (std::size_t m = 0; m < names.size(); ++m)
+        std::printf(" %.1f / %.1f |", 100.0 * sum[m] / o.people, 100.0 * worst[m]);
+      std::printf("\n");
+      std::fflush(stdout);
+    }
+  }
+}
+
+std::string find_oxford(const std::string& given) {
+  if (!given.empty()) return given;
+  for (const char* d :
+       {"../shared/data/oxford_steps", "/work/shared/data/oxford_steps", "tests/data/oxford_steps"})
+    if (std::filesystem::exists(std::string(d) + "/counts.csv")) return d;
+  throw UsageError("no Oxford traces found: give --oxford DIR");
+}
+
+void oxford_table(const EvalOptions& o) {
+  const std::string dir = find_oxford(o.oxford_dir);
+  std::ifstream counts(dir + "/counts.csv");
+  std::string line;
+  std::getline(counts, line);  // header: trace,position,steps
+  std::vector<std::pair<std::string, int>> traces;
+  while (std::getline(counts, line)) {
+    const auto c1 = line.find(','), c2 = line.rfind(',');
+    if (c1 == std::string::npos || c2 == c1) continue;
+    traces.emplace_back(line.substr(0, c1), std::stoi(line.substr(c2 + 1)));
+  }
+  const auto names = fusion::step_detector_names();
+  std::printf("\n## Oxford phone traces (%s): count accuracy per trace, %%\n\n| trace | true |",
+              dir.c_str());
+  for (auto n : names) std::printf(" %.*s |", static_cast<int>(n.size()), n.data());
+  std::printf("\n|---|---|");
+  for (std::size_t i = 0; i < names.size(); ++i) std::printf("---|");
+  std::printf("\n");
+  std::vector<double> sum(names.size(), 0.0);
+  int i = 0;
+  for (const auto& [trace, truth] : traces) {
+    progress("oxford", ++i, static_cast<int>(traces.size()));
+    std::string path = dir + "/" + trace + ".imu.csv";
+    if (!std::filesystem::exists(path)) path += ".gz";
+    const auto records = read_imu_csv(path, false);
+    std::vector<fusion::ImuSample> samples;
+    for (const auto& r : records) samples.push_back(r.imu);
+    std::printf("| %s | %d |", trace.c_str(), truth);
+    for (std::size_t m = 0; m < names.size(); ++m) {
+      auto d = fusion::make_step_detector(names[m], fusion::StepMount::kBody);
+      const std::size_t n = count_steps(*d, samples);
+      const double acc = count_accuracy(n, static_cast<std::size_t>(truth));
+      sum[m] += acc;
+      std::printf(" %zu (%.1f) |", n, 100.0 * acc);
+    }
+    std::printf("\n");
+  }
+  std::printf("| **mean** | |");
+  for (std::size_t m = 0; m < names.size(); ++m)
+    std::printf(" **%.2f** |", 100.0 * sum[m] / static_cast<double>(traces.size()));
+  std::printf("\n");
+}
+
+void pose_table() {
+  const auto set = sim::simulate_pose_windows(1001, 10, 20);
+  const auto& net = fusion::builtin_pose_network();
+  int confusion[fusion::kPoseCount][fusion::kPoseCount] = {};
+  std::size_t ok = 0;
+  for (std::size_t i = 0; i < set.features.size(); ++i) {
+    const auto got = net.classify(set.features[i]);
+    const int want = static_cast<int>(set.labels[i]);
+    const int g = got ? static_cast<int>(*got) : 0;
+    ++confusion[want][g];
+    ok += (got && *got == set.labels[i]) ? 1u : 0u;
+  }
+  std::printf(
+      "\n## Pose classification (BP 3-8-4, shipped weights), 10 held-out simulated people, "
+      "%zu windows: accuracy %.2f %%\n\n| true \\ classified | hand-held | call | pocket "
+      "| arm-swing |\n|---|---|---|---|---|\n",
+      set.features.size(),
+      100.0 * static_cast<double>(ok) / static_cast<double>(set.features.size()));
+  for (int t = 0; t < fusion::kPoseCount; ++t) {
+    const auto name = sim::pose_name(static_cast<fusion::PhonePose>(t));
+    std::printf("| %.*s |", static_cast<int>(name.size()), name.data());
+    for (int c = 0; c < fusion::kPoseCount; ++c) std::printf(" %d |", confusion[t][c]);
+    std::printf("\n");
+  }
+}
+
+void pdr_table(int loops) {
+  std::printf(
+      "\n## PDR closed loops (%d walks, people held out of training): end-point error / "
+      "distance\n\n| variant | median %% | 90th pct %% | walks <= 2 %% | steps counted / true |"
+      "\n|---|---|---|---|---|\n",
+      loops);
+  const std::pair<sim::LoopVariant, const char*> variants[] = {
+      {sim::LoopVariant::kAsSimulated, "pose switches, full sensor errors"},
+      {sim::LoopVariant::kSinglePose, "one pose, full sensor errors"},
+      {sim::LoopVariant::kIdealSensors, "pose switches, no biases/misalignment"}};
+  for (const auto& [variant, name] : variants) {
+    std::vector<double> err;
+    std::size_t counted = 0, truth = 0;
+    for (int i = 0; i < loops; ++i) {
+      progress("loops", i + 1, loops);
+      const auto r = sim::simulate_pdr_loop(static_cast<std::uint64_t>(2001 + i), variant);
+      err.push_back(100.0 * r.error_fraction);
+      counted += r.steps_counted;
+      truth += r.steps_true;
+    }
+    std::sort(err.begin(), err.end());
+    const auto within = std::count_if(err.begin(), err.end(), [](double e) { return e <= 2.0; });
+    std::printf("| %s | %.2f | %.2f | %ld / %d (%.0f %%) | %zu / %zu |\n", name,
+                err[err.size() / 2], err[(err.size() * 9) / 10 - 1], static_cast<long>(within),
+                loops, 100.0 * static_cast<double>(within) / loops, counted, truth);
+    std::fflush(stdout);
+  }
+}
+
+void run_eval(const EvalOptions& o) {
+  if (o.tables.find("gait") != std::string::npos) gait_table(o);
+  if (o.tables.find("oxford") != std::string::npos) oxford_table(o);
+  if (o.tables.find("pose") != std::string::npos) pose_table();
+  if (o.tables.find("pdr") != std::string::npos) pdr_table(o.loops);
+}
+
+}  // namespace
+
+void register_steps_eval(CLI::App& app) {
+  auto opts = std::make_shared<EvalOptions>();
+  auto* cmd = app.add_subcommand("steps-eval",
+                                 "Accuracy tables: gaits x step methods, Oxford "
+                                 "traces, pose classifier, PDR closed loops");
+  cmd->add_option("--people", opts->people, "simulated people per gait")->capture_default_str();
+  cmd->add_option("--oxford", opts->oxford_dir,
+                  "Oxford step traces (default: ../shared/data/oxford_steps, then "
+                  "tests/data/oxford_steps)");
+  cmd->add_option("--loops", opts->loops, "simulated closed-loop PDR walks")->capture_default_str();
+  cmd->add_option("--tables", opts->tables, "comma list: gait, oxford, pose, pdr")
+      ->capture_default_str();
+  cmd->callback([opts] { run_eval(*opts); });
+}
+
+}  // namespace telltale::cli

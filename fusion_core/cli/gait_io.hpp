@@ -1,0 +1,37 @@
+#pragma once
+/// \file
+/// IMU CSV reading and gait-simulator CSV writing shared by the steps, pdr, gait-sim and
+/// steps-eval subcommands (SPEC section 6 column names).
+
+#include <CLI/CLI.hpp>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "telltale/fusion/imu_sample.hpp"
+#include "telltale/fusion/sim/gait_sim.hpp"
+
+namespace telltale::cli {
+
+void register_pdr(CLI::App& app);  // registered by register_steps (cmd_pdr.cpp)
+
+/// One row of an IMU CSV: gyro NaN when the file has no gyro columns, mag NaN without mag.
+struct ImuRecord {
+  fusion::ImuSample imu;
+  Eigen::Vector3d mag_uT = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+};
+
+/// Reads `t_s,ax_m_s2,ay_m_s2,az_m_s2` (required), `gx_rad_s,gy_rad_s,gz_rad_s` (required when
+/// `require_gyro`), `mx_uT,my_uT,mz_uT` (optional). Throws io::CsvError on bad input.
+[[nodiscard]] std::vector<ImuRecord> read_imu_csv(const std::string& path, bool require_gyro,
+                                                  bool* has_gyro = nullptr,
+                                                  bool* has_mag = nullptr);
+
+/// Writes the IMU CSV (t_s, gyro, acc, mag) and, if `truth_path` is not empty, the truth CSV:
+/// t_s,x_m,y_m,heading_deg,distance_m,gait,pose,switching,steps,foot_steps,step_hz,step_length_m
+/// (gait and pose as indexes: gait 0..4 = slow-walk..run, pose 0..3 = hand-held, call, pocket,
+/// arm-swing).
+void write_gait_run(const fusion::sim::GaitRun& run, const std::string& imu_path,
+                    const std::string& truth_path);
+
+}  // namespace telltale::cli

@@ -1,0 +1,299 @@
+#pragma once
+/// \file
+/// Pedestrian dead reckoning with a phone carried in four poses (seed 003, SPEC section 5), or
+/// with a foot-mounted IMU (seed 004).
+///
+/// Pipeline per sample (Pdr::update): step detection (peak-valley of seed 003 for the phone, the
+/// adaptive detector of seed 004 for the foot) -> pose features over a sliding window -> BP pose
+/// classifier (3 inputs, 4 outputs) at every step -> heading of the walking direction from gyro +
+/// magnetometer (a two-state Kalman filter, seed 004 Fig. 2) in the walking frame given by the pose
+/// rotation matrices of seed 003 (eqs. (14)-(15)) -> pose-switch detection by cross-correlation of
+/// consecutive step waveforms, with the mean heading of the 3 straight steps before the switch used
+/// during it -> step length L = a h + b f + c per pose (eq. (13)) -> position (eq. (11)).
+///
+/// Frames: the phone's sensor axes are whatever the phone has; the walking frame is x forward, y
+/// left, z up with `v_walking = M_pose v_sensor` (M = I for hand-held and arm swing). Position is
+/// x east, y north (m) from the start; heading clockwise from north.
+///
+/// Memory: fixed-size buffers and Eigen fixed-size types, no heap in update().
+
+#include <array>
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "telltale/fusion/imu_sample.hpp"
+#include "telltale/fusion/phone_pose.hpp"
+#include "telltale/fusion/steps.hpp"
+
+namespace telltale::fusion {
+
+// ---------------------------------------------------------------------------------------------
+/// The three features seed 003 kept after PCA (Table 1), over a sliding time window:
+/// acceleration energy = total (3-axis) variance of the specific force, m^2/s^4;
+/// acceleration variance = variance of |f|, m^2/s^4; gyro variance = total (3-axis) variance of
+/// the angular rate, rad^2/s^2 (NaN when the samples carry no gyro).
+struct PoseFeatures {
+  double acc_energy = 0.0;
+  double acc_variance = 0.0;
+  double gyro_variance = 0.0;
+};
+
+class PoseFeatureWindow {
+ public:
+  static constexpr std::size_t kCapacity = 1024;
+  explicit PoseFeatureWindow(double window_s = 2.0) : window_s_(window_s) {}
+  /// Adds one sample (t strictly increasing, finite acc; gyro may be NaN).
+  void push(const ImuSample& s);
+  [[nodiscard]] PoseFeatures features() const;
+  /// Mean specific force over the window (sensor frame): the gravity direction, m/s^2.
+  [[nodiscard]] Eigen::Vector3d mean_acc() const;
+  [[nodiscard]] std::size_t size() const { return size_; }
+  [[nodiscard]] double span_s() const;
+
+ private:
+  void pop();
+  double window_s_;
+  std::array<ImuSample, kCapacity> buf_{};
+  std::size_t head_ = 0, size_ = 0;
+  Eigen::Vector3d sum_f_ = Eigen::Vector3d::Zero(), sum_f2_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d sum_w_ = Eigen::Vector3d::Zero(), sum_w2_ = Eigen::Vector3d::Zero();
+  double sum_m_ = 0.0, sum_m2_ = 0.0;
+  std::size_t gyro_count_ = 0;
+};
+
+// ---------------------------------------------------------------------------------------------
+/// BP network of seed 003 (eqs. (4)-(10)): 3 inputs, one sigmoid hidden layer, 4 linear outputs
+/// (one per pose, trained toward one-hot targets), pose = the largest output. Hidden size 8: the
+/// rules of eqs. (1)-(3) give sqrt(n+m)+a = 3..13, log2(n) = 2, sqrt(nm) = 3.5; 8 was the
+/// smallest that reached the training accuracy plateau (tools/train_pose.cpp).
+/// Inputs are log features, standardised with the training mean and scale.
+struct PoseNetwork {
+  static constexpr int kInputs = 3;
+  static constexpr int kHidden = 8;
+  static constexpr int kOutputs = kPoseCount;
+  using Input = Eigen::Matrix<double, kInputs, 1>;
+  using Output = Eigen::Matrix<double, kOutputs, 1>;
+  Eigen::Matrix<double, kHidden, kInputs> w_ih = Eigen::Matrix<double, kHidden, kInputs>::Zero();
+  Eigen::Matrix<double, kHidden, 1> b_h = Eigen::Matrix<double, kHidden, 1>::Zero();
+  Eigen::Matrix<double, kOutputs, kHidden> w_ho = Eigen::Matrix<double, kOutputs, kHidden>::Zero();
+  Output b_o = Output::Zero();
+  Input in_mean = Input::Zero();
+  Input in_scale = Input::Ones();
+  bool trained = false;
+
+  /// Network input for a feature triple (log, then standardised). NaN gyro variance -> NaN.
+  [[nodiscard]] Input input(const PoseFeatures& f) const;
+  [[nodiscard]] Output forward(const Input& x) const;
+  /// Pose for a feature triple; nullopt when untrained or a feature is not finite.
+  [[nodiscard]] std::optional<PhonePose> classify(const PoseFeatures& f) const;
+};
+
+/// Deterministic back-propagation training (seed 003, steps 1-7): per-sample gradient descent on
+/// the squared error with learning rate `eta`, samples visited in a seeded shuffled order each
+/// epoch. Sets the input standardisation from the data.
+struct PoseTrainingParams {
+  int epochs = 400;
+  double eta = 0.05;
+  std::uint64_t seed = 1;
+};
+[[nodiscard]] PoseNetwork train_pose_network(const std::vector<PoseFeatures>& features,
+                                             const std::vector<PhonePose>& labels,
+                                             PoseTrainingParams params = {});
+
+// ---------------------------------------------------------------------------------------------
+/// Seed 003 eq. (13): step length L = a*h + b*f_step + c per pose (h in m, f_step in Hz).
+struct StepLengthModel {
+  std::array<Eigen::Vector3d, kPoseCount> abc{};  ///< per pose: a (m/m), b (m/Hz), c (m)
+  StepLengthModel();                              ///< generic walking coefficients
+  [[nodiscard]] double length_m(PhonePose pose, double height_m, double step_hz) const;
+};
+
+/// A walk of known length used to calibrate the step-length model.
+struct CalibrationWalk {
+  double height_m = 1.75;
+  std::vector<double> step_hz;  ///< estimated step frequency at each counted step
+  double distance_m = 0.0;      ///< the known length of the walk
+};
+/// Least squares for (a, b, c): each walk says sum_i (a h + b f_i + c) = distance. With fewer
+/// walks than unknowns (or walks that do not vary h and f) the solution stays as close as
+/// possible to `prior` (ridge weight `prior_weight` per coefficient, relative to one walk).
+[[nodiscard]] Eigen::Vector3d calibrate_step_length(const std::vector<CalibrationWalk>& walks,
+                                                    const Eigen::Vector3d& prior,
+                                                    double prior_weight = 1e-3);
+
+/// The model file (fusion_core/data/pose_bp.txt): network + step-length coefficients, text.
+[[nodiscard]] std::string format_pdr_model(const PoseNetwork& net, const StepLengthModel& len);
+/// Parses it; false on malformed text (the outputs are then untouched).
+[[nodiscard]] bool parse_pdr_model(std::string_view text, PoseNetwork& net, StepLengthModel& len);
+/// The model shipped with the library (pose_bp.txt compiled in); untrained if it was missing.
+[[nodiscard]] const PoseNetwork& builtin_pose_network();
+[[nodiscard]] const StepLengthModel& builtin_step_length_model();
+
+/// Seed 003 eqs. (14)-(15): v_walking = M v_sensor for a pose (identity for hand-held, arm swing).
+[[nodiscard]] Eigen::Matrix3d pose_rotation(PhonePose pose);
+
+// ---------------------------------------------------------------------------------------------
+/// Heading of the walking frame's x axis from gyro + magnetometer (seed 004, Fig. 2): a two-state
+/// Kalman filter [heading, heading-rate bias]; prediction with the gyro rate about the tracked
+/// up direction, update with the tilt-compensated magnetic heading. The up direction is tracked
+/// by integrating the gyro and pulling toward the accelerometer (`up_tau_s`), so a swinging arm
+/// does not tilt it. Magnetic north (no declination).
+struct HeadingFilterParams {
+  double gyro_noise_rad_s = 0.02;  ///< heading-rate noise density, rad/s/sqrt(Hz)
+  double bias_walk_rad_s2 = 2e-4;  ///< bias random walk, rad/s^2/sqrt(Hz)
+  double mag_noise_deg = 6.0;      ///< magnetic heading noise per sample, deg
+  double gate_deg = 40.0;          ///< larger innovations are rejected...
+  double reset_after_s = 3.0;      ///< ...unless they persist this long (then reset)
+  double up_tau_s = 1.5;           ///< time constant of the pull toward the accelerometer
+};
+class HeadingFilter {
+ public:
+  using Params = HeadingFilterParams;
+  struct State {
+    double heading_rad = 0.0;
+    double bias_rad_s = 0.0;
+    Eigen::Matrix2d p = Eigen::Matrix2d::Identity();
+    Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  ///< up, walking frame
+    double last_t_s = 0.0;
+    double rejected_since_s = -1.0;
+    bool initialised = false;
+  };
+  struct Diagnostics {
+    unsigned rejected_non_finite = 0;
+    unsigned rejected_mag = 0;  ///< magnetometer updates refused by the gate
+    unsigned resets = 0;
+  };
+  explicit HeadingFilter(Params params = {}) : params_(params) {}
+  /// Feeds a sample already rotated into the walking frame; mag may be NaN (prediction only).
+  void update(double t_s, const Eigen::Vector3d& gyro_rad_s, const Eigen::Vector3d& acc_m_s2,
+              const Eigen::Vector3d& mag_uT);
+  /// Forgets the heading (next magnetic reading initialises it); keeps the up direction.
+  void reset_heading() { state_.initialised = false; }
+  /// The walking frame changed by `r` (v_new = r v_old): re-expresses the up direction and
+  /// forgets the heading.
+  void change_frame(const Eigen::Matrix3d& r) {
+    state_.up = r * state_.up;
+    state_.initialised = false;
+  }
+  [[nodiscard]] double heading_rad() const { return state_.heading_rad; }
+  [[nodiscard]] bool initialised() const { return state_.initialised; }
+  [[nodiscard]] const State& state() const { return state_; }
+  void set_state(const State& s) { state_ = s; }
+  [[nodiscard]] const Diagnostics& diagnostics() const { return diag_; }
+  /// Tilt-compensated heading of the x axis from a magnetometer reading and the up direction
+  /// (same frame); NaN when x is near vertical or the field is degenerate.
+  [[nodiscard]] static double magnetic_heading_rad(const Eigen::Vector3d& mag,
+                                                   const Eigen::Vector3d& up);
+
+ private:
+  Params params_;
+  State state_;
+  Diagnostics diag_;
+  bool up_init_ = false;
+};
+
+// ---------------------------------------------------------------------------------------------
+struct PdrParams {
+  StepMount mount = StepMount::kBody;  ///< kBody: phone (seed 003); kFoot: toe sensor (seed 004)
+  double height_m = 1.75;              ///< walker's height, m
+  double feature_window_s = 2.0;       ///< pose feature window, s
+  double switch_correlation = 0.5;     ///< step waveforms correlating less = pose switch...
+  double switch_tilt_deg = 15.0;       ///< ...if gravity also moved this much in the sensor frame
+                                       ///< (twice this much is a switch whatever the correlation)
+  int switch_exit_steps = 2;           ///< correlated steps needed to leave a switch
+  int pose_window_steps = 10;          ///< steps after a switch to confirm the new pose
+  int pose_fallback_steps = 10;        ///< identical answers that change the pose without a switch
+  double pose_gravity_deg = 45.0;      ///< a pose whose M does not bring gravity this close to
+                                       ///< the walking frame's up is not plausible
+  double straight_deg = 10.0;          ///< 3 steps within this of their mean are "straight"
+  int pose_confirm_steps = 3;          ///< identical classifications before the pose changes
+  HeadingFilterParams heading;
+};
+
+/// Everything a node publishes after a sample.
+struct PdrOutput {
+  double t_s = 0.0;
+  std::size_t steps = 0;     ///< steps of both feet
+  double cadence_spm = 0.0;  ///< steps per minute (0 until two steps)
+  double step_hz = 0.0;      ///< step frequency used for the step length
+  double last_step_length_m = 0.0;
+  double distance_m = 0.0;
+  double x_m = 0.0;          ///< east of the start, m
+  double y_m = 0.0;          ///< north of the start, m
+  double heading_deg = 0.0;  ///< walking direction, clockwise from north
+  PhonePose pose = PhonePose::kHandHeld;
+  bool switching = false;  ///< a pose switch is in progress (heading held)
+  int gait = 1;            ///< coarse gait from cadence: 0 slow walk .. 4 run
+  bool step = false;       ///< a step completed at this sample
+};
+
+class Pdr {
+ public:
+  using Params = PdrParams;
+  struct Diagnostics {
+    unsigned rejected_non_finite = 0;
+    unsigned switches = 0;           ///< pose switches detected by cross-correlation
+    unsigned pose_changes = 0;       ///< classified pose changes applied
+    unsigned replaced_headings = 0;  ///< steps that used the pre-switch heading
+  };
+  /// `net` and `lengths` default to the built-in model; they are copied.
+  explicit Pdr(Params params = {}, const PoseNetwork& net = builtin_pose_network(),
+               const StepLengthModel& lengths = builtin_step_length_model());
+  /// Feeds one sample; `mag_uT` may be NaN. Returns the state after it (also `output()`).
+  const PdrOutput& update(const ImuSample& sample, const Eigen::Vector3d& mag_uT);
+  [[nodiscard]] const PdrOutput& output() const { return out_; }
+  [[nodiscard]] const Diagnostics& diagnostics() const { return diag_; }
+  [[nodiscard]] const StepDiagnostics& step_diagnostics() const;
+  /// Step frequencies seen at each step so far are not stored (no heap); for calibration, collect
+  /// `output().step_hz` at every step in the caller.
+
+ private:
+  static constexpr int kWave = 16;  ///< points per axis in a step waveform
+  using Wave = Eigen::Matrix<double, 3 * kWave, 1>;
+  void on_step(double t_s);
+  [[nodiscard]] Wave step_wave(double t0_s, double t1_s) const;
+
+  Params params_;
+  PoseNetwork net_;
+  StepLengthModel lengths_;
+  PeakValleyStepDetector phone_steps_;
+  AdaptiveStepDetector foot_steps_;
+  PoseFeatureWindow features_;
+  HeadingFilter heading_;
+  Diagnostics diag_;
+  PdrOutput out_;
+  PhonePose applied_pose_ = PhonePose::kHandHeld;
+  PhonePose candidate_pose_ = PhonePose::kHandHeld;
+  int candidate_count_ = 0;
+  // Recent raw accelerations for the step waveforms.
+  static constexpr std::size_t kRaw = 512;
+  std::array<double, kRaw> raw_t_{};
+  std::array<Eigen::Vector3d, kRaw> raw_f_{};
+  std::size_t raw_head_ = 0, raw_size_ = 0;
+  std::array<Wave, 2> waves_{};             ///< the last two step waveforms
+  std::array<Eigen::Vector3d, 2> tilts_{};  ///< their mean gravity directions (sensor frame)
+  bool settling_ = false;  ///< switch over, waiting for the new pose to be confirmed
+  int settling_steps_ = 0;
+  bool pose_known_ = false;
+  double pending_m_ = 0.0;                 ///< distance walked before the first heading
+  std::array<double, 32> switch_len_m_{};  ///< steps laid with the replacement heading
+  int switch_steps_ = 0;
+  int wave_count_ = 0;
+  double last_step_t_s_ = -1.0;
+  double interval_ema_s_ = 0.0;
+  // Heading over the current step (circular mean) and of the last three steps.
+  double sum_sin_ = 0.0, sum_cos_ = 0.0;
+  std::array<double, 4> recent_heading_rad_{};  ///< oldest first
+  int recent_count_ = 0;
+  bool switching_ = false;
+  int correlated_steps_ = 0;
+  double replacement_heading_rad_ = 0.0;
+  bool have_replacement_ = false;
+  bool have_t_ = false;
+  double last_t_s_ = 0.0;
+};
+
+}  // namespace telltale::fusion

@@ -1,0 +1,251 @@
+#pragma once
+/// \file
+/// Streaming step detectors (SPEC section 4, seeds 004 and 003).
+///
+/// Every detector takes one ImuSample at a time (`update`) and says whether a step completed at
+/// that sample. Input contract, shared by all of them:
+/// - `t_s` strictly increasing (non-uniform rates from 25 to 400 Hz are fine); a sample whose time
+///   does not advance, or whose accelerometer is NaN/Inf, is ignored and counted in Diagnostics;
+/// - the gyro is optional: a NaN gyro means "no gyroscope" (accelerometer-only phone traces), and
+///   the detectors that can use it fall back to their accelerometer conditions;
+/// - the sensor axes may be in any orientation (magnitudes and the dominant gyro axis are used).
+///
+/// Mount: a foot-mounted sensor counts the steps of ITS foot (one per gait cycle of that foot);
+/// a body-worn sensor (belt, pocket, phone in any pose) counts every step.
+///
+/// Memory: fixed-size ring buffers, no heap after construction.
+
+#include <array>
+#include <cstddef>
+#include <memory>
+#include <span>
+#include <string_view>
+
+#include "telltale/fusion/imu_sample.hpp"
+
+namespace telltale::fusion {
+
+enum class StepMount { kFoot, kBody };
+
+/// One detected step.
+struct StepEvent {
+  double t_s = 0.0;         ///< time of the sample at which the step was confirmed
+  double interval_s = 0.0;  ///< time since the previous step (0 for the first one)
+};
+
+struct StepDiagnostics {
+  unsigned rejected_non_finite = 0;  ///< samples with NaN/Inf time or accelerometer
+  unsigned rejected_time = 0;        ///< samples whose time did not advance
+  unsigned rejected_timing = 0;      ///< candidate steps refused by the time threshold
+  unsigned rejected_amplitude = 0;   ///< candidate steps refused by the amplitude conditions
+  bool gyro_used = false;            ///< the last accepted sample carried a finite gyro
+};
+
+/// Fixed-capacity sliding window over time that keeps the mean of its positive samples and the
+/// mean of its negative samples (the adaptive thresholds of seed 004, eqs. (3)-(6)).
+class SignedMeanWindow {
+ public:
+  static constexpr std::size_t kCapacity = 1024;  ///< 2.5 s at 400 Hz
+  void reset();
+  /// Adds (t, v) and drops samples older than t - window_s (or the oldest when full).
+  void push(double t_s, double v, double window_s);
+  [[nodiscard]] double positive_mean() const { return n_pos_ ? sum_pos_ / n_pos_ : 0.0; }
+  [[nodiscard]] double negative_mean() const { return n_neg_ ? sum_neg_ / n_neg_ : 0.0; }
+  [[nodiscard]] std::size_t size() const { return size_; }
+
+ private:
+  void pop();
+  std::array<double, kCapacity> t_{};
+  std::array<double, kCapacity> v_{};
+  std::size_t head_ = 0;
+  std::size_t size_ = 0;
+  double sum_pos_ = 0.0;
+  double sum_neg_ = 0.0;
+  double n_pos_ = 0.0;
+  double n_neg_ = 0.0;
+};
+
+/// Two cascaded first-order low-pass sections with a time constant, valid for non-uniform dt.
+class LowPass2 {
+ public:
+  explicit LowPass2(double cutoff_hz = 3.0) : cutoff_hz_(cutoff_hz) {}
+  double step(double x, double dt_s);
+  void reset() { init_ = false; }
+
+ private:
+  double cutoff_hz_;
+  double y1_ = 0.0;
+  double y2_ = 0.0;
+  bool init_ = false;
+};
+
+/// The interface every step detector implements (registry: make_step_detector).
+class StepDetector {
+ public:
+  virtual ~StepDetector() = default;
+  /// Feeds one sample. Returns true and fills `event` when a step is confirmed at this sample.
+  virtual bool update(const ImuSample& sample, StepEvent& event) = 0;
+  virtual void reset() = 0;
+  [[nodiscard]] virtual std::string_view name() const = 0;
+  [[nodiscard]] virtual const StepDiagnostics& diagnostics() const = 0;
+};
+
+/// Seed 004: multi-source adaptive thresholds. Over a sliding window, upper/lower acceleration
+/// thresholds are the means of the positive/negative samples of the dynamic specific-force
+/// magnitude (|f| - g), and upper/lower angular-rate thresholds the same on the dominant gyro axis.
+/// A step counts when, since the previous step, the acceleration has exceeded its upper and gone
+/// below its lower threshold, the angular rate likewise (eq. (7): all four), the cycle has closed
+/// (foot: the foot then rests for `stance_s`; body: the acceleration falls below its lower
+/// threshold after the upper one) and the time thresholds hold (interval >=
+/// `min_interval_fraction` x recent interval and >= `min_interval_s`). Without a gyro the two
+/// acceleration conditions, the closing and the time thresholds remain.
+struct AdaptiveStepParams {
+  double window_s = 2.0;               ///< sliding window of the adaptive thresholds, s
+  double acc_cutoff_hz = 12.0;         ///< low-pass on |f| before thresholding, Hz
+  double gyro_cutoff_hz = 12.0;        ///< low-pass on the gyro axis, Hz
+  double acc_floor_m_s2 = 1.0;         ///< thresholds never come closer to 0 than this, m/s^2
+  double gyro_floor_rad_s = 0.5;       ///< same for the angular rate, rad/s
+  double min_interval_s = 0.36;        ///< absolute time threshold, s (foot: 2.8 cycles/s max)
+  double max_interval_s = 3.0;         ///< beyond this the cadence memory is reset, s
+  double min_interval_fraction = 0.5;  ///< time threshold relative to the recent interval
+  double initial_interval_s = 1.0;     ///< cadence memory at start, s
+  double mean_tau_s = 4.0;             ///< time constant of the |f| mean the signal is taken about
+  bool use_gyro = true;                ///< false: acceleration conditions only
+  bool require_stance = true;          ///< foot: a cycle closes with the foot at rest
+  double stance_s = 0.03;              ///< rest needed to close a foot cycle, s
+  double stance_fraction = 0.25;       ///< rest = |f|-g and |w| below this x upper thresholds
+};
+class AdaptiveStepDetector final : public StepDetector {
+ public:
+  using Params = AdaptiveStepParams;
+  explicit AdaptiveStepDetector(Params params = {});
+  bool update(const ImuSample& sample, StepEvent& event) override;
+  void reset() override;
+  [[nodiscard]] std::string_view name() const override { return "adaptive"; }
+  [[nodiscard]] const StepDiagnostics& diagnostics() const override { return diag_; }
+  /// Current thresholds (eqs. (3)-(6)): acc upper/lower (m/s^2), gyro upper/lower (rad/s).
+  [[nodiscard]] std::array<double, 4> thresholds() const;
+
+ private:
+  Params params_;
+  StepDiagnostics diag_;
+  SignedMeanWindow acc_window_;
+  SignedMeanWindow gyro_window_;
+  LowPass2 acc_lp_;
+  LowPass2 gyro_lp_;
+  Eigen::Vector3d gyro_energy_ = Eigen::Vector3d::Zero();
+  double g_est_m_s2_ = 9.80665;
+  double last_t_s_ = 0.0;
+  double last_step_t_s_ = -1e9;
+  double interval_ema_s_ = 1.0;
+  double quiet_since_s_ = -1.0;
+  bool have_t_ = false;
+  bool have_step_ = false;
+  std::array<bool, 4> seen_{};  ///< acc>up, acc<lo, gyro>up, gyro<lo since the last step
+};
+
+/// Baseline: peaks of the low-passed |f| above a fixed height, at least a fixed time apart
+/// (the "peak detection" column of seed 004, Table 2). Parameters suit a normal walk.
+struct PeakStepParams {
+  double cutoff_hz = 5.0;         ///< low-pass on |f|, Hz
+  double min_height_m_s2 = 11.5;  ///< a peak must exceed this |f|, m/s^2
+  double min_distance_s = 0.3;    ///< peaks closer than this are merged, s
+};
+class PeakStepDetector final : public StepDetector {
+ public:
+  using Params = PeakStepParams;
+  explicit PeakStepDetector(Params params = {});
+  bool update(const ImuSample& sample, StepEvent& event) override;
+  void reset() override;
+  [[nodiscard]] std::string_view name() const override { return "peak"; }
+  [[nodiscard]] const StepDiagnostics& diagnostics() const override { return diag_; }
+
+ private:
+  Params params_;
+  StepDiagnostics diag_;
+  LowPass2 lp_;
+  double y1_ = 0.0, y2_ = 0.0, t1_ = 0.0;
+  int n_ = 0;
+  double last_t_s_ = 0.0;
+  double last_step_t_s_ = -1e9;
+};
+
+/// Baseline: rising crossings of a fixed |f| threshold with a refractory time ("fixed threshold").
+struct FixedThresholdStepParams {
+  double cutoff_hz = 5.0;        ///< low-pass on |f|, Hz
+  double threshold_m_s2 = 11.5;  ///< rising crossing of this |f| counts, m/s^2
+  double hysteresis_m_s2 = 1.0;  ///< must fall below threshold - hysteresis to re-arm, m/s^2
+  double refractory_s = 0.3;     ///< minimum time between steps, s
+};
+class FixedThresholdStepDetector final : public StepDetector {
+ public:
+  using Params = FixedThresholdStepParams;
+  explicit FixedThresholdStepDetector(Params params = {});
+  bool update(const ImuSample& sample, StepEvent& event) override;
+  void reset() override;
+  [[nodiscard]] std::string_view name() const override { return "fixed-threshold"; }
+  [[nodiscard]] const StepDiagnostics& diagnostics() const override { return diag_; }
+
+ private:
+  Params params_;
+  StepDiagnostics diag_;
+  LowPass2 lp_;
+  bool armed_ = true;
+  bool have_t_ = false;
+  double last_t_s_ = 0.0;
+  double last_step_t_s_ = -1e9;
+};
+
+/// Seed 003, eq. (12): peak then valley on the low-passed |f|. A peak counts when it exceeds the
+/// mean of the previous step's peak and valley and the time since the previous peak exceeds the
+/// time threshold; the following valley closes the step (the event is reported at the valley).
+/// Interpretation (the paper leaves them open): the time threshold follows the cadence
+/// (fraction of the recent interval, with an absolute floor); a peak-to-valley swing below
+/// `min_swing_m_s2` is not a step (standing still); the reference mean decays toward the running
+/// mean of the signal after a pause so a new walk at a lower intensity is picked up.
+struct PeakValleyStepParams {
+  double cutoff_hz = 3.0;              ///< low-pass on |f|, Hz (steps are 1-3.5 Hz)
+  double min_interval_s = 0.25;        ///< absolute time threshold between peaks, s
+  double min_interval_fraction = 0.5;  ///< time threshold relative to the recent interval
+  double max_interval_s = 2.0;         ///< beyond this the step memory is reset, s
+  double initial_interval_s = 0.5;     ///< cadence memory at start and after a pause, s
+  double min_swing_m_s2 = 0.6;         ///< smallest peak-to-valley swing that is a step, m/s^2
+  double valley_rise_fraction = 0.25;  ///< a valley is confirmed once |f| rises by this x swing
+};
+class PeakValleyStepDetector final : public StepDetector {
+ public:
+  using Params = PeakValleyStepParams;
+  explicit PeakValleyStepDetector(Params params = {});
+  bool update(const ImuSample& sample, StepEvent& event) override;
+  void reset() override;
+  [[nodiscard]] std::string_view name() const override { return "peak-valley"; }
+  [[nodiscard]] const StepDiagnostics& diagnostics() const override { return diag_; }
+
+ private:
+  Params params_;
+  StepDiagnostics diag_;
+  LowPass2 lp_;
+  enum class Phase { kSeekPeak, kSeekValley } phase_ = Phase::kSeekPeak;
+  bool have_t_ = false;
+  double last_t_s_ = 0.0;
+  double mean_m_s2_ = 9.80665;  ///< slow running mean of the filtered |f|
+  double prev_peak_ = 0.0, prev_valley_ = 0.0;
+  bool have_prev_ = false;
+  double cand_peak_ = 0.0, cand_peak_t_s_ = 0.0;
+  double valley_ = 0.0;
+  double last_peak_t_s_ = -1e9;
+  double last_step_t_s_ = -1e9;
+  double interval_ema_s_ = 0.5;
+  double y1_ = 0.0, y2_ = 0.0;
+  int n_ = 0;
+};
+
+/// Names accepted by make_step_detector: "adaptive", "peak", "fixed-threshold", "peak-valley".
+[[nodiscard]] std::span<const std::string_view> step_detector_names();
+/// The default detector for a mount: foot -> "adaptive", body -> "peak-valley".
+[[nodiscard]] std::string_view default_step_detector(StepMount mount);
+/// Builds a detector with defaults suited to the mount; nullptr for an unknown name.
+[[nodiscard]] std::unique_ptr<StepDetector> make_step_detector(std::string_view name,
+                                                               StepMount mount);
+
+}  // namespace telltale::fusion

@@ -1,0 +1,629 @@
+#include "telltale/fusion/pdr.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <random>
+#include <sstream>
+
+#include "pose_bp_data.hpp"
+
+namespace telltale::fusion {
+namespace {
+
+constexpr double kTwoPi = 2.0 * M_PI;
+
+double wrap_2pi(double a) {
+  a = std::fmod(a, kTwoPi);
+  return a < 0.0 ? a + kTwoPi : a;
+}
+
+double sigmoid(double x) { return 1.0 / (1.0 + std::exp(-x)); }
+
+}  // namespace
+
+// --- features ---------------------------------------------------------------------------------
+void PoseFeatureWindow::pop() {
+  const ImuSample& s = buf_[head_];
+  const double m = s.acc_body_m_s2.norm();
+  sum_f_ -= s.acc_body_m_s2;
+  sum_f2_ -= s.acc_body_m_s2.cwiseAbs2();
+  sum_m_ -= m;
+  sum_m2_ -= m * m;
+  if (s.gyro_body_rad_s.allFinite()) {
+    sum_w_ -= s.gyro_body_rad_s;
+    sum_w2_ -= s.gyro_body_rad_s.cwiseAbs2();
+    --gyro_count_;
+  }
+  head_ = (head_ + 1) % kCapacity;
+  --size_;
+}
+
+void PoseFeatureWindow::push(const ImuSample& s) {
+  while (size_ > 0 && (size_ == kCapacity || buf_[head_].t_s < s.t_s - window_s_)) pop();
+  buf_[(head_ + size_) % kCapacity] = s;
+  ++size_;
+  const double m = s.acc_body_m_s2.norm();
+  sum_f_ += s.acc_body_m_s2;
+  sum_f2_ += s.acc_body_m_s2.cwiseAbs2();
+  sum_m_ += m;
+  sum_m2_ += m * m;
+  if (s.gyro_body_rad_s.allFinite()) {
+    sum_w_ += s.gyro_body_rad_s;
+    sum_w2_ += s.gyro_body_rad_s.cwiseAbs2();
+    ++gyro_count_;
+  }
+}
+
+double PoseFeatureWindow::span_s() const {
+  if (size_ < 2) return 0.0;
+  return buf_[(head_ + size_ - 1) % kCapacity].t_s - buf_[head_].t_s;
+}
+
+Eigen::Vector3d PoseFeatureWindow::mean_acc() const {
+  return size_ ? Eigen::Vector3d(sum_f_ / static_cast<double>(size_)) : Eigen::Vector3d::Zero();
+}
+
+PoseFeatures PoseFeatureWindow::features() const {
+  PoseFeatures f;
+  if (size_ == 0) return f;
+  const double n = static_cast<double>(size_);
+  const Eigen::Vector3d mean_f = sum_f_ / n;
+  f.acc_energy = std::max(0.0, (sum_f2_ / n - mean_f.cwiseAbs2()).sum());
+  const double mean_m = sum_m_ / n;
+  f.acc_variance = std::max(0.0, sum_m2_ / n - mean_m * mean_m);
+  if (gyro_count_ == 0) {
+    f.gyro_variance = std::nan("");
+  } else {
+    const double ng = static_cast<double>(gyro_count_);
+    const Eigen::Vector3d mean_w = sum_w_ / ng;
+    f.gyro_variance = std::max(0.0, (sum_w2_ / ng - mean_w.cwiseAbs2()).sum());
+  }
+  return f;
+}
+
+// --- BP network -------------------------------------------------------------------------------
+PoseNetwork::Input PoseNetwork::input(const PoseFeatures& f) const {
+  // Log features: the variances span three decades between a phone at the ear and a swinging
+  // arm, and their ratios (not differences) separate the poses.
+  const Input raw(std::log(f.acc_energy + 1e-4), std::log(f.acc_variance + 1e-4),
+                  std::log(f.gyro_variance + 1e-6));
+  return (raw - in_mean).cwiseQuotient(in_scale);
+}
+
+PoseNetwork::Output PoseNetwork::forward(const Input& x) const {
+  // Eq. (4): H_j = f(sum_i w_ij x_i - a_j) with a sigmoid f; eq. (5): O_k = sum_j H_j w_jk - b_k.
+  const Eigen::Matrix<double, kHidden, 1> h = (w_ih * x + b_h).unaryExpr(&sigmoid);
+  return w_ho * h + b_o;
+}
+
+std::optional<PhonePose> PoseNetwork::classify(const PoseFeatures& f) const {
+  if (!trained) return std::nullopt;
+  const Input x = input(f);
+  if (!x.allFinite()) return std::nullopt;
+  Eigen::Index k = 0;
+  forward(x).maxCoeff(&k);
+  return static_cast<PhonePose>(k);
+}
+
+PoseNetwork train_pose_network(const std::vector<PoseFeatures>& features,
+                               const std::vector<PhonePose>& labels, PoseTrainingParams params) {
+  PoseNetwork net;
+  const std::size_t n = std::min(features.size(), labels.size());
+  if (n == 0) return net;
+  // Standardisation from the data (log features).
+  std::vector<PoseNetwork::Input> raw(n);
+  for (std::size_t i = 0; i < n; ++i) raw[i] = net.input(features[i]);
+  PoseNetwork::Input mean = PoseNetwork::Input::Zero(), sq = PoseNetwork::Input::Zero();
+  for (const auto& r : raw) mean += r;
+  mean /= static_cast<double>(n);
+  for (const auto& r : raw) sq += (r - mean).cwiseAbs2();
+  net.in_mean = mean;
+  net.in_scale = (sq / static_cast<double>(n)).cwiseSqrt().cwiseMax(1e-6);
+  std::vector<PoseNetwork::Input> x(n);
+  for (std::size_t i = 0; i < n; ++i) x[i] = (raw[i] - mean).cwiseQuotient(net.in_scale);
+
+  // Step 1: small random initial weights (seeded; uniform +-0.5 from our own transform).
+  std::mt19937_64 rng(params.seed);
+  auto uni = [&rng] { return static_cast<double>(rng() >> 11) * 0x1.0p-53 - 0.5; };
+  for (int i = 0; i < net.w_ih.size(); ++i) net.w_ih.data()[i] = uni();
+  for (int i = 0; i < net.b_h.size(); ++i) net.b_h.data()[i] = uni();
+  for (int i = 0; i < net.w_ho.size(); ++i) net.w_ho.data()[i] = uni();
+  for (int i = 0; i < net.b_o.size(); ++i) net.b_o.data()[i] = uni();
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  for (int epoch = 0; epoch < params.epochs; ++epoch) {
+    for (std::size_t i = n - 1; i > 0; --i) std::swap(order[i], order[rng() % (i + 1)]);
+    for (const std::size_t i : order) {
+      // Steps 2-3: forward pass.
+      const Eigen::Matrix<double, PoseNetwork::kHidden, 1> h =
+          (net.w_ih * x[i] + net.b_h).unaryExpr(&sigmoid);
+      const PoseNetwork::Output o = net.w_ho * h + net.b_o;
+      // Step 4: error e_k = Y_k - O_k against the one-hot target.
+      PoseNetwork::Output e = -o;
+      e[static_cast<Eigen::Index>(labels[i])] += 1.0;
+      // Steps 5-6 (eqs. (7)-(10)): weights and thresholds along the error gradient.
+      const Eigen::Matrix<double, PoseNetwork::kHidden, 1> back =
+          (net.w_ho.transpose() * e)
+              .cwiseProduct(
+                  h.cwiseProduct(Eigen::Matrix<double, PoseNetwork::kHidden, 1>::Ones() - h));
+      net.w_ho += params.eta * e * h.transpose();
+      net.b_o += params.eta * e;
+      net.w_ih += params.eta * back * x[i].transpose();
+      net.b_h += params.eta * back;
+    }
+  }
+  net.trained = true;
+  return net;
+}
+
+// --- step length ------------------------------------------------------------------------------
+StepLengthModel::StepLengthModel() {
+  // Generic walking coefficients (overridden by the shipped calibration in pose_bp.txt).
+  for (auto& c : abc) c = Eigen::Vector3d(0.3, 0.4, -0.51);
+}
+
+double StepLengthModel::length_m(PhonePose pose, double height_m, double step_hz) const {
+  const Eigen::Vector3d& c = abc[static_cast<std::size_t>(pose)];
+  return std::max(0.0, c[0] * height_m + c[1] * step_hz + c[2]);
+}
+
+Eigen::Vector3d calibrate_step_length(const std::vector<CalibrationWalk>& walks,
+                                      const Eigen::Vector3d& prior, double prior_weight) {
+  // Each walk: a (N h) + b (sum f) + c N = D. Rows are divided by N so every walk weighs the
+  // same whatever its length; ridge toward the prior keeps the unobservable combinations.
+  Eigen::Matrix3d ata = prior_weight * Eigen::Matrix3d::Identity();
+  Eigen::Vector3d atb = prior_weight * prior;
+  for (const auto& w : walks) {
+    if (w.step_hz.empty()) continue;
+    const double n = static_cast<double>(w.step_hz.size());
+    const double mean_f = std::accumulate(w.step_hz.begin(), w.step_hz.end(), 0.0) / n;
+    const Eigen::Vector3d row(w.height_m, mean_f, 1.0);
+    ata += row * row.transpose();
+    atb += row * (w.distance_m / n);
+  }
+  return ata.ldlt().solve(atb);
+}
+
+// --- model file -------------------------------------------------------------------------------
+std::string format_pdr_model(const PoseNetwork& net, const StepLengthModel& len) {
+  std::ostringstream o;
+  o.precision(17);
+  o << "# Telltale PDR model: BP pose network (seed 003) + step-length coefficients.\n"
+       "# Written by tools/train_pose (deterministic); do not edit by hand.\n"
+       "# pose order: hand-held call pocket arm-swing\n";
+  auto put = [&o](const char* name, const auto& m) {
+    o << name << ' ' << m.rows() << ' ' << m.cols();
+    for (Eigen::Index r = 0; r < m.rows(); ++r)
+      for (Eigen::Index c = 0; c < m.cols(); ++c) o << ' ' << m(r, c);
+    o << '\n';
+  };
+  put("in_mean", net.in_mean);
+  put("in_scale", net.in_scale);
+  put("w_ih", net.w_ih);
+  put("b_h", net.b_h);
+  put("w_ho", net.w_ho);
+  put("b_o", net.b_o);
+  Eigen::Matrix<double, kPoseCount, 3> abc;
+  for (int p = 0; p < kPoseCount; ++p)
+    abc.row(p) = len.abc[static_cast<std::size_t>(p)].transpose();
+  put("step_length_abc", abc);
+  return o.str();
+}
+
+bool parse_pdr_model(std::string_view text, PoseNetwork& net_out, StepLengthModel& len_out) {
+  PoseNetwork net;
+  Eigen::Matrix<double, kPoseCount, 3> abc;
+  int found = 0;
+  std::istringstream in{std::string(text)};
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream ls(line);
+    std::string name;
+    long rows = 0, cols = 0;
+    if (!(ls >> name >> rows >> cols)) return false;
+    auto read = [&](auto& m) {
+      if (rows != m.rows() || cols != m.cols()) return false;
+      for (Eigen::Index r = 0; r < m.rows(); ++r)
+        for (Eigen::Index c = 0; c < m.cols(); ++c)
+          if (!(ls >> m(r, c)) || !std::isfinite(m(r, c))) return false;
+      ++found;
+      return true;
+    };
+    bool ok = false;
+    if (name == "in_mean")
+      ok = read(net.in_mean);
+    else if (name == "in_scale")
+      ok = read(net.in_scale);
+    else if (name == "w_ih")
+      ok = read(net.w_ih);
+    else if (name == "b_h")
+      ok = read(net.b_h);
+    else if (name == "w_ho")
+      ok = read(net.w_ho);
+    else if (name == "b_o")
+      ok = read(net.b_o);
+    else if (name == "step_length_abc")
+      ok = read(abc);
+    if (!ok) return false;
+  }
+  if (found != 7) return false;
+  net.trained = true;
+  net_out = net;
+  for (int p = 0; p < kPoseCount; ++p)
+    len_out.abc[static_cast<std::size_t>(p)] = abc.row(p).transpose();
+  return true;
+}
+
+namespace {
+struct Builtin {
+  PoseNetwork net;
+  StepLengthModel len;
+  Builtin() { (void)parse_pdr_model(kPoseBpText, net, len); }
+};
+const Builtin& builtin() {
+  static const Builtin b;
+  return b;
+}
+}  // namespace
+
+const PoseNetwork& builtin_pose_network() { return builtin().net; }
+const StepLengthModel& builtin_step_length_model() { return builtin().len; }
+
+Eigen::Matrix3d pose_rotation(PhonePose pose) {
+  Eigen::Matrix3d m = Eigen::Matrix3d::Identity();
+  if (pose == PhonePose::kCall) m << 0, 0, -1, 0, -1, 0, -1, 0, 0;  // eq. (14)
+  if (pose == PhonePose::kPocket) m << 0, 0, -1, 0, 1, 0, 1, 0, 0;  // eq. (15)
+  return m;
+}
+
+// --- heading ----------------------------------------------------------------------------------
+double HeadingFilter::magnetic_heading_rad(const Eigen::Vector3d& mag, const Eigen::Vector3d& up) {
+  const Eigen::Vector3d north = mag - mag.dot(up) * up;
+  const double nn = north.norm();
+  if (!(nn > 1e-6)) return std::nan("");
+  const Eigen::Vector3d n = north / nn;
+  const Eigen::Vector3d e = n.cross(up);
+  const Eigen::Vector3d x = Eigen::Vector3d::UnitX() - up.x() * up;
+  if (x.norm() < 0.3) return std::nan("");  // x within ~17 deg of vertical: no heading
+  return wrap_2pi(std::atan2(x.dot(e), x.dot(n)));
+}
+
+void HeadingFilter::update(double t_s, const Eigen::Vector3d& gyro, const Eigen::Vector3d& acc,
+                           const Eigen::Vector3d& mag) {
+  if (!std::isfinite(t_s) || !acc.allFinite() || !(acc.norm() > 1e-3)) {
+    ++diag_.rejected_non_finite;
+    return;
+  }
+  const bool gyro_ok = gyro.allFinite();
+  const double dt = up_init_ ? t_s - state_.last_t_s : 0.0;
+  if (up_init_ && !(dt > 0.0)) {
+    ++diag_.rejected_non_finite;
+    return;
+  }
+  state_.last_t_s = t_s;
+  // Up direction in the walking frame: gyro-propagated (du/dt = u x w for a world-fixed vector),
+  // pulled toward the accelerometer's direction with time constant up_tau_s.
+  if (!up_init_) {
+    state_.up = acc.normalized();
+    up_init_ = true;
+  } else {
+    if (gyro_ok) state_.up += state_.up.cross(gyro) * dt;
+    state_.up += dt / (params_.up_tau_s + dt) * (acc.normalized() - state_.up);
+    state_.up.normalize();
+  }
+  // Prediction: heading rate = -(yaw rate about up) (heading is clockwise).
+  if (state_.initialised) {
+    const double rate = gyro_ok ? -gyro.dot(state_.up) : 0.0;
+    state_.heading_rad = wrap_2pi(state_.heading_rad + (rate - state_.bias_rad_s) * dt);
+    Eigen::Matrix2d f;
+    f << 1.0, -dt, 0.0, 1.0;
+    const double q_h = gyro_ok ? params_.gyro_noise_rad_s * params_.gyro_noise_rad_s : 1.0;
+    Eigen::Matrix2d q = Eigen::Matrix2d::Zero();
+    q(0, 0) = q_h * dt;
+    q(1, 1) = params_.bias_walk_rad_s2 * params_.bias_walk_rad_s2 * dt;
+    state_.p = f * state_.p * f.transpose() + q;
+  }
+  if (!mag.allFinite()) {
+    if (!state_.initialised) {  // no magnetometer: gyro heading relative to the start
+      state_.heading_rad = 0.0;
+      state_.p = Eigen::Matrix2d::Identity() * 1e-4;
+      state_.initialised = true;
+    }
+    return;
+  }
+  const double z = magnetic_heading_rad(mag, state_.up);
+  if (!std::isfinite(z)) return;
+  const double r = std::pow(params_.mag_noise_deg * M_PI / 180.0, 2);
+  if (!state_.initialised) {
+    state_.heading_rad = z;
+    state_.p << r, 0.0, 0.0, 1e-4;
+    state_.initialised = true;
+    state_.rejected_since_s = -1.0;
+    return;
+  }
+  const double y = std::remainder(z - state_.heading_rad, kTwoPi);
+  if (std::abs(y) > params_.gate_deg * M_PI / 180.0) {
+    ++diag_.rejected_mag;
+    if (state_.rejected_since_s < 0.0) state_.rejected_since_s = t_s;
+    if (t_s - state_.rejected_since_s > params_.reset_after_s) {
+      state_.heading_rad = z;
+      state_.p << r, 0.0, 0.0, 1e-4;
+      state_.rejected_since_s = -1.0;
+      ++diag_.resets;
+    }
+    return;
+  }
+  state_.rejected_since_s = -1.0;
+  const double s = state_.p(0, 0) + r;
+  const Eigen::Vector2d k = state_.p.col(0) / s;
+  state_.heading_rad = wrap_2pi(state_.heading_rad + k[0] * y);
+  state_.bias_rad_s += k[1] * y;
+  const Eigen::Matrix2d ikh = Eigen::Matrix2d::Identity() - k * Eigen::RowVector2d(1.0, 0.0);
+  state_.p = ikh * state_.p;
+}
+
+// --- PDR --------------------------------------------------------------------------------------
+Pdr::Pdr(Params params, const PoseNetwork& net, const StepLengthModel& lengths)
+    : params_(params),
+      net_(net),
+      lengths_(lengths),
+      foot_steps_([] {
+        AdaptiveStepParams p;
+        return p;
+      }()),
+      features_(params.feature_window_s),
+      heading_(params.heading) {}
+
+const StepDiagnostics& Pdr::step_diagnostics() const {
+  return params_.mount == StepMount::kFoot ? foot_steps_.diagnostics() : phone_steps_.diagnostics();
+}
+
+Pdr::Wave Pdr::step_wave(double t0, double t1) const {
+  Wave w = Wave::Zero();
+  if (raw_size_ == 0) return w;
+  std::size_t j = 0;  // index into the ring from the oldest
+  for (int i = 0; i < kWave; ++i) {
+    const double t = t0 + (t1 - t0) * (i + 0.5) / kWave;
+    while (j + 1 < raw_size_ && raw_t_[(raw_head_ + j + 1) % kRaw] <= t) ++j;
+    const Eigen::Vector3d& f = raw_f_[(raw_head_ + j) % kRaw];
+    for (int a = 0; a < 3; ++a) w[a * kWave + i] = f[a];
+  }
+  return w;
+}
+
+void Pdr::on_step(double t_s) {
+  const bool foot = params_.mount == StepMount::kFoot;
+  const double per_event = foot ? 2.0 : 1.0;  // a foot sensor sees one event per two steps
+  if (last_step_t_s_ >= 0.0) {
+    const double interval = (t_s - last_step_t_s_) / per_event;
+    if (interval < 2.0)
+      interval_ema_s_ = interval_ema_s_ > 0.0 ? 0.5 * interval_ema_s_ + 0.5 * interval : interval;
+  }
+  const double t_prev = last_step_t_s_;
+  last_step_t_s_ = t_s;
+  out_.steps += static_cast<std::size_t>(per_event);
+  if (interval_ema_s_ > 0.0) {
+    out_.step_hz = 1.0 / interval_ema_s_;
+    out_.cadence_spm = 60.0 * out_.step_hz;
+  }
+  const double f = out_.step_hz;
+  out_.gait = f < 1.6 ? 0 : f < 1.95 ? 1 : f < 2.35 ? 2 : f < 2.75 ? 3 : 4;
+
+  if (!foot) {
+    // Pose switch (seed 003): cross-correlation of this step's waveform with the same foot's
+    // previous one. A turn also changes the waveform, so we add a condition of our own: the
+    // gravity direction in the sensor frame must have moved (the phone was re-oriented).
+    if (t_prev >= 0.0) {
+      const Wave w = step_wave(t_prev, t_s);
+      Eigen::Vector3d tilt(w.segment<kWave>(0).mean(), w.segment<kWave>(kWave).mean(),
+                           w.segment<kWave>(2 * kWave).mean());
+      tilt.normalize();
+      const auto slot = static_cast<std::size_t>(wave_count_ % 2);
+      if (wave_count_ >= 2) {
+        const Wave a = w.array() - w.mean();
+        const Wave b = waves_[slot].array() - waves_[slot].mean();
+        const double den = a.norm() * b.norm();
+        const double r = den > 1e-9 ? a.dot(b) / den : 0.0;
+        const double tilt_deg =
+            std::acos(std::clamp(tilt.dot(tilts_[slot]), -1.0, 1.0)) * 180.0 / M_PI;
+        const bool changed =
+            (r < params_.switch_correlation && tilt_deg > params_.switch_tilt_deg) ||
+            tilt_deg > 2.0 * params_.switch_tilt_deg;
+        if (!switching_ && changed) {
+          switching_ = true;
+          settling_ = false;
+          correlated_steps_ = 0;
+          switch_steps_ = 0;
+          ++diag_.switches;
+          // If the 3 steps before the switch were straight, their mean heading stands in for
+          // the heading during the switch.
+          // The comparison spans two steps, so the switch may have begun during the latest
+          // step: the 3 steps before that one are the ones known to be clean.
+          have_replacement_ = false;
+          if (recent_count_ >= 4) {
+            double s = 0, c = 0;
+            for (std::size_t i = 0; i < 3; ++i) {
+              s += std::sin(recent_heading_rad_[i]);
+              c += std::cos(recent_heading_rad_[i]);
+            }
+            const double mean = std::atan2(s, c);
+            bool straight = true;
+            for (std::size_t i = 0; i < 3; ++i)
+              straight =
+                  straight && std::abs(std::remainder(recent_heading_rad_[i] - mean, kTwoPi)) <
+                                  params_.straight_deg * M_PI / 180.0;
+            if (straight) {
+              replacement_heading_rad_ = wrap_2pi(mean);
+              have_replacement_ = true;
+            }
+          }
+        } else if (switching_) {
+          correlated_steps_ =
+              (r >= params_.switch_correlation && tilt_deg < params_.switch_tilt_deg)
+                  ? correlated_steps_ + 1
+                  : 0;
+          if (!settling_ && correlated_steps_ >= params_.switch_exit_steps) {
+            // The phone is steady again: wait for fresh classifications of the new pose.
+            settling_ = true;
+            settling_steps_ = 0;
+            candidate_count_ = 0;
+          }
+        }
+      }
+      waves_[slot] = w;
+      tilts_[slot] = tilt;
+      ++wave_count_;
+    }
+    // Pose: classify the feature window at every step. A pose can only change around a detected
+    // switch (turns fool the gyro-variance feature), or when one answer persists for
+    // pose_fallback_steps; the first pose is the first confirmed answer.
+    if (settling_ && ++settling_steps_ > params_.pose_window_steps) {
+      settling_ = switching_ = false;  // no confirmed pose: keep the previous one
+    }
+    // The classifier sees only the three features of seed 003; the rotation matrices of eqs.
+    // (14)-(15) also assume how the phone sits in each pose. We keep the best-scoring pose whose
+    // matrix brings the window's mean gravity near the walking frame's up (our addition: without
+    // it a pocket taken for a phone call turns the heading upside down).
+    std::optional<PhonePose> pose;
+    if (net_.trained) {
+      const PoseNetwork::Input x = net_.input(features_.features());
+      const Eigen::Vector3d g = features_.mean_acc();
+      if (x.allFinite() && g.norm() > 1.0) {
+        PoseNetwork::Output score = net_.forward(x);
+        const double cos_max = std::cos(params_.pose_gravity_deg * M_PI / 180.0);
+        for (int k = 0; k < kPoseCount; ++k) {
+          Eigen::Index best = 0;
+          score.maxCoeff(&best);
+          const auto p = static_cast<PhonePose>(best);
+          if ((pose_rotation(p) * g).normalized().z() > cos_max) {
+            pose = p;
+            break;
+          }
+          score[best] = -std::numeric_limits<double>::infinity();
+        }
+      }
+    }
+    if (pose) {
+      if (*pose == candidate_pose_) {
+        ++candidate_count_;
+      } else {
+        candidate_pose_ = *pose;
+        candidate_count_ = 1;
+      }
+      const bool may_change =
+          !pose_known_ || settling_ || candidate_count_ >= params_.pose_fallback_steps;
+      if (candidate_count_ >= params_.pose_confirm_steps && may_change) {
+        settling_ = switching_ = false;
+        const Eigen::Matrix3d r =
+            pose_rotation(candidate_pose_) * pose_rotation(applied_pose_).transpose();
+        if (!r.isIdentity(1e-9)) {
+          heading_.change_frame(r);  // new walking frame: heading again from the magnetometer
+          sum_sin_ = sum_cos_ = 0.0;
+        }
+        if (pose_known_ && candidate_pose_ != applied_pose_) ++diag_.pose_changes;
+        applied_pose_ = candidate_pose_;
+        pose_known_ = true;
+      }
+    } else if (!pose_known_ && out_.steps >= static_cast<std::size_t>(params_.pose_confirm_steps)) {
+      // No classification possible (no gyroscope, or no model): keep the hand-held frame
+      // (M = I) rather than holding the track back for ever.
+      pose_known_ = true;
+    }
+  }
+
+  // Heading of this step: circular mean over the step, or the replacement during a switch.
+  double heading = heading_.heading_rad();
+  if (sum_sin_ != 0.0 || sum_cos_ != 0.0) heading = wrap_2pi(std::atan2(sum_sin_, sum_cos_));
+  sum_sin_ = sum_cos_ = 0.0;
+  const bool replaced = switching_ && have_replacement_;
+  if (replaced) {
+    heading = replacement_heading_rad_;
+    ++diag_.replaced_headings;
+  } else if (!switching_) {
+    for (std::size_t i = 0; i + 1 < recent_heading_rad_.size(); ++i)
+      recent_heading_rad_[i] = recent_heading_rad_[i + 1];
+    recent_heading_rad_.back() = heading;
+    recent_count_ = std::min(recent_count_ + 1, static_cast<int>(recent_heading_rad_.size()));
+  }
+  // Eq. (13) and eq. (11). The first step has no frequency yet: the person's usual walk.
+  const double hz = out_.step_hz > 0.0 ? out_.step_hz : 1.8;
+  const double len = per_event * lengths_.length_m(applied_pose_, params_.height_m, hz);
+  out_.last_step_length_m = len;
+  out_.distance_m += len;
+  if (!foot && (!pose_known_ || !heading_.initialised())) {
+    // At the start the pose (hence the walking frame and the heading) is not known yet: the
+    // first steps are laid along the first heading we get (a straight start).
+    pending_m_ += len;
+    return;
+  }
+  out_.x_m += (len + pending_m_) * std::sin(heading);
+  out_.y_m += (len + pending_m_) * std::cos(heading);
+  pending_m_ = 0.0;
+  if (replaced && switch_steps_ < static_cast<int>(switch_len_m_.size()))
+    switch_len_m_[static_cast<std::size_t>(switch_steps_++)] = len;
+  if (!switching_ && switch_steps_ > 0) {
+    // First step after a switch (our addition to seed 003): if the walker turned while the
+    // pre-switch heading stood in, the heading after the switch tells by how much; the switch
+    // steps are re-laid with headings interpolated from the old to the new one.
+    const double turn = std::remainder(heading - replacement_heading_rad_, kTwoPi);
+    if (std::abs(turn) > params_.straight_deg * M_PI / 180.0) {
+      const double n = static_cast<double>(switch_steps_);
+      for (int k = 0; k < switch_steps_; ++k) {
+        const double l = switch_len_m_[static_cast<std::size_t>(k)];
+        const double h = replacement_heading_rad_ + turn * (k + 0.5) / n;
+        out_.x_m += l * (std::sin(h) - std::sin(replacement_heading_rad_));
+        out_.y_m += l * (std::cos(h) - std::cos(replacement_heading_rad_));
+      }
+    }
+    switch_steps_ = 0;
+  }
+  out_.heading_deg = heading * 180.0 / M_PI;
+}
+
+const PdrOutput& Pdr::update(const ImuSample& s, const Eigen::Vector3d& mag_uT) {
+  out_.step = false;
+  if (!std::isfinite(s.t_s) || !s.acc_body_m_s2.allFinite() || (have_t_ && !(s.t_s > last_t_s_))) {
+    ++diag_.rejected_non_finite;
+    return out_;
+  }
+  have_t_ = true;
+  last_t_s_ = s.t_s;
+  out_.t_s = s.t_s;
+  const bool foot = params_.mount == StepMount::kFoot;
+  if (!foot) {
+    features_.push(s);
+    if (raw_size_ == kRaw) {
+      raw_head_ = (raw_head_ + 1) % kRaw;
+      --raw_size_;
+    }
+    raw_t_[(raw_head_ + raw_size_) % kRaw] = s.t_s;
+    raw_f_[(raw_head_ + raw_size_) % kRaw] = s.acc_body_m_s2;
+    ++raw_size_;
+  }
+  // Into the walking frame of the pose in force (eqs. (14)-(15)).
+  const Eigen::Matrix3d m = foot ? Eigen::Matrix3d::Identity() : pose_rotation(applied_pose_);
+  heading_.update(s.t_s, m * s.gyro_body_rad_s, m * s.acc_body_m_s2, m * mag_uT);
+  if (heading_.initialised()) {
+    sum_sin_ += std::sin(heading_.heading_rad());
+    sum_cos_ += std::cos(heading_.heading_rad());
+    if (!out_.step)
+      out_.heading_deg = switching_ && have_replacement_ ? replacement_heading_rad_ * 180.0 / M_PI
+                                                         : heading_.heading_rad() * 180.0 / M_PI;
+  }
+  StepEvent ev;
+  const bool step = foot ? foot_steps_.update(s, ev) : phone_steps_.update(s, ev);
+  if (step) {
+    on_step(ev.t_s);
+    out_.step = true;
+  }
+  out_.pose = applied_pose_;
+  out_.switching = switching_;
+  return out_;
+}
+
+}  // namespace telltale::fusion

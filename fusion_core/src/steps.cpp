@@ -1,0 +1,366 @@
+#include "telltale/fusion/steps.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace telltale::fusion {
+namespace {
+
+constexpr double kG = 9.80665;
+
+/// Common input gate: finite time and accelerometer, time advancing. Returns dt (0 on the
+/// first sample) or a negative value when the sample must be ignored.
+double gate(const ImuSample& s, bool& have_t, double& last_t, StepDiagnostics& diag) {
+  if (!std::isfinite(s.t_s) || !s.acc_body_m_s2.allFinite()) {
+    ++diag.rejected_non_finite;
+    return -1.0;
+  }
+  if (have_t && !(s.t_s > last_t)) {
+    ++diag.rejected_time;
+    return -1.0;
+  }
+  const double dt = have_t ? s.t_s - last_t : 0.0;
+  have_t = true;
+  last_t = s.t_s;
+  return dt;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+void SignedMeanWindow::reset() { *this = SignedMeanWindow(); }
+
+void SignedMeanWindow::pop() {
+  const double v = v_[head_];
+  if (v > 0.0) {
+    sum_pos_ -= v;
+    n_pos_ -= 1.0;
+  } else if (v < 0.0) {
+    sum_neg_ -= v;
+    n_neg_ -= 1.0;
+  }
+  head_ = (head_ + 1) % kCapacity;
+  --size_;
+}
+
+void SignedMeanWindow::push(double t_s, double v, double window_s) {
+  while (size_ > 0 && (size_ == kCapacity || t_[head_] < t_s - window_s)) pop();
+  const std::size_t tail = (head_ + size_) % kCapacity;
+  t_[tail] = t_s;
+  v_[tail] = v;
+  ++size_;
+  if (v > 0.0) {
+    sum_pos_ += v;
+    n_pos_ += 1.0;
+  } else if (v < 0.0) {
+    sum_neg_ += v;
+    n_neg_ += 1.0;
+  }
+  // Running sums drift by rounding over hours; resynchronise when the window empties of a sign.
+  if (n_pos_ == 0.0) sum_pos_ = 0.0;
+  if (n_neg_ == 0.0) sum_neg_ = 0.0;
+}
+
+double LowPass2::step(double x, double dt_s) {
+  if (!init_ || !(dt_s > 0.0)) {
+    y1_ = y2_ = x;
+    init_ = true;
+    return x;
+  }
+  const double tau = 1.0 / (2.0 * M_PI * cutoff_hz_);
+  const double k = dt_s / (tau + dt_s);
+  y1_ += k * (x - y1_);
+  y2_ += k * (y1_ - y2_);
+  return y2_;
+}
+
+// ---------------------------------------------------------------------------------------------
+AdaptiveStepDetector::AdaptiveStepDetector(Params params)
+    : params_(params), acc_lp_(params.acc_cutoff_hz), gyro_lp_(params.gyro_cutoff_hz) {
+  interval_ema_s_ = params_.initial_interval_s;
+}
+
+void AdaptiveStepDetector::reset() { *this = AdaptiveStepDetector(params_); }
+
+std::array<double, 4> AdaptiveStepDetector::thresholds() const {
+  return {std::max(acc_window_.positive_mean(), params_.acc_floor_m_s2),
+          std::min(acc_window_.negative_mean(), -params_.acc_floor_m_s2),
+          std::max(gyro_window_.positive_mean(), params_.gyro_floor_rad_s),
+          std::min(gyro_window_.negative_mean(), -params_.gyro_floor_rad_s)};
+}
+
+bool AdaptiveStepDetector::update(const ImuSample& s, StepEvent& event) {
+  const double dt = gate(s, have_t_, last_t_s_, diag_);
+  if (dt < 0.0) return false;
+  const bool gyro_ok = params_.use_gyro && s.gyro_body_rad_s.allFinite();
+  diag_.gyro_used = gyro_ok;
+
+  // Dynamic specific force: |f| about its slow mean (absorbs accelerometer scale and bias, and
+  // the fact that a foot's mean |f| over a cycle is above g).
+  const double mag = s.acc_body_m_s2.norm();
+  const double k_mean = dt > 0.0 ? dt / (params_.mean_tau_s + dt) : 1.0;
+  g_est_m_s2_ += k_mean * (mag - g_est_m_s2_);
+  const double a = acc_lp_.step(mag, dt) - g_est_m_s2_;
+  acc_window_.push(s.t_s, a, params_.window_s);
+
+  double w = 0.0;
+  if (gyro_ok) {
+    // The dominant rotation axis (the foot's pitch axis whatever the mounting): the axis with
+    // the most angular-rate energy over ~2 s.
+    const double k_e = dt > 0.0 ? dt / (2.0 + dt) : 1.0;
+    gyro_energy_ += k_e * (s.gyro_body_rad_s.cwiseAbs2() - gyro_energy_);
+    Eigen::Index axis = 0;
+    gyro_energy_.maxCoeff(&axis);
+    w = gyro_lp_.step(s.gyro_body_rad_s[axis], dt);
+    gyro_window_.push(s.t_s, w, params_.window_s);
+  }
+
+  const auto th = thresholds();
+  // Eq. (7): the four threshold conditions, each latched since the previous step.
+  const bool now_a_hi = a > th[0];
+  const bool now_a_lo = a < th[1];
+  const bool now_w_hi = gyro_ok && w > th[2];
+  const bool now_w_lo = gyro_ok && w < th[3];
+  seen_[0] = seen_[0] || now_a_hi;
+  seen_[1] = seen_[1] || now_a_lo;
+  seen_[2] = seen_[2] || now_w_hi;
+  seen_[3] = seen_[3] || now_w_lo;
+  const bool all = seen_[0] && seen_[1] && (!gyro_ok || (seen_[2] && seen_[3]));
+
+  // What closes a cycle (the paper's flow chart, Fig. 6, is not in the text; our reading):
+  // - foot: the four excursions happen in swing, toe-off and heel strike, in an order that
+  //   depends on the gait, and several of them twice per cycle; the one event that occurs once
+  //   per cycle of that foot is the stance, so the step is confirmed when, after the four
+  //   excursions, the foot has been at rest (|f| near g, |w| small) for `stance_s`;
+  // - body: the trunk's vertical force goes once above and once below its mean per step, so the
+  //   step is confirmed at the first sample below the lower threshold after the upper one.
+  bool close = false;
+  if (params_.require_stance) {
+    const double quiet_a = std::max(params_.stance_fraction * th[0], params_.acc_floor_m_s2);
+    const double quiet_w = std::max(params_.stance_fraction * th[2], params_.gyro_floor_rad_s);
+    const bool quiet =
+        std::abs(mag - kG) < quiet_a && (!gyro_ok || s.gyro_body_rad_s.norm() < quiet_w);
+    if (!quiet) {
+      quiet_since_s_ = -1.0;
+    } else if (quiet_since_s_ < 0.0) {
+      quiet_since_s_ = s.t_s;
+    }
+    close = all && quiet_since_s_ >= 0.0 && s.t_s - quiet_since_s_ >= params_.stance_s;
+  } else {
+    close = all && now_a_lo;
+  }
+  if (!close) return false;
+
+  // Time thresholds: never faster than the absolute limit, nor than a fraction of the recent
+  // interval; after a long pause the cadence memory restarts.
+  const double since = s.t_s - last_step_t_s_;
+  if (since > params_.max_interval_s) interval_ema_s_ = params_.initial_interval_s;
+  const double t_min =
+      std::max(params_.min_interval_s, params_.min_interval_fraction * interval_ema_s_);
+  seen_ = {};
+  if (since < t_min) {
+    ++diag_.rejected_timing;
+    return false;
+  }
+  if (have_step_ && since <= params_.max_interval_s)
+    interval_ema_s_ += 0.3 * (since - interval_ema_s_);
+  event.t_s = s.t_s;
+  event.interval_s = have_step_ ? since : 0.0;
+  last_step_t_s_ = s.t_s;
+  have_step_ = true;
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+PeakStepDetector::PeakStepDetector(Params params) : params_(params), lp_(params.cutoff_hz) {}
+
+void PeakStepDetector::reset() { *this = PeakStepDetector(params_); }
+
+bool PeakStepDetector::update(const ImuSample& s, StepEvent& event) {
+  bool have_t = n_ > 0;
+  const double dt = gate(s, have_t, last_t_s_, diag_);
+  if (dt < 0.0) return false;
+  const double y = lp_.step(s.acc_body_m_s2.norm(), dt);
+  bool step = false;
+  if (n_ >= 2 && y1_ > y2_ && y1_ >= y && y1_ > params_.min_height_m_s2) {
+    if (t1_ - last_step_t_s_ >= params_.min_distance_s) {
+      event.t_s = t1_;
+      event.interval_s = last_step_t_s_ > -1e8 ? t1_ - last_step_t_s_ : 0.0;
+      last_step_t_s_ = t1_;
+      step = true;
+    } else {
+      ++diag_.rejected_timing;
+    }
+  }
+  y2_ = y1_;
+  y1_ = y;
+  t1_ = s.t_s;
+  n_ = std::min(n_ + 1, 2);
+  return step;
+}
+
+// ---------------------------------------------------------------------------------------------
+FixedThresholdStepDetector::FixedThresholdStepDetector(Params params)
+    : params_(params), lp_(params.cutoff_hz) {}
+
+void FixedThresholdStepDetector::reset() { *this = FixedThresholdStepDetector(params_); }
+
+bool FixedThresholdStepDetector::update(const ImuSample& s, StepEvent& event) {
+  const double dt = gate(s, have_t_, last_t_s_, diag_);
+  if (dt < 0.0) return false;
+  const double y = lp_.step(s.acc_body_m_s2.norm(), dt);
+  if (!armed_) {
+    if (y < params_.threshold_m_s2 - params_.hysteresis_m_s2) armed_ = true;
+    return false;
+  }
+  if (y <= params_.threshold_m_s2) return false;
+  armed_ = false;
+  if (s.t_s - last_step_t_s_ < params_.refractory_s) {
+    ++diag_.rejected_timing;
+    return false;
+  }
+  event.t_s = s.t_s;
+  event.interval_s = last_step_t_s_ > -1e8 ? s.t_s - last_step_t_s_ : 0.0;
+  last_step_t_s_ = s.t_s;
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+PeakValleyStepDetector::PeakValleyStepDetector(Params params)
+    : params_(params), lp_(params.cutoff_hz) {
+  interval_ema_s_ = params_.initial_interval_s;
+}
+
+void PeakValleyStepDetector::reset() { *this = PeakValleyStepDetector(params_); }
+
+bool PeakValleyStepDetector::update(const ImuSample& s, StepEvent& event) {
+  const double dt = gate(s, have_t_, last_t_s_, diag_);
+  if (dt < 0.0) return false;
+  const double y = lp_.step(s.acc_body_m_s2.norm(), dt);
+  const double k_mean = dt > 0.0 ? dt / (2.0 + dt) : 1.0;
+  mean_m_s2_ = n_ == 0 ? y : mean_m_s2_ + k_mean * (y - mean_m_s2_);
+  const bool is_max = n_ >= 2 && y1_ > y2_ && y1_ >= y;
+  const bool is_min = n_ >= 2 && y1_ < y2_ && y1_ <= y;
+  const double t1 = s.t_s - dt;  // time of the extremum (previous sample)
+  const double y_ext = y1_;
+  y2_ = y1_;
+  y1_ = y;
+  n_ = std::min(n_ + 1, 2);
+
+  // After a pause the previous step no longer describes the gait: forget it.
+  if (have_prev_ && s.t_s - last_step_t_s_ > params_.max_interval_s) {
+    have_prev_ = false;
+    interval_ema_s_ = params_.initial_interval_s;
+  }
+  if (phase_ == Phase::kSeekPeak) {
+    if (!is_max) return false;
+    // Eq. (12), first condition: the peak exceeds the mean of the previous peak and valley.
+    const double ref = have_prev_ ? 0.5 * (prev_peak_ + prev_valley_) : mean_m_s2_;
+    if (!(y_ext > ref) || !(y_ext > mean_m_s2_)) return false;
+    // Second condition: the time since the previous peak exceeds the time threshold.
+    const double t_th =
+        std::max(params_.min_interval_s, params_.min_interval_fraction * interval_ema_s_);
+    if (t1 - last_peak_t_s_ < t_th) {
+      ++diag_.rejected_timing;
+      return false;
+    }
+    cand_peak_ = y_ext;
+    cand_peak_t_s_ = t1;
+    valley_ = y_ext;
+    phase_ = Phase::kSeekValley;
+    return false;
+  }
+  // Seeking the valley that closes the step.
+  if (is_max && y_ext > cand_peak_) {  // a higher peak before any valley: it is the real peak
+    cand_peak_ = y_ext;
+    cand_peak_t_s_ = t1;
+    valley_ = y_ext;
+    return false;
+  }
+  valley_ = std::min(valley_, y);
+  if (s.t_s - cand_peak_t_s_ > params_.max_interval_s) {  // no valley: not a step
+    ++diag_.rejected_amplitude;
+    phase_ = Phase::kSeekPeak;
+    return false;
+  }
+  const double swing = cand_peak_ - valley_;
+  const bool risen = y - valley_ > params_.valley_rise_fraction * swing;
+  if (!risen) return false;
+  if (swing < params_.min_swing_m_s2 || !(valley_ < mean_m_s2_)) {
+    if (is_min) {  // a shallow dip: keep waiting for the real valley unless too late
+      ++diag_.rejected_amplitude;
+    }
+    return false;
+  }
+  const double since = cand_peak_t_s_ - last_peak_t_s_;
+  if (have_prev_ && since > 0.0 && since < params_.max_interval_s)
+    interval_ema_s_ += 0.3 * (since - interval_ema_s_);
+  event.t_s = s.t_s;
+  event.interval_s = have_prev_ ? s.t_s - last_step_t_s_ : 0.0;
+  prev_peak_ = cand_peak_;
+  prev_valley_ = valley_;
+  have_prev_ = true;
+  last_peak_t_s_ = cand_peak_t_s_;
+  last_step_t_s_ = s.t_s;
+  phase_ = Phase::kSeekPeak;
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+namespace {
+constexpr std::array<std::string_view, 4> kNames = {"adaptive", "peak", "fixed-threshold",
+                                                    "peak-valley"};
+}
+
+std::span<const std::string_view> step_detector_names() { return kNames; }
+
+std::string_view default_step_detector(StepMount mount) {
+  return mount == StepMount::kFoot ? "adaptive" : "peak-valley";
+}
+
+std::unique_ptr<StepDetector> make_step_detector(std::string_view name, StepMount mount) {
+  const bool foot = mount == StepMount::kFoot;
+  if (name == "adaptive") {
+    AdaptiveStepParams p;
+    if (!foot) {
+      // A body-worn sensor rotates at the stride (half the step) frequency: its gyro conditions
+      // would accept every other step only, so the body variant keeps the acceleration ones.
+      p.use_gyro = false;
+      p.require_stance = false;
+      p.acc_cutoff_hz = 4.0;
+      p.acc_floor_m_s2 = 0.4;
+      p.min_interval_s = 0.22;
+      p.initial_interval_s = 0.55;
+      p.max_interval_s = 2.0;
+    }
+    return std::make_unique<AdaptiveStepDetector>(p);
+  }
+  if (name == "peak") {
+    PeakStepParams p;
+    if (foot) {
+      p.min_height_m_s2 = 20.0;
+      p.min_distance_s = 0.6;
+    }
+    return std::make_unique<PeakStepDetector>(p);
+  }
+  if (name == "fixed-threshold") {
+    FixedThresholdStepParams p;
+    if (foot) {
+      p.threshold_m_s2 = 20.0;
+      p.hysteresis_m_s2 = 3.0;
+      p.refractory_s = 0.6;
+    }
+    return std::make_unique<FixedThresholdStepDetector>(p);
+  }
+  if (name == "peak-valley") {
+    PeakValleyStepParams p;
+    if (foot) {
+      p.min_interval_s = 0.36;
+      p.min_swing_m_s2 = 2.0;
+    }
+    return std::make_unique<PeakValleyStepDetector>(p);
+  }
+  return nullptr;
+}
+
+}  // namespace telltale::fusion

@@ -1,0 +1,110 @@
+// Gait simulator: physical invariants and the bookkeeping of its truth.
+#include "telltale/fusion/sim/gait_sim.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace telltale::fusion::sim {
+namespace {
+
+constexpr double kG = 9.80665;
+
+TEST(GaitSim, PeopleSpanTheHeightRangeAndGaitsOrderByCadenceAndLength) {
+  double lo = 9, hi = 0;
+  for (std::uint64_t s = 1; s <= 200; ++s) {
+    const Person p = random_person(s);
+    lo = std::min(lo, p.height_m);
+    hi = std::max(hi, p.height_m);
+    for (int g = 1; g < kGaitCount; ++g) {
+      EXPECT_GT(nominal_step_hz(static_cast<Gait>(g), p),
+                nominal_step_hz(static_cast<Gait>(g - 1), p));
+      EXPECT_GT(nominal_step_length_m(static_cast<Gait>(g), p),
+                nominal_step_length_m(static_cast<Gait>(g - 1), p));
+    }
+  }
+  EXPECT_GE(lo, 1.55);
+  EXPECT_LE(hi, 1.95);
+  EXPECT_LT(lo, 1.60);
+  EXPECT_GT(hi, 1.90);
+}
+
+TEST(GaitSim, DeterministicForASeed) {
+  const auto sc = *make_gait_scenario("phone-arm-swing-walk", 3);
+  const auto a = simulate_gait(sc, random_person(3), 3);
+  const auto b = simulate_gait(sc, random_person(3), 3);
+  ASSERT_EQ(a.samples.size(), b.samples.size());
+  for (std::size_t i = 0; i < a.samples.size(); i += 97)
+    EXPECT_EQ(a.samples[i].imu.acc_body_m_s2, b.samples[i].imu.acc_body_m_s2);
+}
+
+// Standing still: specific force g, no rotation, field magnitude of the earth's.
+TEST(GaitSim, AtRestTheSensorsSeeGravityAndTheEarthField) {
+  for (const char* name : {"foot-walk", "phone-call-walk", "phone-pocket-walk"}) {
+    const auto run = simulate_gait(*make_gait_scenario(name, 2), random_person(2), 2);
+    for (const auto& s : run.samples) {
+      if (s.imu.t_s > 1.5) break;
+      EXPECT_NEAR(s.imu.acc_body_m_s2.norm(), kG, 0.3) << name;
+      EXPECT_LT(s.imu.gyro_body_rad_s.norm(), 0.1) << name;
+      EXPECT_NEAR(s.mag_uT.norm(), std::hypot(20.0, 44.0), 4.0) << name;
+    }
+  }
+}
+
+// Walking: the truth counts, distance and foot/body relation add up, and the mean vertical
+// specific force over the walk is g (no net vertical acceleration).
+TEST(GaitSim, TruthBookkeepingAddsUp) {
+  for (const char* name : {"foot-mixed", "body-run", "phone-switch"}) {
+    const auto run = simulate_gait(*make_gait_scenario(name, 7), random_person(7), 7);
+    EXPECT_EQ(run.foot_step_times_s.size() * 2, run.step_times_s.size()) << name;
+    EXPECT_EQ(static_cast<std::size_t>(run.samples.back().steps), run.step_times_s.size());
+    EXPECT_EQ(static_cast<std::size_t>(run.samples.back().foot_steps),
+              run.foot_step_times_s.size());
+    EXPECT_NEAR(run.samples.back().distance_m, run.distance_m, 1e-9);
+    double mean_mag = 0;
+    for (const auto& s : run.samples) mean_mag += s.imu.acc_body_m_s2.norm();
+    mean_mag /= static_cast<double>(run.samples.size());
+    EXPECT_GT(mean_mag, kG - 0.2) << name;
+  }
+}
+
+// A closed loop returns to its start within two steps (the walk ends on the step that completes
+// the path, with an even number of steps so both feet stand together).
+TEST(GaitSim, ClosedLoopReturnsToTheStart) {
+  for (std::uint64_t s = 1; s <= 5; ++s) {
+    const auto run = simulate_gait(*make_gait_scenario("loop", s), random_person(s), s);
+    const auto& last = run.samples.back();
+    EXPECT_LT(std::hypot(last.x_m, last.y_m), 1.7);
+    EXPECT_GT(run.distance_m, 55.0);
+  }
+}
+
+// Foot: stance then swing; in swing the toe rotates fast about its pitch axis (y), the others stay
+// small; running reaches higher rates and forces than slow walking.
+TEST(GaitSim, FootRotatesAboutItsPitchAxisAndRunningIsHarder) {
+  auto peak = [](const char* name) {
+    const auto run = simulate_gait(*make_gait_scenario(name, 4), random_person(4), 4);
+    Eigen::Vector3d w = Eigen::Vector3d::Zero();
+    double f = 0;
+    for (const auto& s : run.samples) {
+      w = w.cwiseMax(s.imu.gyro_body_rad_s.cwiseAbs());
+      f = std::max(f, s.imu.acc_body_m_s2.norm());
+    }
+    return std::make_pair(w, f);
+  };
+  const auto slow = peak("foot-slow-walk");
+  const auto run = peak("foot-run");
+  EXPECT_GT(slow.first.y(), 3.0 * slow.first.x());
+  EXPECT_GT(run.first.y(), slow.first.y());
+  EXPECT_GT(run.second, slow.second);
+}
+
+TEST(GaitSim, UnknownScenariosAreRefused) {
+  EXPECT_FALSE(make_gait_scenario("foot-crawl", 1));
+  EXPECT_FALSE(make_gait_scenario("phone-bag-walk", 1));
+  EXPECT_FALSE(make_gait_scenario("boat", 1));
+  for (const auto& e : gait_scenario_examples()) EXPECT_TRUE(make_gait_scenario(e, 1)) << e;
+}
+
+}  // namespace
+}  // namespace telltale::fusion::sim

@@ -1,0 +1,225 @@
+// PDR (seed 003): pose rotations, magnetic heading geometry, the heading filter against analytic
+// motion, BP training determinism and the shipped model on held-out people, step-length
+// calibration, and closed-loop walks on the simulator.
+#include "telltale/fusion/pdr.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+#include "telltale/fusion/sim/pose_dataset.hpp"
+
+namespace telltale::fusion {
+namespace {
+
+constexpr double kG = 9.80665;
+constexpr double kDeg = M_PI / 180.0;
+
+TEST(PoseRotation, PaperMatricesAreProperRotations) {
+  for (int p = 0; p < kPoseCount; ++p) {
+    const Eigen::Matrix3d m = pose_rotation(static_cast<PhonePose>(p));
+    EXPECT_TRUE((m * m.transpose()).isIdentity(1e-15));
+    EXPECT_NEAR(m.determinant(), 1.0, 1e-15);
+  }
+  // Eqs. (14)-(15) as printed: call [[0,0,-1],[0,-1,0],[-1,0,0]], pocket
+  // [[0,0,-1],[0,1,0],[1,0,0]].
+  EXPECT_EQ(pose_rotation(PhonePose::kCall) * Eigen::Vector3d(1, 2, 3),
+            Eigen::Vector3d(-3, -2, -1));
+  EXPECT_EQ(pose_rotation(PhonePose::kPocket) * Eigen::Vector3d(1, 2, 3),
+            Eigen::Vector3d(-3, 2, 1));
+}
+
+// Walking frame x forward, y left, z up; earth field ENU (0, 20, -44) uT. For a heading psi the
+// field in the walking frame is (20 cos psi, 20 sin psi, -44) — the tilt-compensated heading must
+// return psi whatever the tilt.
+TEST(HeadingFilter, MagneticHeadingInvertsTheFieldGeometryUnderTilt) {
+  for (double psi : {0.0, 37.0, 90.0, 181.0, 300.0}) {
+    const Eigen::Vector3d m_level(20 * std::cos(psi * kDeg), 20 * std::sin(psi * kDeg), -44);
+    for (double roll : {-30.0, 0.0, 20.0})
+      for (double pitch : {-25.0, 0.0, 40.0}) {
+        // Tilt the sensor: vectors in the tilted frame are R^T v.
+        const Eigen::Matrix3d r = (Eigen::AngleAxisd(pitch * kDeg, Eigen::Vector3d::UnitY()) *
+                                   Eigen::AngleAxisd(roll * kDeg, Eigen::Vector3d::UnitX()))
+                                      .toRotationMatrix();
+        const double h = HeadingFilter::magnetic_heading_rad(
+            r.transpose() * m_level, r.transpose() * Eigen::Vector3d::UnitZ());
+        EXPECT_NEAR(std::remainder(h / kDeg - psi, 360.0), 0.0, 1e-9) << psi << roll << pitch;
+      }
+  }
+}
+
+// Given a level sensor turning right at 20 deg/s with a consistent magnetometer, when filtered,
+// then the heading follows the turn (clockwise heading increases) within a degree.
+TEST(HeadingFilter, FollowsAConstantRightTurn) {
+  HeadingFilter f;
+  const double rate = 20.0 * kDeg;
+  for (int k = 0; k <= 500; ++k) {
+    const double t = k * 0.02;
+    const double psi = 10.0 * kDeg + rate * t;
+    const Eigen::Vector3d mag(20 * std::cos(psi), 20 * std::sin(psi), -44);
+    f.update(t, {0, 0, -rate}, {0, 0, kG}, mag);  // right turn = negative yaw rate about up
+  }
+  EXPECT_NEAR(std::remainder(f.heading_rad() / kDeg - (10.0 + 200.0), 360.0), 0.0, 1.0);
+  EXPECT_EQ(f.diagnostics().rejected_mag, 0u);
+}
+
+TEST(HeadingFilter, GyroOnlyWithoutMagnetometerAndRejectsNaN) {
+  HeadingFilter f;
+  const Eigen::Vector3d no_mag = Eigen::Vector3d::Constant(std::nan(""));
+  for (int k = 0; k <= 100; ++k) f.update(k * 0.01, {0, 0, 0.5}, {0, 0, kG}, no_mag);
+  // Left turn at 0.5 rad/s for 1 s from heading 0: heading 360 - 28.6 deg.
+  EXPECT_NEAR(std::remainder(f.heading_rad() / kDeg + 0.5 / kDeg, 360.0), 0.0, 1e-6);
+  f.update(1.5, {std::nan(""), 0, 0}, {0, 0, std::nan("")}, no_mag);
+  EXPECT_EQ(f.diagnostics().rejected_non_finite, 1u);
+}
+
+TEST(PoseNetwork, TrainingIsDeterministicAndTheModelFileRoundTrips) {
+  const auto set = sim::simulate_pose_windows(1, 3, 6);
+  PoseTrainingParams p;
+  p.epochs = 30;
+  const PoseNetwork a = train_pose_network(set.features, set.labels, p);
+  const PoseNetwork b = train_pose_network(set.features, set.labels, p);
+  EXPECT_EQ(a.w_ih, b.w_ih);
+  EXPECT_EQ(a.w_ho, b.w_ho);
+  StepLengthModel len;
+  len.abc[2] = {0.5, 0.3, -0.4};
+  PoseNetwork c;
+  StepLengthModel len2;
+  ASSERT_TRUE(parse_pdr_model(format_pdr_model(a, len), c, len2));
+  EXPECT_TRUE(c.w_ih.isApprox(a.w_ih, 1e-15));
+  EXPECT_TRUE(c.b_o.isApprox(a.b_o, 1e-15));
+  EXPECT_EQ(len2.abc[2], len.abc[2]);
+  EXPECT_FALSE(parse_pdr_model("w_ih 2 2 1 2 3 4\n", c, len2));
+  EXPECT_FALSE(parse_pdr_model("in_mean 3 1 1 nan 2\n", c, len2));
+}
+
+// The shipped network (trained by tools/train_pose on people 1..23) on 10 people it never saw:
+// seed 003 reports > 90 % (decision tree) and > 94 % (SVM) for related work; we require 95 %.
+TEST(PoseNetwork, ShippedModelClassifiesHeldOutPeopleAtLeast95Percent) {
+  const PoseNetwork& net = builtin_pose_network();
+  ASSERT_TRUE(net.trained) << "fusion_core/data/pose_bp.txt missing or malformed";
+  const auto set = sim::simulate_pose_windows(1001, 10, 20);
+  std::size_t ok = 0;
+  for (std::size_t i = 0; i < set.features.size(); ++i)
+    ok += net.classify(set.features[i]) == set.labels[i] ? 1u : 0u;
+  const double acc = static_cast<double>(ok) / static_cast<double>(set.features.size());
+  RecordProperty("held_out_accuracy_percent", std::to_string(100.0 * acc));
+  EXPECT_GE(acc, 0.95);
+}
+
+// Walks generated from known coefficients are fitted back exactly (the model is linear).
+TEST(StepLengthCalibration, RecoversKnownCoefficientsAndStaysNearThePriorWithOneWalk) {
+  const Eigen::Vector3d truth(0.45, 0.25, -0.35);
+  std::vector<CalibrationWalk> walks;
+  for (double h : {1.58, 1.72, 1.90})
+    for (double f : {1.5, 1.9, 2.2}) {
+      CalibrationWalk w;
+      w.height_m = h;
+      w.step_hz.assign(40, f);
+      w.distance_m = 40 * (truth[0] * h + truth[1] * f + truth[2]);
+      walks.push_back(w);
+    }
+  const Eigen::Vector3d fit = calibrate_step_length(walks, Eigen::Vector3d::Zero(), 1e-9);
+  EXPECT_TRUE(fit.isApprox(truth, 1e-6)) << fit.transpose();
+  // One walk of known length: the fitted model reproduces that walk's length.
+  const Eigen::Vector3d prior(0.3, 0.4, -0.51);
+  const Eigen::Vector3d one = calibrate_step_length({walks[4]}, prior, 1e-3);
+  const double per_step = one[0] * walks[4].height_m + one[1] * 1.9 + one[2];
+  EXPECT_NEAR(40 * per_step, walks[4].distance_m, 0.01 * walks[4].distance_m);
+}
+
+// Given a walker with a phone held in hand on a straight line with ideal sensors, when the PDR
+// runs, then the step count and the straight-line distance are right within 5 % and the track
+// points the right way.
+TEST(Pdr, StraightWalkHandHeld) {
+  auto sc = *sim::make_gait_scenario("phone-hand-held-walk", 11);
+  sc.path = {{500.0, 0.0}};
+  sc.start_heading_deg = 60.0;
+  sc.errors.acc_bias_m_s2 = sc.errors.gyro_bias_rad_s = sc.errors.mag_bias_uT = 0.0;
+  auto person = sim::random_person(11);
+  for (int i = 0; i < kPoseCount; ++i) person.mount_yaw_deg[i] = person.mount_tilt_deg[i] = 0.0;
+  const auto run = sim::simulate_gait(sc, person, 11);
+  PdrParams p;
+  p.height_m = person.height_m;
+  Pdr pdr(p);
+  for (const auto& s : run.samples) (void)pdr.update(s.imu, s.mag_uT);
+  const auto& out = pdr.output();
+  EXPECT_NEAR(static_cast<double>(out.steps), static_cast<double>(run.step_times_s.size()), 1.0);
+  EXPECT_NEAR(out.distance_m, run.distance_m, 0.05 * run.distance_m);
+  EXPECT_NEAR(std::atan2(out.x_m, out.y_m) / kDeg, 60.0, 1.5);
+  EXPECT_EQ(out.pose, PhonePose::kHandHeld);
+  EXPECT_GT(out.cadence_spm, 80.0);
+}
+
+// Given a phone without gyroscope (accelerometer + magnetometer), when walking straight, then
+// the PDR still counts, keeps the hand-held frame and lays the track along the magnetic heading.
+TEST(Pdr, AccelerometerAndMagnetometerOnly) {
+  auto sc = *sim::make_gait_scenario("phone-hand-held-walk", 12);
+  sc.path = {{500.0, 0.0}};
+  sc.start_heading_deg = 200.0;
+  const auto person = sim::random_person(12);
+  const auto run = sim::simulate_gait(sc, person, 12);
+  PdrParams p;
+  p.height_m = person.height_m;
+  Pdr pdr(p);
+  for (auto s : run.samples) {
+    s.imu.gyro_body_rad_s.setConstant(std::nan(""));
+    (void)pdr.update(s.imu, s.mag_uT);
+  }
+  EXPECT_NEAR(static_cast<double>(pdr.output().steps), static_cast<double>(run.step_times_s.size()),
+              1.0);
+  EXPECT_GT(std::hypot(pdr.output().x_m, pdr.output().y_m), 0.9 * run.distance_m);
+  EXPECT_NEAR(std::remainder(std::atan2(pdr.output().x_m, pdr.output().y_m) / kDeg - 200.0, 360.0),
+              0.0, 8.0);
+}
+
+// Given the four poses in turn on a straight walk, then the switches are detected by
+// cross-correlation and the final pose is the true one.
+TEST(Pdr, DetectsPoseSwitchesAndEndsInTheTruePose) {
+  auto sc = *sim::make_gait_scenario("phone-switch", 5);
+  sc.path = {{2000.0, 0.0}};
+  const auto person = sim::random_person(5);
+  const auto run = sim::simulate_gait(sc, person, 5);
+  PdrParams p;
+  p.height_m = person.height_m;
+  Pdr pdr(p);
+  for (const auto& s : run.samples) (void)pdr.update(s.imu, s.mag_uT);
+  EXPECT_GE(pdr.diagnostics().switches, 3u);
+  EXPECT_EQ(pdr.output().pose, run.samples.back().pose);
+  EXPECT_NEAR(std::atan2(pdr.output().x_m, pdr.output().y_m) / kDeg, 0.0, 5.0);
+}
+
+// Closed loops with pose switches (people held out of training). The issue asks for end-point
+// error <= 2 % of the distance in >= 90 % of walks (seed 003: 85 %). With this simulator's sensor
+// error model that is NOT reached: the measured figures (fusion_cli steps-eval --tables pdr) are
+// about 30 % of walks within 2 %, median 3.7 %; with ideal sensors and one pose the median is
+// 1.0 %. The per-pose heading bias of a 1 uT hard-iron residual and 2 deg of phone yaw (2-4 deg,
+// different in every pose) is what stands between; see /work/notes/issue-5.md. This test holds the
+// line at what is measured so a regression shows.
+TEST(Pdr, ClosedLoopsWithPoseSwitchesMeasuredFigures) {
+  std::vector<double> err;
+  for (int i = 0; i < 20; ++i)
+    err.push_back(sim::simulate_pdr_loop(static_cast<std::uint64_t>(2001 + i)).error_fraction);
+  std::sort(err.begin(), err.end());
+  const auto within = std::count_if(err.begin(), err.end(), [](double e) { return e <= 0.02; });
+  RecordProperty("within_2_percent", std::to_string(within));
+  RecordProperty("median_percent", std::to_string(100 * err[10]));
+  EXPECT_LE(err[10], 0.045);
+  EXPECT_GE(within, 5);
+  EXPECT_LE(err[17], 0.09);
+}
+
+TEST(Pdr, ClosedLoopsWithIdealSensorsInOnePose) {
+  std::vector<double> err;
+  for (int i = 0; i < 10; ++i)
+    err.push_back(sim::simulate_pdr_loop(static_cast<std::uint64_t>(2001 + i),
+                                         sim::LoopVariant::kIdealSensors)
+                      .error_fraction);
+  std::sort(err.begin(), err.end());
+  EXPECT_LE(err[5], 0.03);
+}
+
+}  // namespace
+}  // namespace telltale::fusion
