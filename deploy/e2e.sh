@@ -24,7 +24,7 @@ command -v node >/dev/null || { echo "e2e: FAILED: node not found (Node.js >= 20
 major=$(node -p 'process.versions.node.split(".")[0]')
 [ "$major" -ge 20 ] || { echo "e2e: FAILED: Node.js $major found, >= 20 needed" >&2; exit 1; }
 "$root/deploy/web_deps.sh"
-for b in shore_server boat_node; do
+for b in shore_server boat_node wearable_node; do
   [ -x "$bin/$b" ] || { echo "e2e: FAILED: $bin/$b not built" >&2; exit 1; }
 done
 mkdir -p "$root/tests/artifacts"

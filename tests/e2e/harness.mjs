@@ -42,6 +42,11 @@ function start(cmd, args, readyPattern, timeoutMs = 15000) {
     };
     child.stdout.on('data', onData);
     child.stderr.on('data', (d) => { out += d; });
+    child.on('error', (err) => {
+      children.delete(child);
+      clearTimeout(timer);
+      reject(new Error(`${cmd}: ${err.message}`));
+    });
     child.on('exit', (code) => {
       children.delete(child);
       clearTimeout(timer);
@@ -86,6 +91,13 @@ export async function startFleet({ domain, boats = [] }) {
       await b.ready;
       this.boats.set(id, b.child);
       return b.child;
+    },
+    async addAthlete(id, extra = []) {
+      const w = start(join(binDir, 'wearable_node'), ['--domain', String(domain), '--athlete-id', id, ...extra],
+        /wearable_node ready/);
+      await w.ready;
+      this.boats.set(`athlete:${id}`, w.child);
+      return w.child;
     },
     async rest(path, init = {}) {
       const res = await fetch(`${url}api/v1${path}`, {

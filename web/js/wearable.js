@@ -60,8 +60,16 @@ export function mountWearables(container, { live }) {
       (Number.isFinite(a.heading_deg) ? ` · HDG ${a.heading_deg.toFixed(0)}°` : '');
     // Track: recorded part, then what arrived live; x east, y north -> SVG y down.
     const rec = recorded.get(id) ?? { x_m: [], y_m: [] };
-    const xs = [...rec.x_m, ...entry.track.x];
-    const ys = [...rec.y_m, ...entry.track.y];
+    const xs = [];
+    const ys = [];
+    const addPoints = (px, py) => px.forEach((x, i) => {
+      if (Number.isFinite(x) && Number.isFinite(py[i])) {
+        xs.push(x);
+        ys.push(py[i]);
+      }
+    });
+    addPoints(rec.x_m, rec.y_m);
+    addPoints(entry.track.x, entry.track.y);
     if (!xs.length) return;
     const minX = Math.min(...xs);
     const maxX = Math.max(...xs);
