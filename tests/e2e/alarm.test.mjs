@@ -37,7 +37,10 @@ test('an alarm shows in the fleet view within 2 s of the boat crossing the thres
       if (card.dataset.alarm === 'alarm' && !window.__alarmSeenMs) window.__alarmSeenMs = Date.now();
     }).observe(card, { attributes: true, attributeFilter: ['data-alarm'] });
   });
-  // Six seconds cover a full roll cycle (3-6 s): put the threshold in the middle of it.
+  // The simulated boat bears away from 0 deg during its first seconds: skip those, then take
+  // six seconds (a full roll cycle is 3-6 s) and put the threshold in the middle of them.
+  await page.waitForTimeout(3000);
+  await page.evaluate(() => { window.__samples = []; });
   await page.waitForTimeout(6500);
   const heels = (await page.evaluate(() => window.__samples)).map((s) => s.heel);
   const lo = Math.min(...heels);

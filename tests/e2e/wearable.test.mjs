@@ -29,6 +29,8 @@ test('wearable view: steps, cadence, gait, pose and a growing track', async () =
   await eventually(async () => Number.isFinite(await num('steps')), { what: 'a step count' });
   const steps0 = await num('steps');
   await eventually(async () => (await num('steps')) > steps0, { timeoutMs: 6000, what: 'steps to increase' });
+  // Cadence needs a few steps to be estimated; then it is a walking or running pace.
+  await eventually(async () => (await num('cadence')) > 0, { timeoutMs: 6000, what: 'a cadence' });
   const cadence = await num('cadence');
   assert.ok(cadence > 30 && cadence < 250, `cadence ${cadence} spm`);
   assert.notEqual(await page.textContent(`${card} .gait`), '–');

@@ -52,7 +52,7 @@ export function mountWearables(container, { live }) {
     put('steps', String(a.steps ?? '–'));
     put('cadence', Number.isFinite(a.cadence_spm) ? a.cadence_spm.toFixed(0) : '–');
     put('gait', a.gait ?? '–');
-    put('pose', a.pose ?? '–');
+    put('pose', a.pose ? a.pose.replace(/_/g, ' ') : '–');
     put('distance', Number.isFinite(a.distance_m) ? a.distance_m.toFixed(0) : '–');
     const stale = a.stale || Date.now() - entry.receivedAt > 3000;
     c.dataset.stale = String(stale);
@@ -78,6 +78,7 @@ export function mountWearables(container, { live }) {
     const span = Math.max(maxX - minX, maxY - minY, 10) * 1.15;
     const cx = (minX + maxX) / 2;
     const cy = (minY + maxY) / 2;
+    c.querySelector('.meta').textContent += ` · track ${span.toFixed(0)} m across, north up`;
     const p = c._parts;
     p.plot.setAttribute('viewBox', `${cx - span / 2} ${-cy - span / 2} ${span} ${span}`);
     p.path.setAttribute('points', xs.map((x, i) => `${x.toFixed(2)},${(-ys[i]).toFixed(2)}`).join(' '));
