@@ -86,7 +86,7 @@ export function updateCard(root, entry, stale) {
   p.side.setAttribute('transform', `rotate(${(-(b.pitch_deg ?? 0)).toFixed(1)})`);
   const leds = b.leds ?? { left: 0, right: 0, up: 0, down: 0, count: 6 };
   for (const s of ['left', 'right', 'up', 'down']) ledBar(p.leds[s], leds[s] ?? 0, leds.count || 6);
-  const age = (Date.now() - entry.receivedAt) / 1000;
+  const age = Math.max(0, (Date.now() - b.t_utc_ns / 1e6) / 1000); // since the boat's last sample
   p.meta.textContent =
     `${b.last_sample_time.slice(11, 19)} UTC` +
     (b.heading_deg === null || b.heading_deg === undefined ? '' : ` · HDG ${b.heading_deg.toFixed(0)}°`) +
