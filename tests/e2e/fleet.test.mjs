@@ -51,6 +51,14 @@ test('fleet view: a card per boat with live heel and pitch that change', async (
     { timeoutMs: 3000, what: 'sparkline points' });
 });
 
+test('the alarm sound switches on and off from the header (Web Audio, after a click)', async () => {
+  await page.click('#sound');
+  assert.equal(await page.getAttribute('#sound', 'aria-pressed'), 'true');
+  assert.equal(await page.textContent('#sound'), 'Sound on');
+  await page.click('#sound');
+  assert.equal(await page.getAttribute('#sound', 'aria-pressed'), 'false');
+});
+
 test('fleet view: sorting by heel orders the cards by |heel|', async () => {
   await page.selectOption('#sort', 'heel');
   await page.waitForTimeout(1200); // cards re-sort once a second
