@@ -4,26 +4,28 @@
 
 namespace telltale::shore {
 namespace {
-std::string frame(const std::string& type, const std::string& data) {
-  std::string f;
-  f.reserve(type.size() + data.size() + 16);
-  f += "event: ";
-  f += type;
-  f += "\ndata: ";
-  f += data;  // JSON from nlohmann::dump() has no raw newlines
-  f += "\n\n";
+std::shared_ptr<const std::string> frame(const std::string& type, const std::string& data) {
+  auto f = std::make_shared<std::string>();
+  f->reserve(type.size() + data.size() + 16);
+  *f += "event: ";
+  *f += type;
+  *f += "\ndata: ";
+  *f += data;  // JSON from nlohmann::dump() has no raw newlines
+  *f += "\n\n";
   return f;
 }
 }  // namespace
 
-LiveHub::LiveHub(std::size_t max_clients, std::size_t max_events)
-    : max_clients_(max_clients), max_events_(max_events) {}
+LiveHub::LiveHub(std::size_t max_clients, std::size_t max_events,
+                 std::chrono::milliseconds frame_interval)
+    : max_clients_(max_clients), max_events_(max_events), frame_interval_(frame_interval) {}
 
 std::shared_ptr<LiveHub::Client> LiveHub::connect(std::optional<std::string> only_key) {
   std::lock_guard lock(mutex_);
   if (closed_ || clients_.size() >= max_clients_) return nullptr;
   auto client = std::make_shared<Client>();
   client->only_key_ = std::move(only_key);
+  client->seen_version_ = version_;  // the stream starts with its own snapshot
   clients_.push_back(client);
   return client;
 }
@@ -33,22 +35,19 @@ void LiveHub::disconnect(const std::shared_ptr<Client>& client) {
   clients_.erase(std::remove(clients_.begin(), clients_.end(), client), clients_.end());
 }
 
-void LiveHub::publish_sample(const std::string& key, std::string data) {
-  {
-    std::lock_guard lock(mutex_);
-    if (clients_.empty()) return;
-    for (auto& c : clients_)
-      if (!c->only_key_ || *c->only_key_ == key) c->latest_[key] = data;
-  }
-  cv_.notify_all();
+void LiveHub::publish_sample(const std::string& key, const std::string& data) {
+  auto f = frame("sample", data);  // built outside the lock
+  std::lock_guard lock(mutex_);
+  Latest& l = latest_[key];
+  l.version = ++version_;
+  l.frame = std::move(f);
 }
 
 void LiveHub::publish_event(const std::string& type, const std::string& data,
                             const std::string& key) {
-  const std::string f = frame(type, data);
+  const auto f = frame(type, data);
   {
     std::lock_guard lock(mutex_);
-    if (clients_.empty()) return;
     for (auto& c : clients_) {
       if (c->only_key_ && *c->only_key_ != key) continue;
       if (c->events_.size() >= max_events_) {
@@ -61,21 +60,45 @@ void LiveHub::publish_event(const std::string& type, const std::string& data,
   cv_.notify_all();
 }
 
+bool LiveHub::pending(const Client& c) const {
+  if (!c.events_.empty() || c.dropped_events_ > 0) return true;
+  if (version_ <= c.seen_version_) return false;
+  if (!c.only_key_) return true;
+  const auto it = latest_.find(*c.only_key_);
+  return it != latest_.end() && it->second.version > c.seen_version_;
+}
+
 std::string LiveHub::wait(Client& client, std::chrono::milliseconds timeout, bool& closed) {
+  using Clock = std::chrono::steady_clock;
+  const auto deadline = Clock::now() + timeout;
   std::unique_lock lock(mutex_);
-  cv_.wait_for(lock, timeout,
-               [&] { return closed_ || !client.latest_.empty() || !client.events_.empty(); });
+  // Pace: one batch per frame interval at most (a stop still wakes us).
+  cv_.wait_until(lock, std::min(client.next_frame_, deadline), [this] { return closed_; });
+  // Samples do not notify: look again every frame interval; events wake us at once.
+  while (!closed_ && !pending(client)) {
+    const auto now = Clock::now();
+    if (now >= deadline) break;
+    cv_.wait_until(lock, std::min(deadline, now + frame_interval_),
+                   [&] { return closed_ || !client.events_.empty(); });
+  }
   closed = closed_;
   std::string out;
+  if (closed || !pending(client)) return out;
+  client.next_frame_ = Clock::now() + frame_interval_;
   if (client.dropped_events_ > 0) {
     // The client was too slow to take every event: tell it, so it can refetch what it missed.
-    out += frame("overflow", "{\"dropped_events\":" + std::to_string(client.dropped_events_) + "}");
+    out += *frame("overflow",
+                  "{\"dropped_events\":" + std::to_string(client.dropped_events_) + "}");
     client.dropped_events_ = 0;
   }
-  for (auto& e : client.events_) out += e;
+  for (const auto& e : client.events_) out += *e;
   client.events_.clear();
-  for (auto& [key, data] : client.latest_) out += frame("sample", data);
-  client.latest_.clear();
+  for (const auto& [key, l] : latest_) {
+    if (l.version <= client.seen_version_) continue;
+    if (client.only_key_ && *client.only_key_ != key) continue;
+    out += *l.frame;
+  }
+  client.seen_version_ = version_;
   return out;
 }
 

@@ -1,13 +1,19 @@
 #pragma once
 /// \file
-/// Live push to dashboards (Server-Sent Events). Each client has its own mailbox: the latest
-/// sample per boat (a slow client skips intermediate samples, it never queues them) and a bounded
-/// queue of events (alarms, stale/live changes) that are never coalesced. Frames are serialised
-/// once per publish, not once per client.
+/// Live push to dashboards (Server-Sent Events), built so that no number of slow or fast
+/// dashboards can slow down ingest.
+///
+/// Samples: the hub keeps only the latest frame per key (boat); publishing replaces it under a
+/// short lock and wakes nobody. Each client takes, at most once per frame interval (default
+/// 40 ms = the boats' 25 Hz), every key that changed since its previous batch: a slow client skips
+/// intermediate samples, it never queues them. Events (alarms, athletes) are queued per client
+/// (bounded, the oldest dropped and reported as `overflow`) and wake the client at once. Frames
+/// are serialised once per publish and shared between clients.
 
 #include <chrono>
 #include <condition_variable>
 #include <cstddef>
+#include <cstdint>
 #include <deque>
 #include <map>
 #include <memory>
@@ -23,21 +29,22 @@ class LiveHub {
   class Client;
 
   /// At most `max_clients` streams at once; at most `max_events` events wait per client.
-  LiveHub(std::size_t max_clients, std::size_t max_events);
+  LiveHub(std::size_t max_clients, std::size_t max_events,
+          std::chrono::milliseconds frame_interval = std::chrono::milliseconds(40));
 
   /// A new client, or nullptr when the hub is full or closed. With `only_key` set the client gets
   /// samples and events of that key (boat) alone (an athlete's dashboard).
   std::shared_ptr<Client> connect(std::optional<std::string> only_key = std::nullopt);
   void disconnect(const std::shared_ptr<Client>& client);
 
-  /// Replaces the pending sample of `key` for every client. `data` is the JSON payload.
-  void publish_sample(const std::string& key, std::string data);
-  /// Queues an event of SSE type `type` about `key` for every client that may see it (the oldest
-  /// is dropped when a client's queue is full).
+  /// Replaces the latest sample of `key`. `data` is the JSON payload.
+  void publish_sample(const std::string& key, const std::string& data);
+  /// Queues an event of SSE type `type` about `key` for every client that may see it.
   void publish_event(const std::string& type, const std::string& data, const std::string& key);
 
-  /// Waits up to `timeout` for anything pending and returns it as SSE frames; empty on timeout.
-  /// Sets `closed` when the hub is shutting down (the stream must end).
+  /// The next batch for `client` as SSE frames, waiting up to `timeout` for something to send
+  /// (and at least until the client's next frame time). Empty on timeout. Sets `closed` when the
+  /// hub is shutting down (the stream must end).
   std::string wait(Client& client, std::chrono::milliseconds timeout, bool& closed);
 
   /// Wakes every waiting client and refuses new ones.
@@ -45,10 +52,19 @@ class LiveHub {
   [[nodiscard]] std::size_t clients() const;
 
  private:
+  struct Latest {
+    std::uint64_t version = 0;
+    std::shared_ptr<const std::string> frame;
+  };
+  [[nodiscard]] bool pending(const Client& c) const;
+
   std::size_t max_clients_;
   std::size_t max_events_;
+  std::chrono::milliseconds frame_interval_;
   mutable std::mutex mutex_;
   std::condition_variable cv_;
+  std::map<std::string, Latest> latest_;
+  std::uint64_t version_ = 0;
   std::vector<std::shared_ptr<Client>> clients_;
   bool closed_ = false;
 };
@@ -57,8 +73,9 @@ class LiveHub::Client {
  private:
   friend class LiveHub;
   std::optional<std::string> only_key_;
-  std::map<std::string, std::string> latest_;     ///< key -> payload of the newest sample
-  std::deque<std::string> events_;                ///< ready SSE frames
+  std::uint64_t seen_version_ = 0;  ///< samples up to this version were sent
+  std::chrono::steady_clock::time_point next_frame_{};
+  std::deque<std::shared_ptr<const std::string>> events_;
   std::size_t dropped_events_ = 0;
 };
 

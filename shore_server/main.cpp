@@ -4,7 +4,10 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <condition_variable>
+#include <mutex>
 #include <thread>
+#include <vector>
 
 #include "alarm_service.hpp"
 #include "auth.hpp"
@@ -33,6 +36,44 @@ struct Options {
   int stale_ms = 2000;
   int commit_ms = 250;
   int session_gap_s = 60;
+  int stream_interval_ms = 100;
+};
+
+/// Live samples from the DDS listener to the live worker (fleet model, alarms, dashboards).
+class LiveQueue {
+ public:
+  void push(const AttitudeSample& s, std::uint64_t arrival_utc_ns) {
+    {
+      std::lock_guard lock(mutex_);
+      // 5 s of a 200-boat fleet at 25 Hz: beyond that the live view skips ahead (the
+      // recording has its own queue and loses nothing).
+      if (queue_.size() >= 25000) queue_.clear();
+      queue_.emplace_back(s, arrival_utc_ns);
+    }
+    cv_.notify_one();
+  }
+  /// Swaps out everything queued; false once closed.
+  bool take(std::vector<std::pair<AttitudeSample, std::uint64_t>>& out) {
+    out.clear();
+    std::unique_lock lock(mutex_);
+    cv_.wait(lock, [&] { return closed_ || !queue_.empty(); });
+    if (closed_) return false;
+    out.swap(queue_);
+    return true;
+  }
+  void close() {
+    {
+      std::lock_guard lock(mutex_);
+      closed_ = true;
+    }
+    cv_.notify_all();
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::vector<std::pair<AttitudeSample, std::uint64_t>> queue_;
+  bool closed_ = false;
 };
 
 void add_tokens(const Options& o, TokenStore& tokens) {
@@ -61,16 +102,27 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
   o.store.session_gap = std::chrono::seconds(o.session_gap_s);
   Store store(o.store);
   FleetModel fleet(std::chrono::milliseconds(o.stale_ms));
-  LiveHub hub(o.http.max_stream_clients, 256);
+  LiveHub hub(o.http.max_stream_clients, 256, std::chrono::milliseconds(o.stream_interval_ms));
   AlarmService alarms(store, hub, fleet);
 
+  // Fast DDS calls the listener on its receive thread: it only queues, so reception never waits
+  // for the fleet model, the alarms or the dashboards. The recording is queued first; the live
+  // path runs on a worker of its own and, if it ever falls 5 s behind, skips to the newest.
+  LiveQueue live;
+  std::thread live_worker([&] {
+    std::vector<std::pair<AttitudeSample, std::uint64_t>> batch;
+    while (live.take(batch)) {
+      for (const auto& [s, arrival_utc] : batch) {
+        const BoatView view = fleet.update(s, std::chrono::steady_clock::now(), arrival_utc);
+        alarms.on_sample(s, view.status ? view.status->group : std::string());
+        hub.publish_sample(s.boat_id, boat_json(view));
+      }
+    }
+  });
   FleetCallbacks callbacks;
   callbacks.on_attitude = [&](const AttitudeSample& s) {
-    const BoatView view =
-        fleet.update(s, std::chrono::steady_clock::now(), telltale::utc_now_ns());
     store.enqueue(s);
-    alarms.on_sample(s, view.status ? view.status->group : std::string());
-    hub.publish_sample(s.boat_id, boat_json(view));
+    live.push(s, telltale::utc_now_ns());
   };
   callbacks.on_backfill = [&](const AttitudeSample& s) {
     // Old samples go to the recording only: the live view and the alarms are about now.
@@ -112,6 +164,8 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
   hub.close();
   api.stop();
   http_thread.join();
+  live.close();
+  live_worker.join();
   std::printf("shore_server stopped: %llu samples committed\n",
               static_cast<unsigned long long>(store.committed()));
 }
@@ -123,6 +177,7 @@ int main(int argc, char** argv) {
   Options o;
   int domain = -1;
   CLI::App app{"Telltale shore server: fleet over DDS -> SQLite, REST API, live stream, dashboard"};
+  app.set_config("--config", "", "read options from this file (INI/TOML: key = value)");
   app.add_option("--domain", domain, "DDS domain id (default: $TELLTALE_DOMAIN)");
   app.add_option("--http-port", o.http.port, "HTTP port; 0 picks a free one and prints it")
       ->capture_default_str();
@@ -146,6 +201,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--rest-threads", o.http.rest_threads, "HTTP workers besides the streams")
       ->capture_default_str();
+  app.add_option("--stream-interval-ms", o.stream_interval_ms,
+                 "a live-stream client gets each boat's latest sample at most this often")
+      ->capture_default_str()
+      ->check(CLI::Range(10, 5000));
   app.add_option("--stale-ms", o.stale_ms, "a boat silent this long is stale")
       ->capture_default_str();
   app.add_option("--commit-ms", o.commit_ms, "store commit interval (the durability window)")

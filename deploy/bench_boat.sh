@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# CPU and memory of one boat node (issue 6): 100 Hz simulated IMU, 25 Hz publishing to a shore,
+# session log on, for SECONDS (default 60). Loopback only.
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+bin="$root/build/bin"
+seconds=${1:-60}
+domain=$((150 + $$ % 50))
+dir=$(mktemp -d)
+trap 'kill -INT $shore 2>/dev/null || true; wait 2>/dev/null || true; rm -rf "$dir"' EXIT
+"$bin/shore_server" --domain "$domain" --http-port 0 --db "$dir/s.db" --coach-token t >"$dir/shore" 2>&1 &
+shore=$!
+sleep 1
+"$bin/boat_node" --domain "$domain" --boat-id bench --imu-rate-hz 100 --rate-hz 25 \
+  --log-dir "$dir/log" >"$dir/boat" 2>&1 &
+boat=$!
+sleep 3  # discovery and start-up
+ticks=$(getconf CLK_TCK)
+read -r u0 s0 < <(awk '{print $14, $15}' /proc/$boat/stat)
+sleep "$seconds"
+read -r u1 s1 < <(awk '{print $14, $15}' /proc/$boat/stat)
+rss_kb=$(awk '/VmRSS/ {print $2}' /proc/$boat/status)
+hwm_kb=$(awk '/VmHWM/ {print $2}' /proc/$boat/status)
+threads=$(awk '/Threads/ {print $2}' /proc/$boat/status)
+kill -INT $boat; wait $boat || true
+cpu=$(echo "scale=2; 100 * ($u1 + $s1 - $u0 - $s0) / $ticks / $seconds" | bc)
+echo "boat_node over ${seconds}s: CPU ${cpu}% of one core, RSS $((rss_kb / 1024)) MB (peak $((hwm_kb / 1024)) MB), $threads threads"
+tail -n 1 "$dir/boat"
