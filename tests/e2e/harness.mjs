@@ -177,6 +177,9 @@ export async function screenshots(page, name, settleMs = 600) {
   for (const [size, vp] of Object.entries(SIZES)) {
     await page.setViewportSize(vp);
     await page.waitForTimeout(settleMs);
+    // Every view fits the width of a phone and a laptop: no sideways scrolling.
+    const scrollWidth = await page.evaluate(() => document.documentElement.scrollWidth);
+    if (scrollWidth > vp.width) throw new Error(`${name}: page is ${scrollWidth} px wide at ${size} (${vp.width} px)`);
     const file = join(artifacts, `${name}-${size}.png`);
     await page.screenshot({ path: file, fullPage: true });
     files.push(file);

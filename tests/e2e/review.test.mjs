@@ -49,6 +49,12 @@ test('review: charts, heel distribution and bands for a recorded session', async
   await page.fill('#scrubber', String(Math.floor(s.duration_s / 2)));
   await page.dispatchEvent('#scrubber', 'input');
   assert.match(await page.textContent('.scrub-readout'), /heel [+−]\d+\.\d°/);
+  // Nothing wider than the window (charts sized to their box, controls wrap on a phone).
+  for (const width of [390, 1440]) {
+    await page.setViewportSize({ width, height: 900 });
+    await page.waitForTimeout(300);
+    assert.ok((await page.evaluate(() => document.documentElement.scrollWidth)) <= width, `no horizontal scroll at ${width}`);
+  }
   await screenshots(page, 'review');
 });
 

@@ -18,7 +18,9 @@ export const COLORS = ['#0047ab', '#c00018', '#0a6d2c', '#7a3cb8', '#b35c00'];
 
 // Width of a chart's container, for uPlot (which sizes in pixels).
 export function widthOf(node) {
-  return Math.max(280, Math.floor(node.getBoundingClientRect().width || 320));
+  const cs = getComputedStyle(node);
+  const inner = node.clientWidth - parseFloat(cs.paddingLeft) - parseFloat(cs.paddingRight);
+  return Math.max(260, Math.floor(inner || 320));
 }
 
 // Resizes every chart to its container when the window changes size.
