@@ -94,6 +94,27 @@ test('boat view: the coach sees the rule, active alarms, and saves an edited rul
   await screenshots(page, 'boat-alarm-rules');
 });
 
+test('boat view: the coach acknowledges, then silences, a standing alarm', async () => {
+  // ILCA-2 sails heeled to starboard for its first 90 s (the simulator tacks every 90 s), far
+  // outside the band [-90, -5]: its alarm stands while the coach acts on it.
+  const rule = { id: 'ilca2-flat', scope: 'boat:ILCA-2', quantity: 'heel', min_deg: -90, max_deg: -5, hold_s: 0,
+    hysteresis_deg: 1, level: 'alarm', enabled: true };
+  await fleet.rest('/alarms/rules', { method: 'PUT', body: JSON.stringify([rule]), headers: { 'Content-Type': 'application/json' } });
+  await page.evaluate(() => { location.hash = '#/boat/ILCA-2'; });
+  const item = '.alarms .event[data-level="alarm"]';
+  await page.waitForSelector(`${item}[data-phase="raised"] .event-ack`, { timeout: 5000 });
+  assert.equal(await page.getAttribute('.card[data-boat="ILCA-2"]', 'data-alarm'), 'alarm');
+  await page.click(`${item} .event-ack`);
+  await page.waitForSelector(`${item}[data-phase="acknowledged"]`, { timeout: 5000 });
+  const id = await page.getAttribute(item, 'data-event');
+  await page.click(`${item} .event-silence`);
+  await eventually(async () => {
+    const ev = (await fleet.json('/alarms/events?boat=ILCA-2')).find((e) => String(e.id) === id);
+    return ev && ev.phase === 'silenced' && ev.acknowledged_at;
+  }, { what: 'the event acknowledged then silenced on the shore' });
+  await screenshots(page, 'boat-alarm-ack', 200);
+});
+
 test('no console errors on the alarm pages', () => {
   assert.deepEqual(browser.problems, []);
 });

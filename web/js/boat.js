@@ -127,8 +127,9 @@ export function mountBoat(container, { live, role, params, navigate }) {
         events.length ? el('ul', { class: 'events' }, events.map((ev) => eventItem(ev, role, renderAlarms)))
           : el('p', { class: 'empty', text: 'None.' }));
     };
-    renderAlarms().catch((err) => alarmsBox.replaceChildren(el('p', { class: 'message', text: err.message })));
-    const onAlarm = (e) => { if (e.detail.boat_id === id) renderAlarms().catch(() => {}); };
+    const show = () => renderAlarms().catch((err) => alarmsBox.replaceChildren(el('p', { class: 'message', text: err.message })));
+    show();
+    const onAlarm = (e) => { if (e.detail.boat_id === id) show(); };
     live.addEventListener('alarm', onAlarm);
     cleanups.push(() => live.removeEventListener('alarm', onAlarm));
   } else {
@@ -148,14 +149,22 @@ export function mountBoat(container, { live, role, params, navigate }) {
 }
 
 function eventItem(ev, role, refresh) {
-  const act = (what) => el('button', { type: 'button', text: what, onclick: async () => {
-    await api(`/alarms/events/${ev.id}/${what}`, { method: 'POST' });
-    await refresh();
+  const note = el('span', { class: 'status', role: 'status' });
+  const act = (what) => el('button', { type: 'button', class: `event-${what}`, text: what, onclick: async () => {
+    try {
+      await api(`/alarms/events/${ev.id}/${what}`, { method: 'POST' });
+      await refresh();
+    } catch (err) {
+      // e.g. 409: the alarm cleared meanwhile.
+      note.textContent = ` ${what} failed: ${err.message}`;
+      note.dataset.state = 'error';
+    }
   } });
-  return el('li', { class: `event ${ev.level}`, dataset: { level: ev.level, phase: ev.phase } },
+  const open = ev.phase === 'raised' || ev.phase === 'acknowledged';
+  return el('li', { class: `event ${ev.level}`, dataset: { level: ev.level, phase: ev.phase, event: String(ev.id) } },
     el('strong', { text: `${ev.level.toUpperCase()} ` }),
     `${ev.raised_at.slice(11, 19)} UTC · ${ev.message ?? ''} (${ev.phase})`,
-    role === 'coach' && ev.phase === 'raised' ? [' ', act('ack'), ' ', act('silence')] : null);
+    role === 'coach' && open ? [' ', ev.phase === 'raised' ? act('ack') : null, ' ', act('silence')] : null, note);
 }
 
 const FIELDS = [
