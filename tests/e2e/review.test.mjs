@@ -49,6 +49,20 @@ test('review: charts, heel distribution and bands for a recorded session', async
   await page.fill('#scrubber', String(Math.floor(s.duration_s / 2)));
   await page.dispatchEvent('#scrubber', 'input');
   assert.match(await page.textContent('.scrub-readout'), /heel [+−]\d+\.\d°/);
+  // Drag across the middle of the heel chart: both charts zoom to that span; Reset zoom undoes it.
+  const xScale = (series) => page.$eval(`.chart[data-series="${series}"]`, (b) => [b.uplot.scales.x.min, b.uplot.scales.x.max]);
+  const full = await xScale('heel');
+  const over = await page.$('.chart[data-series="heel"] .u-over');
+  const box = await over.boundingBox();
+  await page.mouse.move(box.x + box.width * 0.3, box.y + box.height / 2);
+  await page.mouse.down();
+  await page.mouse.move(box.x + box.width * 0.6, box.y + box.height / 2, { steps: 5 });
+  await page.mouse.up();
+  const zoomed = await xScale('heel');
+  assert.ok(zoomed[1] - zoomed[0] < (full[1] - full[0]) * 0.5, `zoomed ${zoomed} from ${full}`);
+  assert.deepEqual(await xScale('pitch'), zoomed, 'pitch chart follows');
+  await page.click('#reset-zoom');
+  assert.deepEqual(await xScale('heel'), full);
   // Nothing wider than the window (charts sized to their box, controls wrap on a phone).
   for (const width of [390, 1440]) {
     await page.setViewportSize({ width, height: 900 });
