@@ -103,7 +103,7 @@ test('boat view: the coach acknowledges, then silences, a standing alarm', async
   await page.evaluate(() => { location.hash = '#/boat/ILCA-2'; });
   const item = '.alarms .event[data-level="alarm"]';
   await page.waitForSelector(`${item}[data-phase="raised"] .event-ack`, { timeout: 5000 });
-  assert.equal(await page.getAttribute('.card[data-boat="ILCA-2"]', 'data-alarm'), 'alarm');
+  await page.waitForSelector('.card[data-boat="ILCA-2"][data-alarm="alarm"]', { timeout: 2000 });
   await page.click(`${item} .event-ack`);
   await page.waitForSelector(`${item}[data-phase="acknowledged"]`, { timeout: 5000 });
   const id = await page.getAttribute(item, 'data-event');
