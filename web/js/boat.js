@@ -89,7 +89,7 @@ export function mountBoat(container, { live, role, params, navigate }) {
           y: { range: (u, min, max) => [Math.min(range[0], min ?? 0), Math.max(range[1], max ?? 0)] },
         },
         series: [{}, { label, stroke: color, width: 2, spanGaps: false }],
-        axes: [{ values: (u, vals) => vals.map(clock) }, { size: 50 }],
+        axes: [{ space: 90, values: (u, vals) => vals.map(clock) }, { size: 50 }],
       }, [[], []], box);
       u._key = key;
       charts.push(u);

@@ -142,7 +142,7 @@ function render(body, uPlot, main, vs) {
       cursor: { sync: { key: sync.key, setSeries: false }, drag: { x: true, y: false } },
       series: [{ label: 'Time', value: (u, v) => (v === null ? '–' : `${fmtRel(v)} (${clock(t0 + v)} UTC)`) },
         ...seriesFor(idx, `${label} °`)],
-      axes: [{ values: (u, vals) => {
+      axes: [{ space: 70, values: (u, vals) => {
         const step = vals.length > 1 ? vals[1] - vals[0] : 1;
         return vals.map((v) => (step < 1 ? `${v.toFixed(1)} s` : fmtRel(v)));
       } }, { size: 50 }],
