@@ -4,21 +4,31 @@
 #include <vector>
 
 #include "csv.hpp"
-#include "sim_source.hpp"
+#include "telltale/fusion/sim/scenario.hpp"
 #include "witmotion_feed.hpp"
 
 namespace telltale::boat {
 namespace {
 
+/// A simulator scenario of fusion_core (default: a dinghy sailing upwind), endless.
 class SimImuSource : public ImuSource {
  public:
-  SimImuSource(std::uint64_t seed, double rate_hz) : sim_(seed, rate_hz) {}
-  std::optional<fusion::ImuSample> next() override { return sim_.next(); }
+  SimImuSource(const std::string& scenario, std::uint64_t seed, double rate_hz)
+      : name_(scenario), sim_(fusion::sim::make_scenario(scenario, seed, rate_hz, 0.0)) {
+    if (!sim_) throw std::invalid_argument("unknown simulator scenario '" + scenario + "'");
+  }
+  std::optional<fusion::ImuSample> next() override {
+    fusion::ImuSample s;
+    fusion::sim::AttitudeTruth truth;
+    if (!sim_->next(s, truth)) return std::nullopt;
+    return s;
+  }
   bool real_time() const override { return true; }
-  std::string describe() const override { return "sim"; }
+  std::string describe() const override { return "sim:" + name_; }
 
  private:
-  SimSource sim_;
+  std::string name_;
+  std::unique_ptr<fusion::sim::ImuScenario> sim_;
 };
 
 /// An IMU CSV of SPEC section 6 (t_s, gyro, accelerometer; any column order).
@@ -94,11 +104,13 @@ std::unique_ptr<ImuSource> make_imu_source(const std::string& spec, std::uint64_
                                            const std::function<bool()>& stop) {
   if (spec.rfind("witmotion:", 0) == 0 && spec.size() > 10)
     return std::make_unique<WitMotionImuSource>(spec.substr(10), stop);
-  if (spec == "sim") return std::make_unique<SimImuSource>(seed, sim_rate_hz);
+  if (spec == "sim") return std::make_unique<SimImuSource>("dinghy", seed, sim_rate_hz);
+  if (spec.rfind("sim:", 0) == 0)
+    return std::make_unique<SimImuSource>(spec.substr(4), seed, sim_rate_hz);
   if (spec.rfind("replay:", 0) == 0 && spec.size() > 7)
     return std::make_unique<ReplayImuSource>(spec.substr(7), replay);
   throw std::invalid_argument("unknown --source '" + spec +
-                              "' (sim, sim:SCENARIO, replay:FILE.csv, witmotion:DEVICE)");
+                              "' (sim, sim:SCENARIO, replay:FILE.csv, witmotion:DEVICE[@BAUD])");
 }
 
 }  // namespace telltale::boat

@@ -29,7 +29,7 @@ struct ReplayOptions {
   bool loop = false;  ///< start again at the end (time keeps increasing)
 };
 
-/// "sim", "replay:FILE.csv" or "witmotion:DEVICE[@BAUD]". Throws std::invalid_argument for an
+/// "sim" (the dinghy scenario), "sim:SCENARIO", "replay:FILE.csv" or "witmotion:DEVICE[@BAUD]". Throws std::invalid_argument for an
 /// unknown source, io::CsvError for an unreadable replay file, std::system_error for a device.
 /// `stop` ends a wait for a device.
 std::unique_ptr<ImuSource> make_imu_source(const std::string& spec, std::uint64_t seed,

@@ -24,7 +24,7 @@
 #include "session_log.hpp"
 #include "shutdown.hpp"
 #include "telltale/fusion/alarm_engine.hpp"
-#include "telltale/fusion/complementary.hpp"
+#include "telltale/fusion/attitude_telltale.hpp"
 #include "telltale/fusion/led_panel.hpp"
 #include "telltale/fusion/mounting.hpp"
 
@@ -55,6 +55,8 @@ struct Options {
   double led_step_deg = 5.0;
   int leds_per_bar = 6;
   double default_max_heel_deg = 30.0;
+  double gyro_range_dps = 250.0;  ///< L3G4200D default, as in the paper's instrument
+  double acc_range_g = 2.0;       ///< LSM303DLH default
   std::string fault_drop_link;  ///< "START_S:DURATION_S"
 };
 
@@ -211,7 +213,10 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
 
   telltale::boat::WarningHook hook(o.warn_command, std::chrono::seconds(5));
   const bool tty = isatty(STDOUT_FILENO) != 0;
-  telltale::fusion::ComplementaryFilter filter;
+  telltale::fusion::TelltaleAttitudeParams filter_params;
+  filter_params.gyro_range_rad_s = o.gyro_range_dps * M_PI / 180.0;
+  filter_params.acc_range_m_s2 = o.acc_range_g * telltale::fusion::kStandardGravity_m_s2;
+  telltale::fusion::TelltaleAttitudeFilter filter(filter_params);
   const telltale::fusion::LedPanelParams led_params{o.led_step_deg,
                                                     static_cast<std::uint8_t>(o.leds_per_bar)};
 
@@ -226,9 +231,6 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   double first_t = std::numeric_limits<double>::quiet_NaN();
   double next_publish_s = 0.0;
   double last_t = -std::numeric_limits<double>::infinity();
-  double last_heel = std::numeric_limits<double>::quiet_NaN();
-  double last_pitch = last_heel;
-  double last_publish_t = 0.0;
   double calib_heel = 0.0, calib_pitch = 0.0;
   int calib_n = 0;
   bool calibrating = o.calibrate_s > 0;
@@ -264,18 +266,15 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       ++bad_samples;
       continue;
     }
-    if (sample->acc_body_m_s2.cwiseAbs().maxCoeff() > 156.0 ||
-        sample->gyro_body_rad_s.cwiseAbs().maxCoeff() > 34.9) {
-      health |= telltale::msg::SENSOR_SATURATED;  // +-16 g, +-2000 dps: a typical MEMS range
-    }
     last_sample_wall = now;
     filter.update(mounting.apply(*sample));
 
     if (t + 1e-9 >= next_publish_s) {
       next_publish_s += publish_period_s;
       if (next_publish_s < t) next_publish_s = t + publish_period_s;  // after a gap in the data
-      const double raw_heel = filter.heel_rad() * kRadToDeg;
-      const double raw_pitch = filter.pitch_rad() * kRadToDeg;
+      const telltale::fusion::AttitudeOutput fused = filter.output();
+      const double raw_heel = fused.heel_rad * kRadToDeg;
+      const double raw_pitch = fused.pitch_rad * kRadToDeg;
       if (calibrating) {
         calib_heel += raw_heel;
         calib_pitch += raw_pitch;
@@ -292,18 +291,18 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       }
       const double heel = raw_heel - mounting.heel_offset_deg;
       const double pitch = raw_pitch - mounting.pitch_offset_deg;
-      const double dt = t - last_publish_t;
       telltale::boat::LogRecord r;
       r.seq = ++seq;
       r.t_utc_ns = start_utc_ns + static_cast<unsigned long long>(t * 1e9);
       r.heel_deg = heel;
       r.pitch_deg = pitch;
       r.heading_deg = heading ? heading->tick(now) : std::numeric_limits<double>::quiet_NaN();
-      r.heel_rate_deg_s = std::isfinite(last_heel) && dt > 0 ? (heel - last_heel) / dt : 0.0;
-      r.pitch_rate_deg_s = std::isfinite(last_pitch) && dt > 0 ? (pitch - last_pitch) / dt : 0.0;
-      r.yaw_rate_deg_s = sample->gyro_body_rad_s.z() * kRadToDeg;
-      r.accel_weight = 0.0f;
-      r.quality = health == telltale::msg::SENSOR_OK ? 1.0f : 0.5f;
+      r.heel_rate_deg_s = fused.heel_rate_rad_s * kRadToDeg;
+      r.pitch_rate_deg_s = fused.pitch_rate_rad_s * kRadToDeg;
+      r.yaw_rate_deg_s = fused.yaw_rate_rad_s * kRadToDeg;
+      r.accel_weight = static_cast<float>(fused.acc_weight);
+      r.quality = static_cast<float>(health == telltale::msg::SENSOR_OK ? fused.quality
+                                                                         : 0.5 * fused.quality);
       alarms.evaluate(o.boat_id, o.group, r.t_utc_ns, heel, pitch);
       const AlarmLevel level = alarms.level_of(o.boat_id);
       const auto leds = telltale::fusion::led_panel(heel, pitch, led_params);
@@ -317,9 +316,6 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       if (!dds.publish(*to_wire(r))) ++write_failures;
       backfiller->on_published(r.seq);
       if (!silenced) hook.on_level(o.boat_id, level, heel, now);
-      last_heel = heel;
-      last_pitch = pitch;
-      last_publish_t = t;
       if (o.console && now >= next_console) {
         next_console = now + std::chrono::milliseconds(200);
         std::printf("%s%s", telltale::boat::render_panel(o.boat_id, heel, pitch, leds,
@@ -337,7 +333,9 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       next_status = now + std::chrono::seconds(1);
       std::uint32_t h = health;
       if (heading && heading->degraded()) h |= telltale::msg::SENSOR_HEADING_DEGRADED;
-      if (filter.diagnostics().rejected_non_finite) h |= telltale::msg::SENSOR_NON_FINITE;
+      const auto& diag = filter.diagnostics();
+      if (diag.rejected_non_finite) h |= telltale::msg::SENSOR_NON_FINITE;
+      if (diag.gyro_saturated || diag.acc_saturated) h |= telltale::msg::SENSOR_SATURATED;
       std::string text = h == 0 ? "ok" : "sensor flags " + std::to_string(h);
       if (write_failures) text += "; dds write failures " + std::to_string(write_failures);
       if (log_failures) text += "; session log write failures " + std::to_string(log_failures);
@@ -385,6 +383,12 @@ int main(int argc, char** argv) {
   app.add_option("--imu-rate-hz", o.imu_rate_hz, "IMU rate of the sim source, Hz")
       ->capture_default_str();
   app.add_option("--seed", o.seed, "simulator seed (default: from the boat id)");
+  app.add_option("--gyro-range-dps", o.gyro_range_dps,
+                 "gyro full scale (saturation detection); a WitMotion module: 2000")
+      ->capture_default_str();
+  app.add_option("--acc-range-g", o.acc_range_g,
+                 "accelerometer full scale (saturation detection); a WitMotion module: 16")
+      ->capture_default_str();
   app.add_flag("--replay-fast", o.replay.fast, "replay as fast as possible (default: real time)");
   app.add_flag("--replay-loop", o.replay.loop, "replay the file again at its end");
   app.add_option("--log-dir", o.log_dir, "session log directory")->capture_default_str();

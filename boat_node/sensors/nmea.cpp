@@ -1,6 +1,8 @@
 // NMEA 0183 heading sentences: parser, line assembler, serial and UDP readers (see nmea.hpp).
 #include "nmea.hpp"
 
+#include "serial_port.hpp"
+
 #include <arpa/inet.h>
 #include <fcntl.h>
 #include <netinet/in.h>
@@ -321,50 +323,9 @@ void NmeaStreamReader::run(const NmeaHeadingCallback& cb) {
   }
 }
 
-namespace {
-
-speed_t baud_constant(int baud) {
-  switch (baud) {
-    case 4800:
-      return B4800;
-    case 9600:
-      return B9600;
-    case 19200:
-      return B19200;
-    case 38400:
-      return B38400;
-    case 57600:
-      return B57600;
-    case 115200:
-      return B115200;
-    case 230400:
-      return B230400;
-    default:
-      throw std::invalid_argument("nmea: unsupported baud rate " + std::to_string(baud));
-  }
-}
-
-}  // namespace
-
 NmeaSerialReader::NmeaSerialReader(const std::string& device, int baud, NmeaParseOptions options)
     : NmeaStreamReader(options) {
-  const speed_t speed = baud_constant(baud);
-  const int fd = ::open(device.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) throw std::system_error(errno, std::generic_category(), "nmea: open " + device);
-  attach(fd);  // the base destructor closes it if the setup below throws
-  termios tio{};
-  if (::tcgetattr(fd, &tio) != 0) {
-    throw std::system_error(errno, std::generic_category(), "nmea: " + device + " is not a tty");
-  }
-  ::cfmakeraw(&tio);
-  tio.c_cflag |= CLOCAL | CREAD;
-  tio.c_cflag &= ~static_cast<tcflag_t>(CRTSCTS | CSTOPB | PARENB);
-  tio.c_cc[VMIN] = 0;
-  tio.c_cc[VTIME] = 0;
-  if (::cfsetispeed(&tio, speed) != 0 || ::cfsetospeed(&tio, speed) != 0 ||
-      ::tcsetattr(fd, TCSANOW, &tio) != 0) {
-    throw std::system_error(errno, std::generic_category(), "nmea: configure " + device);
-  }
+  attach(open_serial_raw(device, baud));
 }
 
 bool NmeaSerialReader::read_available(const NmeaHeadingCallback& cb) {

@@ -1,5 +1,7 @@
 #include "witmotion.hpp"
 
+#include "serial_port.hpp"
+
 #include <fcntl.h>
 #include <poll.h>
 #include <termios.h>
@@ -179,57 +181,9 @@ std::vector<std::uint8_t> encode_wit_sample(const WitSample& s, const WitMotionP
   return out;
 }
 
-namespace {
-speed_t baud_constant(int baud) {
-  switch (baud) {
-    case 4800:
-      return B4800;
-    case 9600:
-      return B9600;
-    case 19200:
-      return B19200;
-    case 38400:
-      return B38400;
-    case 57600:
-      return B57600;
-    case 115200:
-      return B115200;
-    case 230400:
-      return B230400;
-    case 460800:
-      return B460800;
-    case 921600:
-      return B921600;
-    default:
-      throw std::invalid_argument("unsupported baud rate " + std::to_string(baud));
-  }
-}
-}  // namespace
-
 WitMotionSerial::WitMotionSerial(const std::string& device, int baud,
                                  WitMotionDecoder::Callback callback, WitMotionParams params)
-    : decoder_(std::move(callback), params) {
-  const speed_t speed = baud_constant(baud);
-  fd_ = ::open(device.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
-  if (fd_ < 0) throw std::system_error(errno, std::generic_category(), "open " + device);
-  termios tio{};
-  if (::tcgetattr(fd_, &tio) != 0) {
-    const int e = errno;
-    ::close(fd_);
-    throw std::system_error(e, std::generic_category(), "tcgetattr " + device);
-  }
-  ::cfmakeraw(&tio);  // 8 data bits, no parity, no echo, no line editing, no CR/LF mapping
-  tio.c_cflag |= CLOCAL | CREAD;
-  tio.c_cflag &= ~static_cast<tcflag_t>(CSTOPB | CRTSCTS);
-  tio.c_cc[VMIN] = 0;
-  tio.c_cc[VTIME] = 0;
-  if (::cfsetispeed(&tio, speed) != 0 || ::cfsetospeed(&tio, speed) != 0 ||
-      ::tcsetattr(fd_, TCSANOW, &tio) != 0) {
-    const int e = errno;
-    ::close(fd_);
-    throw std::system_error(e, std::generic_category(), "configure " + device);
-  }
-}
+    : fd_(open_serial_raw(device, baud)), decoder_(std::move(callback), params) {}
 
 WitMotionSerial::~WitMotionSerial() {
   if (fd_ >= 0) ::close(fd_);

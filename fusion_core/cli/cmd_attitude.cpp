@@ -7,7 +7,7 @@
 
 #include "commands.hpp"
 #include "csv.hpp"
-#include "telltale/fusion/complementary.hpp"
+#include "telltale/fusion/attitude.hpp"
 
 namespace telltale::cli {
 namespace {
@@ -15,17 +15,19 @@ namespace {
 struct AttitudeOptions {
   std::string in;
   std::string out;
-  std::string filter = "complementary";
+  std::string filter{fusion::kDefaultAttitudeFilter};
 };
 
 void run_attitude(const AttitudeOptions& o) {
-  if (o.filter != "complementary") throw UsageError("unknown filter '" + o.filter + "'");
-  io::CsvReader reader(o.in,
-                       {{"t_s"}, {"gx_rad_s"}, {"gy_rad_s"}, {"gz_rad_s"}, {"ax_m_s2"},
-                        {"ay_m_s2"}, {"az_m_s2"}},
-                       "t_s");
-  io::CsvWriter writer(o.out, {"t_s", "heel_deg", "pitch_deg"});
-  fusion::ComplementaryFilter filter;
+  auto filter = fusion::make_attitude_filter(o.filter);
+  if (!filter)
+    throw UsageError("unknown filter '" + o.filter + "' (see fusion_cli attitude --help)");
+  io::CsvReader reader(
+      o.in,
+      {{"t_s"}, {"gx_rad_s"}, {"gy_rad_s"}, {"gz_rad_s"}, {"ax_m_s2"}, {"ay_m_s2"}, {"az_m_s2"}},
+      "t_s");
+  io::CsvWriter writer(o.out, {"t_s", "heel_deg", "pitch_deg", "heel_rate_deg_s",
+                               "pitch_rate_deg_s", "yaw_rate_deg_s", "acc_weight", "quality"});
   std::vector<double> row;
   std::size_t samples = 0;
   std::chrono::nanoseconds in_filter{0};
@@ -36,9 +38,11 @@ void run_attitude(const AttitudeOptions& o) {
     s.gyro_body_rad_s = {row[1], row[2], row[3]};
     s.acc_body_m_s2 = {row[4], row[5], row[6]};
     const auto t0 = std::chrono::steady_clock::now();
-    filter.update(s);
+    filter->update(s);
     in_filter += std::chrono::steady_clock::now() - t0;
-    writer.row({s.t_s, filter.heel_rad() * kDeg, filter.pitch_rad() * kDeg});
+    const fusion::AttitudeOutput a = filter->output();
+    writer.row({s.t_s, a.heel_rad * kDeg, a.pitch_rad * kDeg, a.heel_rate_rad_s * kDeg,
+                a.pitch_rate_rad_s * kDeg, a.yaw_rate_rad_s * kDeg, a.acc_weight, a.quality});
     ++samples;
   }
   writer.close();
@@ -52,12 +56,20 @@ void run_attitude(const AttitudeOptions& o) {
 
 void register_attitude(CLI::App& app) {
   auto opts = std::make_shared<AttitudeOptions>();
+  std::string filters =
+      "filter name (default " + std::string(fusion::kDefaultAttitudeFilter) + "):";
+  for (const auto& n : fusion::attitude_filter_names()) {
+    filters += "\n  " + n + ": " + fusion::attitude_filter_description(n);
+  }
   auto* cmd = app.add_subcommand("attitude", "Heel and pitch from an IMU CSV");
-  cmd->add_option("--in", opts->in, "IMU CSV: t_s,gx_rad_s,gy_rad_s,gz_rad_s,ax_m_s2,ay_m_s2,az_m_s2")
+  cmd->add_option("--in", opts->in,
+                  "IMU CSV: t_s,gx_rad_s,gy_rad_s,gz_rad_s,ax_m_s2,ay_m_s2,az_m_s2")
       ->required();
-  cmd->add_option("--out", opts->out, "output CSV: t_s,heel_deg,pitch_deg")->required();
-  cmd->add_option("--filter", opts->filter, "filter name: complementary")
-      ->capture_default_str();
+  cmd->add_option("--out", opts->out,
+                  "output CSV: t_s,heel_deg,pitch_deg,heel_rate_deg_s,pitch_rate_deg_s,"
+                  "yaw_rate_deg_s,acc_weight,quality")
+      ->required();
+  cmd->add_option("--filter", opts->filter, filters);
   cmd->callback([opts] { run_attitude(*opts); });
 }
 

@@ -4,7 +4,9 @@
 /// main() maps io::CsvError and UsageError to exit status 2 with one line on stderr.
 
 #include <CLI/CLI.hpp>
+#include <functional>
 #include <stdexcept>
+#include <vector>
 
 namespace telltale::cli {
 
@@ -19,5 +21,10 @@ void register_heading(CLI::App& app);
 void register_steps(CLI::App& app);  // steps, pdr
 void register_gait_sim(CLI::App& app);
 void register_steps_eval(CLI::App& app);
+void register_simulate(CLI::App& app);
+/// `eval` is a group: each area (attitude, ...) adds a subcommand through register_eval_<area>
+/// and pushes a runner with its default options; `fusion_cli eval` alone runs them all.
+void register_eval(CLI::App& app);
+void register_eval_attitude(CLI::App& eval, std::vector<std::function<void()>>& run_all);
 
 }  // namespace telltale::cli

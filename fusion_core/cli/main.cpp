@@ -13,6 +13,8 @@ int main(int argc, char** argv) {
   telltale::cli::register_steps(app);
   telltale::cli::register_gait_sim(app);
   telltale::cli::register_steps_eval(app);
+  telltale::cli::register_simulate(app);
+  telltale::cli::register_eval(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,155 @@
+// fusion_cli eval attitude: scenario x filter heel/pitch errors over seeds, and the BROAD
+// recordings' inclination RMSE for every filter.
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "broad.hpp"
+#include "commands.hpp"
+#include "csv.hpp"
+#include "telltale/fusion/attitude_eval.hpp"
+#include "telltale/fusion/sim/scenario.hpp"
+
+namespace telltale::cli {
+namespace {
+
+struct EvalAttitudeOptions {
+  int seeds = 10;
+  std::vector<double> rates_hz{25.0, 100.0};
+  std::vector<std::string> filters;    // empty = all
+  std::vector<std::string> scenarios;  // empty = all
+  std::string broad_dir;               // empty = look in the usual places
+  bool skip_broad = false;
+  bool uncalibrated = false;  ///< raw datasheet sensor errors instead of the calibrated instrument
+};
+
+bool progress_enabled() { return isatty(fileno(stderr)) != 0; }
+
+void progress(const std::string& what) {
+  if (progress_enabled()) std::fprintf(stderr, "\r\033[K%s", what.c_str());
+}
+void progress_done() {
+  if (progress_enabled()) std::fprintf(stderr, "\r\033[K");
+}
+
+std::string find_broad_dir(const std::string& requested) {
+  if (!requested.empty()) return requested;
+  for (const char* d :
+       {"/work/shared/data/broad", "../shared/data/broad", "../../shared/data/broad"}) {
+    if (std::filesystem::is_directory(d)) return d;
+  }
+  return {};
+}
+
+void run_eval_attitude(const EvalAttitudeOptions& o) {
+  const std::vector<std::string> filters =
+      o.filters.empty() ? fusion::attitude_filter_names() : o.filters;
+  const std::vector<std::string> scenarios =
+      o.scenarios.empty() ? fusion::sim::scenario_names() : o.scenarios;
+  if (!o.broad_dir.empty() && !std::filesystem::is_directory(o.broad_dir)) {
+    throw UsageError("--broad-dir '" + o.broad_dir + "' is not a directory");
+  }
+  for (const auto& f : filters) {
+    if (!fusion::make_attitude_filter(f)) throw UsageError("unknown filter '" + f + "'");
+  }
+  for (const auto& s : scenarios) {
+    if (!fusion::sim::make_scenario(s, 1, 25.0, 1.0))
+      throw UsageError("unknown scenario '" + s + "'");
+  }
+  const fusion::sim::ImuErrorParams raw = fusion::sim::ImuErrorParams::uncalibrated();
+  for (const double rate : o.rates_hz) {
+    std::printf(
+        "\n## attitude: simulator (%s sensors), %d seeds, %.0f Hz: heel RMS, pitch RMS (heel max, "
+        "pitch max), deg\n\n",
+        o.uncalibrated ? "uncalibrated" : "calibrated", o.seeds, rate);
+    std::printf("| scenario |");
+    for (const auto& f : filters) std::printf(" %s |", f.c_str());
+    std::printf("\n|---|");
+    for (std::size_t i = 0; i < filters.size(); ++i) std::printf("---|");
+    std::printf("\n");
+    for (const auto& sc : scenarios) {
+      std::vector<fusion::TiltErrorStats> total(filters.size());
+      for (int seed = 1; seed <= o.seeds; ++seed) {
+        progress("eval attitude: " + sc + " seed " + std::to_string(seed) + " at " +
+                 std::to_string(static_cast<int>(rate)) + " Hz");
+        const auto st = fusion::evaluate_on_scenario(filters, sc, static_cast<std::uint64_t>(seed),
+                                                     rate, 0.0, o.uncalibrated ? &raw : nullptr);
+        for (std::size_t i = 0; i < filters.size(); ++i) total[i].merge(st[i]);
+      }
+      progress_done();
+      std::printf("| %s |", sc.c_str());
+      for (const auto& t : total) {
+        std::printf(" %.2f, %.2f (%.2f, %.2f) |", t.heel_rms_deg, t.pitch_rms_deg, t.heel_max_deg,
+                    t.pitch_max_deg);
+      }
+      std::printf("\n");
+      std::fflush(stdout);
+    }
+  }
+  if (o.skip_broad) return;
+  const std::string dir = find_broad_dir(o.broad_dir);
+  if (dir.empty()) {
+    std::printf("\n(BROAD recordings not found: pass --broad-dir)\n");
+    return;
+  }
+  std::vector<std::string> trials;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    const std::string suffix = ".imu.csv";
+    if (name.size() > suffix.size() && name.ends_with(suffix)) {
+      trials.push_back(name.substr(0, name.size() - suffix.size()));
+    }
+  }
+  std::sort(trials.begin(), trials.end());
+  std::printf("\n## attitude: BROAD (%s), inclination RMSE over movement rows, deg\n\n| trial |",
+              dir.c_str());
+  for (const auto& f : filters) std::printf(" %s |", f.c_str());
+  std::printf("\n|---|");
+  for (std::size_t i = 0; i < filters.size(); ++i) std::printf("---|");
+  std::printf("\n");
+  std::vector<double> sum(filters.size(), 0.0);
+  for (const auto& trial : trials) {
+    progress("eval attitude: BROAD " + trial);
+    const auto data =
+        io::read_broad_trial(dir + "/" + trial + ".imu.csv", dir + "/" + trial + ".truth.csv");
+    std::printf("| %s |", trial.c_str());
+    for (std::size_t i = 0; i < filters.size(); ++i) {
+      auto filter = fusion::make_attitude_filter(filters[i]);
+      const double e = fusion::inclination_rmse_deg(*filter, data);
+      sum[i] += e;
+      std::printf(" %.2f |", e);
+    }
+    progress_done();
+    std::printf("\n");
+    std::fflush(stdout);
+  }
+  std::printf("| **mean** |");
+  for (const double s : sum)
+    std::printf(" **%.2f** |", trials.empty() ? 0.0 : s / static_cast<double>(trials.size()));
+  std::printf("\n");
+}
+
+}  // namespace
+
+void register_eval_attitude(CLI::App& eval, std::vector<std::function<void()>>& run_all) {
+  auto opts = std::make_shared<EvalAttitudeOptions>();
+  auto* cmd = eval.add_subcommand("attitude",
+                                  "heel/pitch: scenario x filter errors, BROAD inclination RMSE");
+  cmd->add_option("--seeds", opts->seeds, "simulator seeds per scenario")->capture_default_str();
+  cmd->add_option("--rate-hz", opts->rates_hz, "sample rates")->capture_default_str();
+  cmd->add_option("--filters", opts->filters, "filters (default: all)");
+  cmd->add_option("--scenarios", opts->scenarios, "scenarios (default: all)");
+  cmd->add_option("--broad-dir", opts->broad_dir,
+                  "BROAD CSV folder (default: /work/shared/data/broad or ../shared/data/broad)");
+  cmd->add_flag("--no-broad", opts->skip_broad, "skip the BROAD recordings");
+  cmd->add_flag("--uncalibrated", opts->uncalibrated,
+                "simulate the sensors with raw datasheet errors (no instrument calibration)");
+  cmd->callback([opts] { run_eval_attitude(*opts); });
+  run_all.push_back([opts] { run_eval_attitude(*opts); });
+}
+
+}  // namespace telltale::cli

@@ -1,0 +1,94 @@
+// Accuracy of attitude filters against ground truth.
+#include "telltale/fusion/attitude_eval.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "telltale/fusion/sim/scenario.hpp"
+
+namespace telltale::fusion {
+namespace {
+constexpr double kRadToDeg = 180.0 / M_PI;
+Eigen::Vector3d up_of(double heel, double pitch) {
+  return {std::sin(pitch), std::cos(pitch) * std::sin(heel), std::cos(pitch) * std::cos(heel)};
+}
+}  // namespace
+
+void TiltErrorStats::merge(const TiltErrorStats& o) {
+  const double n = static_cast<double>(samples + o.samples);
+  if (n == 0.0) return;
+  const auto rms = [&](double a, double b) {
+    return std::sqrt(
+        (a * a * static_cast<double>(samples) + b * b * static_cast<double>(o.samples)) / n);
+  };
+  heel_rms_deg = rms(heel_rms_deg, o.heel_rms_deg);
+  pitch_rms_deg = rms(pitch_rms_deg, o.pitch_rms_deg);
+  heel_max_deg = std::max(heel_max_deg, o.heel_max_deg);
+  pitch_max_deg = std::max(pitch_max_deg, o.pitch_max_deg);
+  samples += o.samples;
+}
+
+std::vector<TiltErrorStats> evaluate_on_scenario(const std::vector<std::string>& filter_names,
+                                                 std::string_view scenario_name, std::uint64_t seed,
+                                                 double rate_hz, double duration_s,
+                                                 const sim::ImuErrorParams* errors) {
+  const std::size_t n = filter_names.size();
+  std::vector<TiltErrorStats> st(n);
+  std::vector<std::unique_ptr<AttitudeFilter>> filters;
+  for (const auto& name : filter_names) filters.push_back(make_attitude_filter(name));
+  if (duration_s <= 0.0) duration_s = sim::scenario_default_duration_s(scenario_name);
+  sim::ScenarioOptions options;
+  if (errors != nullptr) options.errors = *errors;
+  auto sc = sim::make_scenario(scenario_name, seed, rate_hz, duration_s, options);
+  if (!sc) return st;
+  std::vector<double> se_h(n, 0.0);
+  std::vector<double> se_p(n, 0.0);
+  ImuSample imu;
+  sim::AttitudeTruth truth;
+  while (sc->next(imu, truth)) {
+    const bool scored = truth.t_s >= sc->warmup_s();
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!filters[i]) continue;
+      filters[i]->update(imu);
+      if (!scored) continue;
+      const AttitudeOutput o = filters[i]->output();
+      const double eh =
+          std::abs(std::remainder(o.heel_rad - truth.heel_rad, 2.0 * M_PI)) * kRadToDeg;
+      const double ep = std::abs(o.pitch_rad - truth.pitch_rad) * kRadToDeg;
+      se_h[i] += eh * eh;
+      se_p[i] += ep * ep;
+      st[i].heel_max_deg = std::max(st[i].heel_max_deg, eh);
+      st[i].pitch_max_deg = std::max(st[i].pitch_max_deg, ep);
+      ++st[i].samples;
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (st[i].samples == 0) continue;
+    st[i].heel_rms_deg = std::sqrt(se_h[i] / static_cast<double>(st[i].samples));
+    st[i].pitch_rms_deg = std::sqrt(se_p[i] / static_cast<double>(st[i].samples));
+  }
+  return st;
+}
+
+double inclination_error_rad(double heel_a, double pitch_a, double heel_b, double pitch_b) {
+  const Eigen::Vector3d a = up_of(heel_a, pitch_a);
+  const Eigen::Vector3d b = up_of(heel_b, pitch_b);
+  return std::atan2(a.cross(b).norm(), a.dot(b));
+}
+
+double inclination_rmse_deg(AttitudeFilter& filter, const InclinationTrial& trial) {
+  double se = 0.0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < trial.imu.size(); ++i) {
+    filter.update(trial.imu[i]);
+    if (!trial.scored[i]) continue;
+    const AttitudeOutput o = filter.output();
+    const double e = inclination_error_rad(o.heel_rad, o.pitch_rad, trial.heel_true_rad[i],
+                                           trial.pitch_true_rad[i]);
+    se += e * e;
+    ++n;
+  }
+  return n == 0 ? 0.0 : std::sqrt(se / static_cast<double>(n)) * kRadToDeg;
+}
+
+}  // namespace telltale::fusion

@@ -1,0 +1,59 @@
+// No heap inside update(), for every attitude filter. This executable compiles the filters'
+// sources itself with EIGEN_RUNTIME_NO_MALLOC (tests/CMakeLists.txt), so Eigen's guard covers
+// their code, and counts every operator new for allocations outside Eigen.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <new>
+#include <vector>
+
+#include "telltale/fusion/attitude.hpp"
+
+namespace {
+std::atomic<long> g_news{0};
+}
+
+void* operator new(std::size_t n) {
+  ++g_news;
+  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+
+namespace telltale::fusion {
+namespace {
+
+TEST(AttitudeNoHeap, UpdateAllocatesNothing) {
+  // Samples prepared before the guard: a roll, a knock, a NaN, a gap and a saturated gyro.
+  std::vector<ImuSample> samples;
+  for (int k = 0; k < 2000; ++k) {
+    const double t = 0.01 * k + (k > 1500 ? 2.0 : 0.0);
+    const double h = 0.3 * std::sin(0.5 * t);
+    ImuSample s{t,
+                {0.15 * std::cos(0.5 * t), 0.02, 0.1},
+                {0.1, 9.80665 * std::sin(h), 9.80665 * std::cos(h)}};
+    if (k == 700) s.acc_body_m_s2 = {20.0, -20.0, 20.0};
+    if (k == 900) s.gyro_body_rad_s.x() = std::nan("");
+    if (k == 1100) s.gyro_body_rad_s = {5.0, 5.0, 5.0};
+    samples.push_back(s);
+  }
+  for (const auto& name : attitude_filter_names()) {
+    auto filter = make_attitude_filter(name);
+    const long before = g_news.load();
+    Eigen::internal::set_is_malloc_allowed(false);
+    double sink = 0.0;
+    for (const auto& s : samples) {
+      filter->update(s);
+      sink += filter->output().heel_rad;
+    }
+    Eigen::internal::set_is_malloc_allowed(true);
+    EXPECT_EQ(g_news.load(), before) << name;
+    EXPECT_TRUE(std::isfinite(sink)) << name;
+  }
+}
+
+}  // namespace
+}  // namespace telltale::fusion
