@@ -86,7 +86,9 @@ export async function startFleet({ domain, boats = [] }) {
   const fleet = {
     url, token, dir, domain, shore: shore.child, boats: new Map(),
     async addBoat(id, extra = []) {
-      const b = start(join(binDir, 'boat_node'), ['--domain', String(domain), '--boat-id', id, ...extra],
+      // The boat's session log goes to the run's temp dir, not the current directory.
+      const b = start(join(binDir, 'boat_node'), ['--domain', String(domain), '--boat-id', id,
+        '--log-dir', join(dir, 'boat_log'), ...extra],
         /boat_node ready/);
       await b.ready;
       this.boats.set(id, b.child);
