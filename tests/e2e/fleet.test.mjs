@@ -15,6 +15,7 @@ before(async () => {
   await fleet.addBoat('ILCA-3', ['--group', 'ILCA6']);
   browser = await startBrowser();
   page = await browser.page();
+  await fleet.waitHeeled(['ILCA-1', 'ILCA-2', 'ILCA-3']);
 });
 
 after(async () => {

@@ -111,6 +111,14 @@ export async function startFleet({ domain, boats = [] }) {
     async json(path, init) {
       return JSON.parse(await this.rest(path, init));
     },
+    // The simulated dinghy sits level for ~10 s after its node starts, then bears away and heels
+    // (boat_node's default `sim` source). Tests that need a heeled boat wait for it here.
+    async waitHeeled(ids, minDeg = 5, timeoutMs = 30000) {
+      await eventually(async () => {
+        const boats = await this.json('/boats');
+        return ids.every((id) => Math.abs(boats.find((b) => b.id === id)?.heel_deg ?? 0) > minDeg);
+      }, { timeoutMs, intervalMs: 250, what: `${ids} heeled beyond ${minDeg} deg` });
+    },
     async stop() {
       await Promise.all([...this.boats.values()].map((c) => stop(c)));
       await stop(this.shore);

@@ -15,8 +15,10 @@ before(async () => {
   fleet = await startFleet({ domain: domainFor(2), boats: ['ILCA-1', 'ILCA-2'] });
   browser = await startBrowser();
   page = await browser.page();
-  // Record ~8 s, then stop the boats so the sessions are final (the shore commits every 250 ms).
-  await new Promise((r) => setTimeout(r, 8000));
+  // Record the launch and ~5 s of sailing, then stop the boats so the sessions are final (the
+  // shore commits every 250 ms).
+  await fleet.waitHeeled(['ILCA-1', 'ILCA-2']);
+  await new Promise((r) => setTimeout(r, 5000));
   for (const c of fleet.boats.values()) await stop(c);
   await new Promise((r) => setTimeout(r, 1000));
   sessions = await fleet.json('/sessions');
