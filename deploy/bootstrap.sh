@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
 # Installs the Debian packages in deploy/packages.txt that are missing; does nothing when all are
-# there. Idempotent: safe to run before every build.
+# there. Idempotent: safe to run before every build. With --browser: deploy/packages-browser.txt
+# (what the browser tests need) instead.
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
-mapfile -t wanted < <(grep -v '^\s*#' "$here/packages.txt" | grep -v '^\s*$')
+list="$here/packages.txt"
+[ "${1:-}" = "--browser" ] && list="$here/packages-browser.txt"
+mapfile -t wanted < <(grep -v '^\s*#' "$list" | grep -v '^\s*$')
 missing=()
 for p in "${wanted[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

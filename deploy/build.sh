@@ -5,3 +5,6 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 "$root/deploy/bootstrap.sh"
 cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 cmake --build "$root/build" -j"$(nproc)"
+# The dashboard's charts library (npm, vendored into web/vendor/); without npm the fleet view
+# still works and the chart views say what is missing.
+"$root/deploy/web_deps.sh" || echo "build: web/ npm packages not installed (need Node.js and npm)" >&2

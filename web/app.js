@@ -1,98 +1,122 @@
-// Telltale fleet view: one card per boat, updated live from /api/v1/stream (Server-Sent Events).
+// Telltale dashboard: hash routes over one live feed.
+//   #/fleet            every boat as a card (default)
+//   #/boat/ID          one boat: live charts, alarms, alarm rules editor (coach)
+//   #/review?boat=ID&session=N&vs=M   session review, overlay, export
+//   #/wearables        athletes: steps, cadence, gait, pose, dead-reckoned track
 // Login: open the page at /#token=TOKEN once; the token is exchanged for an HttpOnly cookie and
 // removed from the address bar.
+import { api, has, loadCapabilities } from './js/api.js';
+import { mountBoat } from './js/boat.js';
+import { mountFleet } from './js/fleet.js';
+import { Live } from './js/live.js';
+import { mountReview } from './js/review.js';
+import { beep, setSound, soundOn } from './js/sound.js';
+import { mountWearables } from './js/wearable.js';
 
-const fleet = document.getElementById('fleet');
-const template = document.getElementById('boat-card');
+const view = document.getElementById('view');
 const connection = document.getElementById('connection');
 const message = document.getElementById('message');
-const cards = new Map();
+const soundButton = document.getElementById('sound');
+const live = new Live();
+let role = sessionStorage.getItem('telltale.role') ?? 'unknown';
+let unmount = () => {};
 
-function fmt(v) {
-  return v === null || v === undefined ? '–' : `${v >= 0 ? '+' : ''}${v.toFixed(1)}°`;
-}
-
-function setConnection(state, text) {
-  connection.dataset.state = state;
-  connection.textContent = text;
-}
+const ROUTES = { fleet: mountFleet, boat: mountBoat, review: mountReview, wearables: mountWearables };
 
 function showMessage(text) {
   message.textContent = text;
   message.hidden = !text;
 }
 
-function ledBar(bar, lit, count) {
-  if (bar.childElementCount !== count) {
-    bar.replaceChildren(...Array.from({ length: count }, () => {
-      const led = document.createElement('span');
-      led.className = 'led';
-      return led;
-    }));
-  }
-  [...bar.children].forEach((led, i) => led.classList.toggle('on', i < lit));
+function navigate(hash) {
+  if (location.hash === hash) route();
+  else location.hash = hash;
 }
 
-function card(id) {
-  let el = cards.get(id);
-  if (el) return el;
-  el = template.content.firstElementChild.cloneNode(true);
-  el.dataset.boat = id;
-  el.querySelector('.boat-id').textContent = id;
-  cards.set(id, el);
-  // Keep cards sorted by boat id.
-  const after = [...cards.keys()].sort().find((k) => k > id);
-  fleet.insertBefore(el, after ? cards.get(after) : null);
-  return el;
-}
-
-function render(boat) {
-  const el = card(boat.id);
-  el.dataset.alarm = boat.alarm_state;
-  el.dataset.stale = String(boat.stale);
-  el.querySelector('.heel').textContent = fmt(boat.heel_deg);
-  el.querySelector('.pitch').textContent = fmt(boat.pitch_deg);
-  // Seen from astern: heel > 0 (starboard down) turns the hull clockwise on screen.
-  const heel = boat.heel_deg ?? 0;
-  el.querySelector('.hull-heel').setAttribute('transform', `rotate(${heel.toFixed(1)})`);
-  const leds = boat.leds ?? { left: 0, right: 0, up: 0, down: 0, count: 6 };
-  const count = leds.count || 6;
-  for (const side of ['left', 'right', 'up', 'down']) {
-    ledBar(el.querySelector(`.bar.${side}`), leds[side], count);
-  }
-  el.querySelector('.meta').textContent =
-    `${boat.last_sample_time.slice(11, 19)} UTC · #${boat.seq}` +
-    (boat.heading_deg === null ? '' : ` · ${boat.heading_deg.toFixed(0)}°`);
+function route() {
+  const [path, query = ''] = location.hash.replace(/^#\/?/, '').split('?');
+  const [name, ...params] = path.split('/');
+  const mount = ROUTES[name] ?? mountFleet;
+  const current = ROUTES[name] ? name : 'fleet';
+  unmount();
+  view.replaceChildren();
+  view.dataset.view = current;
+  document.querySelectorAll('nav a').forEach((a) =>
+    a.toggleAttribute('aria-current', a.dataset.route === current));
+  document.title = `Telltale — ${current}`;
+  unmount = mount(view, { live, role, params, query: new URLSearchParams(query), navigate }) ?? (() => {});
 }
 
 async function login() {
   const m = /(?:^#|&)token=([^&]+)/.exec(location.hash);
   if (!m) return;
   const token = decodeURIComponent(m[1]);
-  history.replaceState(null, '', location.pathname + location.search);
-  const res = await fetch('/api/v1/login', {
-    method: 'POST',
-    headers: { Authorization: `Bearer ${token}` },
+  history.replaceState(null, '', `${location.pathname}${location.search}#/fleet`);
+  const res = await fetch('/api/v1/login', { method: 'POST', headers: { Authorization: `Bearer ${token}` } });
+  if (!res.ok) {
+    showMessage('That token was refused. Ask the coach for a new link.');
+    return;
+  }
+  role = (await res.json()).role ?? role;
+  sessionStorage.setItem('telltale.role', role);
+}
+
+// The alarm sound: a beep when a boat enters warn or alarm, repeated every 5 s while any boat
+// is in alarm and its alarm has not been silenced by the coach.
+function watchAlarms() {
+  const last = new Map();
+  const silenced = new Set();
+  live.addEventListener('boat', (e) => {
+    const b = e.detail;
+    const before = last.get(b.id) ?? 'normal';
+    last.set(b.id, b.alarm_state);
+    if (b.alarm_state !== before && b.alarm_state !== 'normal') beep(b.alarm_state);
+    if (b.alarm_state === 'normal') silenced.delete(b.id);
   });
-  if (!res.ok) showMessage('That token was refused. Ask the coach for a new link.');
+  live.addEventListener('alarm', (e) => {
+    if (e.detail.phase === 'silenced') silenced.add(e.detail.boat_id);
+  });
+  setInterval(() => {
+    if ([...last].some(([id, s]) => s === 'alarm' && !silenced.has(id))) beep('alarm');
+  }, 5000);
+  soundButton.addEventListener('click', () => {
+    setSound(!soundOn());
+    soundButton.setAttribute('aria-pressed', String(soundOn()));
+    soundButton.textContent = soundOn() ? 'Sound on' : 'Sound off';
+  });
 }
 
 async function start() {
+  await loadCapabilities();
   await login();
-  const res = await fetch('/api/v1/boats');
-  if (res.status === 401) {
-    setConnection('lost', 'not logged in');
+  let boats;
+  try {
+    boats = await api('/boats');
+  } catch (err) {
+    if (err.status !== 401) throw err;
+    connection.dataset.state = 'lost';
+    connection.textContent = 'not logged in';
     showMessage('Open the link the shore server printed (it ends in #token=…) to log in.');
     return;
   }
-  (await res.json()).forEach(render);
-  const stream = new EventSource('/api/v1/stream');
-  stream.addEventListener('open', () => setConnection('live', 'live'));
-  stream.addEventListener('error', () => setConnection('lost', 'reconnecting…'));
-  stream.addEventListener('sample', (e) => render(JSON.parse(e.data)));
+  if (has('/me')) {
+    role = (await api('/me')).role ?? role;
+    sessionStorage.setItem('telltale.role', role);
+  }
+  document.body.dataset.role = role;
+  boats.forEach((b) => live.addBoat(b));
+  live.addEventListener('state', (e) => {
+    connection.dataset.state = e.detail;
+    connection.textContent = e.detail === 'live' ? 'live' : 'reconnecting…';
+  });
+  live.start();
+  watchAlarms();
+  window.addEventListener('hashchange', route);
+  route();
 }
 
 start().catch((err) => {
-  setConnection('lost', 'error');
+  connection.dataset.state = 'lost';
+  connection.textContent = 'error';
   showMessage(String(err));
 });
