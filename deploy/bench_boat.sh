@@ -23,6 +23,6 @@ rss_kb=$(awk '/VmRSS/ {print $2}' /proc/$boat/status)
 hwm_kb=$(awk '/VmHWM/ {print $2}' /proc/$boat/status)
 threads=$(awk '/Threads/ {print $2}' /proc/$boat/status)
 kill -INT $boat; wait $boat || true
-cpu=$(echo "scale=2; 100 * ($u1 + $s1 - $u0 - $s0) / $ticks / $seconds" | bc)
+cpu=$(awk -v d=$((u1 + s1 - u0 - s0)) -v t="$ticks" -v s="$seconds" 'BEGIN {printf "%.2f", 100 * d / t / s}')
 echo "boat_node over ${seconds}s: CPU ${cpu}% of one core, RSS $((rss_kb / 1024)) MB (peak $((hwm_kb / 1024)) MB), $threads threads"
 tail -n 1 "$dir/boat"

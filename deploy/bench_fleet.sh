@@ -6,6 +6,10 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 bin="$root/build/bin"
 boats=${1:-200}; seconds=${2:-300}; sse=${3:-1}; wrk_s=${4:-0}
+if [ "$wrk_s" -gt 0 ] && ! command -v wrk >/dev/null; then
+  echo "bench_fleet: the wrk part needs wrk (apt-get install wrk)" >&2
+  exit 2
+fi
 domain=$((150 + $$ % 50))
 dir=$(mktemp -d)
 token=bench-token
