@@ -156,6 +156,23 @@ sqlite3* open_db(const std::string& path, int flags) {
   return db;
 }
 
+/// The schema this build writes. Version 1: attitude gained boot_id (the boats' run id, for
+/// backfill receipts). Databases from earlier builds are migrated in place; a database from a
+/// newer build is refused rather than misread.
+constexpr int kSchemaVersion = 1;
+
+void migrate(sqlite3* db) {
+  Stmt version_q(db, "PRAGMA user_version");
+  const int version = version_q.step() ? static_cast<int>(version_q.i64(0)) : 0;
+  if (version > kSchemaVersion)
+    throw StoreError("written by a newer Telltale (schema " + std::to_string(version) +
+                     ", this build knows " + std::to_string(kSchemaVersion) + ")");
+  Stmt has_boot(db, "SELECT COUNT(*) FROM pragma_table_info('attitude') WHERE name = 'boot_id'");
+  if (has_boot.step() && has_boot.i64(0) == 0)
+    exec(db, "ALTER TABLE attitude ADD COLUMN boot_id INTEGER NOT NULL DEFAULT 0");
+  exec(db, ("PRAGMA user_version = " + std::to_string(kSchemaVersion)).c_str());
+}
+
 SessionInfo session_from(const Stmt& s) {
   return {s.i64(0), s.text(1), s.u64(2), s.u64(3), s.i64(4)};
 }
@@ -202,6 +219,7 @@ Store::Store(StoreConfig config) : config_(std::move(config)) {
   db_ = open_db(config_.path, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
   try {
     exec(db_, kSchema);
+    migrate(db_);
     reader_ = open_db(config_.path, SQLITE_OPEN_READONLY);
     if (sqlite3_prepare_v2(db_,
                            "INSERT OR IGNORE INTO attitude (boat_id, t_utc_ns, seq, heel_deg, "

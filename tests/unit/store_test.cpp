@@ -1,0 +1,131 @@
+// The shore's SQLite store on real files: migration from an older schema, duplicate-free merging
+// of re-sent samples, sessions split on gaps, and the receipts that drive the boats' backfill.
+#include "store.hpp"
+
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+
+namespace telltale::shore {
+namespace {
+
+constexpr std::uint64_t kSecond = 1000000000ULL;
+constexpr std::uint64_t kT0 = 1795300000ULL * kSecond;
+
+class StoreTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("telltale_store_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  StoreConfig config() const {
+    StoreConfig c;
+    c.path = (dir_ / "s.db").string();
+    c.commit_interval = std::chrono::milliseconds(20);
+    c.session_gap = std::chrono::seconds(60);
+    return c;
+  }
+  static AttitudeSample sample(const std::string& boat, std::uint64_t boot, std::uint64_t seq,
+                               std::uint64_t t_ns) {
+    AttitudeSample s;
+    s.boat_id = boat;
+    s.boot_id = boot;
+    s.seq = seq;
+    s.t_utc_ns = t_ns;
+    s.heel_deg = 10.0;
+    s.pitch_deg = 1.0;
+    s.heading_deg = std::nan("");
+    return s;
+  }
+  std::filesystem::path dir_;
+};
+
+// Given a database written before boot_id existed, when a new shore opens it, then the old
+// samples are kept and new ones (with boot ids) are stored beside them.
+TEST_F(StoreTest, MigratesAnOlderSchemaKeepingItsData) {
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(config().path.c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(db,
+                           "CREATE TABLE attitude (boat_id TEXT NOT NULL, t_utc_ns INTEGER NOT NULL,"
+                           " seq INTEGER NOT NULL, heel_deg REAL NOT NULL, pitch_deg REAL NOT NULL,"
+                           " heading_deg REAL, heel_rate_deg_s REAL, pitch_rate_deg_s REAL,"
+                           " yaw_rate_deg_s REAL, accel_weight REAL, quality REAL,"
+                           " PRIMARY KEY (boat_id, t_utc_ns)) WITHOUT ROWID;"
+                           "INSERT INTO attitude VALUES ('old', 1, 1, 5, 0, NULL, 0, 0, 0, 0, 1);",
+                           nullptr, nullptr, nullptr),
+              SQLITE_OK);
+    sqlite3_close(db);
+  }
+  Store store(config());
+  store.enqueue(sample("new", 42, 1, kT0));
+  store.flush();
+  EXPECT_EQ(store.count("old"), 1);
+  EXPECT_EQ(store.count("new"), 1);
+}
+
+TEST_F(StoreTest, RefusesADatabaseFromANewerBuild) {
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(config().path.c_str(), &db), SQLITE_OK);
+    sqlite3_exec(db, "PRAGMA user_version = 99", nullptr, nullptr, nullptr);
+    sqlite3_close(db);
+  }
+  EXPECT_THROW(Store store(config()), StoreError);
+}
+
+// Re-sent samples merge without duplicates; a gap longer than session_gap starts a new session;
+// the receipt is the highest seq with every earlier one stored, and moves once a hole is filled.
+TEST_F(StoreTest, DeduplicatesSplitsSessionsAndAcknowledgesContiguousRuns) {
+  Store store(config());
+  for (std::uint64_t i = 1; i <= 10; ++i)
+    if (i != 4) store.enqueue(sample("b", 7, i, kT0 + i * kSecond / 25));
+  store.flush();
+  auto acks = store.acks();
+  ASSERT_EQ(acks.size(), 1u);
+  EXPECT_EQ(acks[0].boot_id, 7u);
+  EXPECT_EQ(acks[0].acked_seq, 3u);  // seq 4 is missing
+  // Backfill: seq 4 arrives, and 5..6 again.
+  for (std::uint64_t i : {4ULL, 5ULL, 6ULL}) store.enqueue(sample("b", 7, i, kT0 + i * kSecond / 25));
+  store.flush();
+  EXPECT_EQ(store.count("b"), 10);
+  EXPECT_EQ(store.acks()[0].acked_seq, 10u);
+  // Two minutes later: a new session.
+  store.enqueue(sample("b", 7, 11, kT0 + 120 * kSecond));
+  store.flush();
+  const auto sessions = store.sessions(std::string("b"), 0, UINT64_MAX);
+  ASSERT_EQ(sessions.size(), 2u);
+  std::int64_t total = 0;
+  for (const auto& s : sessions) total += s.samples;
+  EXPECT_EQ(total, 11);
+  // A new run of the boat restarts the receipt at its own seq.
+  store.enqueue(sample("b", 8, 1, kT0 + 121 * kSecond));
+  store.flush();
+  EXPECT_EQ(store.acks()[0].boot_id, 8u);
+  EXPECT_EQ(store.acks()[0].acked_seq, 1u);
+}
+
+// After a restart the receipt of a run is rebuilt from what is on disk.
+TEST_F(StoreTest, ReceiptsSurviveARestart) {
+  {
+    Store store(config());
+    for (std::uint64_t i = 1; i <= 5; ++i) store.enqueue(sample("b", 9, i, kT0 + i * kSecond));
+    store.flush();
+  }
+  Store store(config());
+  store.enqueue(sample("b", 9, 7, kT0 + 7 * kSecond));
+  store.flush();
+  EXPECT_EQ(store.acks()[0].acked_seq, 5u);  // 6 still missing
+  store.enqueue(sample("b", 9, 6, kT0 + 6 * kSecond));
+  store.flush();
+  EXPECT_EQ(store.acks()[0].acked_seq, 7u);
+}
+
+}  // namespace
+}  // namespace telltale::shore
