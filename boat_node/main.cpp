@@ -169,40 +169,36 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   };
   telltale::boat::BoatDds dds(o.dds, o.boat_id, callbacks);
 
-  telltale::msg::BoatAttitude out;
-  out.boat_id(o.boat_id);
-  out.boot_id(boot_id);
-  const auto to_wire = [&](const telltale::boat::LogRecord& r) {
-    out.seq(r.seq);
-    out.t_utc_ns(r.t_utc_ns);
-    out.heel_deg(r.heel_deg);
-    out.pitch_deg(r.pitch_deg);
-    out.heading_deg(r.heading_deg);
-    out.heel_rate_deg_s(r.heel_rate_deg_s);
-    out.pitch_rate_deg_s(r.pitch_rate_deg_s);
-    out.yaw_rate_deg_s(r.yaw_rate_deg_s);
-    out.accel_weight(r.accel_weight);
-    out.quality(r.quality);
-    out.leds().left_leds(r.leds[0]);
-    out.leds().right_leds(r.leds[1]);
-    out.leds().up_leds(r.leds[2]);
-    out.leds().down_leds(r.leds[3]);
-    out.leds().led_count(r.led_count);
-    out.leds().level(static_cast<telltale::msg::AlarmLevel>(r.level));
-    return &out;
+  // One message per thread: the sensor loop publishes `out`, the backfill thread its own copy.
+  const auto fill = [&](const telltale::boat::LogRecord& r, telltale::msg::BoatAttitude& m) {
+    m.boat_id(o.boat_id);
+    m.boot_id(boot_id);
+    m.seq(r.seq);
+    m.t_utc_ns(r.t_utc_ns);
+    m.heel_deg(r.heel_deg);
+    m.pitch_deg(r.pitch_deg);
+    m.heading_deg(r.heading_deg);
+    m.heel_rate_deg_s(r.heel_rate_deg_s);
+    m.pitch_rate_deg_s(r.pitch_rate_deg_s);
+    m.yaw_rate_deg_s(r.yaw_rate_deg_s);
+    m.accel_weight(r.accel_weight);
+    m.quality(r.quality);
+    m.leds().left_leds(r.leds[0]);
+    m.leds().right_leds(r.leds[1]);
+    m.leds().up_leds(r.leds[2]);
+    m.leds().down_leds(r.leds[3]);
+    m.leds().led_count(r.led_count);
+    m.leds().level(static_cast<telltale::msg::AlarmLevel>(r.level));
   };
-  std::mutex backfill_msg_mutex;
-  telltale::msg::BoatAttitude backfill_msg;
-  backfill_msg.boat_id(o.boat_id);
-  backfill_msg.boot_id(boot_id);
+  telltale::msg::BoatAttitude out;
   backfiller = std::make_unique<telltale::boat::Backfiller>(
       telltale::boat::BackfillConfig{boot_id, static_cast<std::uint64_t>(2 * o.rate_hz), 2500,
                                      std::chrono::milliseconds(5000)},
       telltale::boat::SessionLogReader(o.log_dir, o.boat_id, boot_id),
-      [&](const telltale::boat::LogRecord& r) {
-        std::lock_guard lock(backfill_msg_mutex);
-        telltale::msg::BoatAttitude m = *to_wire(r);  // copy: `out` belongs to the sensor loop
-        return dds.backfill(m);
+      [&fill, &dds, backfill_msg = telltale::msg::BoatAttitude()](
+          const telltale::boat::LogRecord& r) mutable {
+        fill(r, backfill_msg);
+        return dds.backfill(backfill_msg);
       });
 
   telltale::msg::NodeStatus status;
@@ -240,7 +236,6 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   auto next_status = start;
   auto next_console = start;
   auto next_flush = start + std::chrono::seconds(1);
-  Clock::time_point last_sample_wall = start;
 
   while (!shutdown.stop_requested()) {
     const auto sample = source->next();
@@ -266,7 +261,6 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       ++bad_samples;
       continue;
     }
-    last_sample_wall = now;
     filter.update(mounting.apply(*sample));
 
     if (t + 1e-9 >= next_publish_s) {
@@ -313,7 +307,8 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       r.led_count = led_params.leds_per_bar;
       r.level = static_cast<std::uint8_t>(level);
       if (!log.append(r)) ++log_failures;
-      if (!dds.publish(*to_wire(r))) ++write_failures;
+      fill(r, out);
+      if (!dds.publish(out)) ++write_failures;
       backfiller->on_published(r.seq);
       if (!silenced) hook.on_level(o.boat_id, level, heel, now);
       if (o.console && now >= next_console) {
@@ -357,7 +352,6 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
               o.boat_id.c_str(), static_cast<unsigned long long>(seq),
               static_cast<unsigned long long>(backfiller->resent()), complete ? "yes" : "no",
               bad_samples);
-  (void)last_sample_wall;
 }
 
 }  // namespace
