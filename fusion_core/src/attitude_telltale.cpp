@@ -98,7 +98,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
     renormalise(state_.q_gyro);
   }
   const Eigen::Matrix3d r_gyro = state_.q_gyro.toRotationMatrix();  // body -> I
-  const Eigen::Matrix3d r_corr = state_.q_corr.toRotationMatrix();  // I -> E
+  const Eigen::Vector3d up_i = state_.up_i;                         // before this correction
 
   // --- Rest detection: gyro and accelerometer steady for rest_min_s -> learn the bias.
   const double a_rest = step(k.rest_lp);
@@ -144,14 +144,16 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // = 1.25 m/s^2 for seconds) that the low-pass would absorb as a tilt. Signature: a horizontal
   // acceleration across the heading, toward the side the vehicle turns to. A rotation in place
   // (a turntable's axis, a hand turning the sensor) has no such correlation.
-  const Eigen::Vector3d up_now = r_gyro.transpose() * r_corr.row(2).transpose();  // body frame
-  const double yaw_rate = up_now.dot(gyro);  // rate about the vertical
-  const Eigen::Vector3d a_e = r_corr * acc_i;
-  const Eigen::Vector3d x_e = r_corr * r_gyro.col(0);  // the bow, earth frame
-  const double xh2 = x_e.x() * x_e.x() + x_e.y() * x_e.y();
+  // All of it in frame I, with up_i for the vertical: the bow x (unit), its horizontal part
+  // x_h = x - (x.up) up, |x_h|^2 = 1 - (x.up)^2, and a_lat = (up x x_h).a / |x_h| =
+  // (up x x).a / |x_h|.
+  const double yaw_rate = (r_gyro.transpose() * up_i).dot(gyro);  // rate about the vertical
+  const Eigen::Vector3d bow_i = r_gyro.col(0);
+  const double bow_up = bow_i.dot(up_i);
+  const double xh2 = 1.0 - bow_up * bow_up;
   double turn = 0.0;
   if (xh2 > 0.09) {
-    const double a_lat = (-x_e.y() * a_e.x() + x_e.x() * a_e.y()) / std::sqrt(xh2);  // (z x x_h).a
+    const double a_lat = up_i.cross(bow_i).dot(acc_i) / std::sqrt(xh2);
     turn = a_lat * std::clamp(yaw_rate * k.turn_rate, -1.0, 1.0);
   }
   state_.turn_m_s2 += step(k.turn_lp) * (turn - state_.turn_m_s2);
@@ -172,27 +174,23 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   state_.acc_lp1_i += a_lp * (acc_i - state_.acc_lp1_i);
   state_.acc_lp2_i += a_lp * (state_.acc_lp1_i - state_.acc_lp2_i);
 
-  // --- Correction: rotate I -> E so that the low-passed specific force points up (full step:
-  // the low-pass already is the time constant). A tilt-only rotation (no z component).
-  Eigen::Vector3d v = r_corr * state_.acc_lp2_i;
-  const double vn2 = v.squaredNorm();
-  if (vn2 > 0.25 * p.g_m_s2 * p.g_m_s2) {
-    v /= std::sqrt(vn2);
-    const double qw = std::sqrt(0.5 * (1.0 + v.z()));
-    if (qw > 1e-6) {
-      // The weight scales the correction (nlerp from identity: exact at w = 1, first-order
-      // otherwise, where the steps are small): non-inertial stretches run on the gyro.
-      const double half = 0.5 * w / qw;
-      Eigen::Quaterniond dq(qw, half * v.y(), -half * v.x(), 0.0);  // unit at w = 1
-      renormalise(dq);
-      state_.q_corr = dq * state_.q_corr;
-      renormalise(state_.q_corr);
-      // Bias in motion: the correction this step, seen in the body frame, is minus the residual
-      // bias times dt; integrate it slowly (bias_motion_tau_s) so it never fights the low-pass.
+  // --- Correction: move the vertical of frame I toward the low-passed specific force (full
+  // step at w = 1: the low-pass already is the time constant; a fraction w of the way otherwise,
+  // by normalised linear interpolation, where the steps are small). Only the vertical matters
+  // for heel and pitch, and the turn test is invariant to a rotation about it, so the correction
+  // is this one unit vector rather than a rotation.
+  const double l2 = state_.acc_lp2_i.squaredNorm();
+  if (l2 > 0.25 * p.g_m_s2 * p.g_m_s2) {
+    const Eigen::Vector3d target = state_.acc_lp2_i / std::sqrt(l2);
+    const Eigen::Vector3d moved = up_i + w * (target - up_i);
+    const double m2 = moved.squaredNorm();
+    if (m2 > 1e-6) {  // not a half-turn away (an upside-down start at w ~ 0.5)
+      state_.up_i = moved / std::sqrt(m2);
+      // Bias in motion: this step's correction is the small rotation w (target x up) of frame I,
+      // which is minus the residual bias times dt, seen in the body frame; integrate it slowly
+      // (bias_motion_tau_s) so it never fights the low-pass.
       if (!at_rest && !gap) {
-        const Eigen::Vector3d corr_i =
-            r_corr.row(0).transpose() * (2.0 * dq.x()) + r_corr.row(1).transpose() * (2.0 * dq.y());
-        state_.bias_rad_s -= (r_gyro.transpose() * corr_i) * k.bias_motion;
+        state_.bias_rad_s -= (r_gyro.transpose() * (w * target.cross(up_i))) * k.bias_motion;
         state_.bias_rad_s =
             state_.bias_rad_s.cwiseMax(-p.max_bias_rad_s).cwiseMin(p.max_bias_rad_s);
       }
@@ -206,20 +204,10 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   state_.tilt_var_rad2 += kDriftVar * dt + (gyro_sat ? 1e-4 : 0.0) + (gap ? 1e-2 : 0.0);
   state_.tilt_var_rad2 *= 1.0 - w * step(k.acc);
 
-  // --- Output: up vector of the corrected attitude, seen in the body frame.
-  const Eigen::Quaterniond& qc = state_.q_corr;
-  const Eigen::Vector3d corr_row2(2.0 * (qc.x() * qc.z() - qc.w() * qc.y()),
-                                  2.0 * (qc.y() * qc.z() + qc.w() * qc.x()),
-                                  1.0 - 2.0 * (qc.x() * qc.x() + qc.y() * qc.y()));
-  const Eigen::Vector3d up_body = r_gyro.transpose() * corr_row2;
+  // --- Output: the corrected vertical, seen in the body frame.
+  const Eigen::Vector3d up_body = r_gyro.transpose() * state_.up_i;
   AttitudeOutput& o = state_.out;
-  // The same relation as tilt_from_accel, with the fast atan2 (two C-library atan2 were a third
-  // of the update's time).
-  o.heel_rad = fast_atan2(up_body.y(), up_body.z());
-  o.pitch_rad =
-      fast_atan2(up_body.x(), std::sqrt(up_body.y() * up_body.y() + up_body.z() * up_body.z()));
-  euler_rates_from_up(gyro, up_body, o.heel_rate_rad_s, o.pitch_rate_rad_s);
-  o.yaw_rate_rad_s = yaw_rate_from_up(gyro, up_body);
+  output_from_up(gyro, up_body, o);
   o.acc_weight = w;
   o.quality = 1.0 / (1.0 + state_.tilt_var_rad2 * kInvVar0);
   o.valid = true;

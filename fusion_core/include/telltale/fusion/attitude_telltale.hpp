@@ -76,10 +76,10 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
   using Params = TelltaleAttitudeParams;
   struct State {
     Eigen::Quaterniond q_gyro = Eigen::Quaterniond::Identity();  ///< body -> inertial frame I
-    Eigen::Quaterniond q_corr = Eigen::Quaterniond::Identity();  ///< I -> earth (tilt only)
-    Eigen::Vector3d bias_rad_s = Eigen::Vector3d::Zero();        ///< gyro bias, body
-    Eigen::Vector3d acc_lp1_i = Eigen::Vector3d::Zero();         ///< first low-pass stage, frame I
-    Eigen::Vector3d acc_lp2_i = Eigen::Vector3d::Zero();         ///< second stage, frame I
+    Eigen::Vector3d up_i = Eigen::Vector3d::UnitZ();  ///< the earth's vertical in frame I (unit)
+    Eigen::Vector3d bias_rad_s = Eigen::Vector3d::Zero();  ///< gyro bias, body
+    Eigen::Vector3d acc_lp1_i = Eigen::Vector3d::Zero();   ///< first low-pass stage, frame I
+    Eigen::Vector3d acc_lp2_i = Eigen::Vector3d::Zero();   ///< second stage, frame I
     Eigen::Vector3d acc_fast_i = Eigen::Vector3d::Zero();  ///< 1 s low-pass for the gate, frame I
     Eigen::Vector3d gyro_rest_lp_rad_s = Eigen::Vector3d::Zero();
     Eigen::Vector3d acc_rest_lp_m_s2 = Eigen::Vector3d::Zero();
