@@ -15,6 +15,15 @@ WriterCheck::WriterCheck(std::string security_dir) : security_dir_(std::move(sec
   (void)dds::fleet_tag(security_dir_, "");  // fails now, not on the first sample, without salt
 }
 
+WriterCheck::~WriterCheck() {
+  if (forged_ || unknown_writer_)
+    std::fprintf(stderr,
+                 "shore_server: security: dropped %llu samples with another node's id, %llu from "
+                 "undiscovered writers\n",
+                 static_cast<unsigned long long>(forged_.load()),
+                 static_cast<unsigned long long>(unknown_writer_.load()));
+}
+
 void WriterCheck::on_publisher_discovery(eprosima::fastdds::dds::DomainParticipant*,
                                          rtps::WriterDiscoveryInfo&& info) {
   std::lock_guard lock(mutex_);

@@ -27,6 +27,10 @@ class WriterCheck : public eprosima::fastdds::dds::DomainParticipantListener {
  public:
   /// `security_dir`: the shore's node folder (its fleet.salt gives the tags).
   explicit WriterCheck(std::string security_dir);
+  /// Prints the drop counts (stderr) when there were any.
+  ~WriterCheck() override;
+  WriterCheck(const WriterCheck&) = delete;
+  WriterCheck& operator=(const WriterCheck&) = delete;
 
   void on_publisher_discovery(eprosima::fastdds::dds::DomainParticipant* participant,
                               eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override;
