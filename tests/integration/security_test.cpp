@@ -17,6 +17,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <functional>
+#include <map>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <thread>
 
@@ -120,6 +121,7 @@ class LoopbackCapture {
       const bool ours = (src >= low_ && src <= high_) || (dst >= low_ && dst <= high_);
       if (!ours) continue;
       ++packets_;
+      ++sizes_[static_cast<std::size_t>(n) - ihl - sizeof(udphdr)];
       payloads_.append(reinterpret_cast<const char*>(buf.data() + ihl + sizeof(udphdr)),
                        static_cast<std::size_t>(n) - ihl - sizeof(udphdr));
     }
@@ -133,6 +135,20 @@ class LoopbackCapture {
   std::thread thread_;
   int packets_ = 0;
   std::string payloads_;
+  std::map<std::size_t, int> sizes_;  ///< UDP payload size -> packets
+
+ public:
+  /// The most frequent UDP payload size (the 25 Hz attitude sample's datagram). After finish().
+  [[nodiscard]] std::size_t commonest_size() const {
+    std::size_t best = 0;
+    int count = 0;
+    for (const auto& [size, n] : sizes_)
+      if (n > count) {
+        best = size;
+        count = n;
+      }
+    return best;
+  }
 };
 
 class SecurityTest : public ShoreFixture {
@@ -205,7 +221,8 @@ class SecurityTest : public ShoreFixture {
     int packets = 0;
     std::string payloads = capture.finish(&packets);
     EXPECT_GT(packets, 100) << "the capture saw almost nothing: it proves nothing";
-    std::printf("captured %d packets, %zu payload bytes\n", packets, payloads.size());
+    std::printf("captured %d packets, %zu payload bytes, commonest datagram %zu bytes\n", packets,
+                payloads.size(), capture.commonest_size());
     return payloads;
   }
 
