@@ -1,8 +1,9 @@
 #include "writer_check.hpp"
 
+#include <fastdds/rtps/writer/WriterDiscoveryInfo.h>
+
 #include <algorithm>
 #include <cstdio>
-#include <fastdds/rtps/writer/WriterDiscoveryInfo.h>
 #include <sstream>
 
 #include "dds_security.hpp"
@@ -28,11 +29,27 @@ void WriterCheck::on_publisher_discovery(eprosima::fastdds::dds::DomainParticipa
                                          rtps::WriterDiscoveryInfo&& info) {
   std::lock_guard lock(mutex_);
   const auto& guid = info.info.guid();
-  if (info.status == rtps::WriterDiscoveryInfo::REMOVED_WRITER) {
-    writers_.erase(guid);
-    return;
+  auto partitions = info.info.m_qos.m_partition.getNames();
+  switch (info.status) {
+    case rtps::WriterDiscoveryInfo::DISCOVERED_WRITER:
+      writers_[guid] = Writer{std::move(partitions), true};
+      break;
+    case rtps::WriterDiscoveryInfo::CHANGED_QOS_WRITER: {
+      auto w = writers_.find(guid);
+      if (w == writers_.end() || w->second.partitions == partitions || !w->second.trusted) break;
+      w->second.trusted = false;
+      std::ostringstream writer;
+      writer << guid;
+      std::fprintf(stderr,
+                   "shore_server: security: writer %s changed its partitions after discovery; "
+                   "they are not re-checked against its permissions, so its samples are dropped\n",
+                   writer.str().c_str());
+      break;
+    }
+    case rtps::WriterDiscoveryInfo::REMOVED_WRITER:
+      writers_.erase(guid);
+      break;
   }
-  writers_[guid] = info.info.m_qos.m_partition.getNames();
 }
 
 std::string WriterCheck::partition_of(const std::string& id) {
@@ -52,18 +69,21 @@ bool WriterCheck::allowed(const eprosima::fastdds::dds::InstanceHandle_t& public
     ++unknown_writer_;
     return false;
   }
-  const std::string expected = partition_of(claimed_id);
-  if (std::find(w->second.begin(), w->second.end(), expected) != w->second.end()) return true;
+  const auto& partitions = w->second.partitions;
+  if (w->second.trusted &&
+      std::find(partitions.begin(), partitions.end(), partition_of(claimed_id)) != partitions.end())
+    return true;
   ++forged_;
   if (logged_.insert(guid).second) {
     std::ostringstream writer;
     writer << guid;
-    std::string partitions;
-    for (const auto& p : w->second) partitions += (partitions.empty() ? "" : ",") + p;
+    std::string names;
+    for (const auto& p : partitions) names += (names.empty() ? "" : ",") + p;
     std::fprintf(stderr,
                  "shore_server: security: dropping samples claiming '%s' from writer %s "
-                 "(partitions %s): not that node's partition (further drops counted silently)\n",
-                 claimed_id.c_str(), writer.str().c_str(), partitions.c_str());
+                 "(partitions %s%s): not that node's partition (further drops counted silently)\n",
+                 claimed_id.c_str(), writer.str().c_str(), names.c_str(),
+                 w->second.trusted ? "" : ", changed since");
   }
   return false;
 }

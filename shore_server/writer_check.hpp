@@ -10,6 +10,11 @@
 /// The writers' partitions come from discovery (on_publisher_discovery, discovery thread); the
 /// checks run on the readers' listener thread. A sample from a writer not yet discovered is
 /// dropped too (fail closed) and counted apart.
+///
+/// Only the partitions a writer is first discovered with count: Fast DDS 2.9 checks them against
+/// the writer's signed permissions when it matches the writer (check_remote_datawriter) but not
+/// when the writer later changes its PARTITION QoS (measured: security_test's
+/// PartitionSwitchAfterCreation). A writer whose partitions change is distrusted for good.
 
 #include <atomic>
 #include <cstdint>
@@ -50,7 +55,11 @@ class WriterCheck : public eprosima::fastdds::dds::DomainParticipantListener {
 
   std::string security_dir_;
   std::mutex mutex_;
-  std::map<eprosima::fastrtps::rtps::GUID_t, std::vector<std::string>> writers_;
+  struct Writer {
+    std::vector<std::string> partitions;  ///< as first discovered
+    bool trusted = true;                  ///< false once it announced other partitions
+  };
+  std::map<eprosima::fastrtps::rtps::GUID_t, Writer> writers_;
   std::map<std::string, std::string> partition_cache_;  ///< id -> tt-<tag>
   std::set<eprosima::fastrtps::rtps::GUID_t> logged_;
   std::atomic<std::uint64_t> forged_{0};

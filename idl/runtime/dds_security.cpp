@@ -30,8 +30,7 @@ void apply_security(const std::string& dir, eprosima::fastdds::dds::DomainPartic
   props.emplace_back("dds.sec.access.plugin", "builtin.Access-Permissions");
   props.emplace_back("dds.sec.access.builtin.Access-Permissions.permissions_ca",
                      uri("permissions_ca.pem"));
-  props.emplace_back("dds.sec.access.builtin.Access-Permissions.governance",
-                     uri("governance.p7s"));
+  props.emplace_back("dds.sec.access.builtin.Access-Permissions.governance", uri("governance.p7s"));
   props.emplace_back("dds.sec.access.builtin.Access-Permissions.permissions",
                      uri("permissions.p7s"));
   props.emplace_back("dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC");

@@ -2,11 +2,11 @@
 // Security, each test with its own PKI made by deploy/security/make_fleet_pki.sh in a temporary
 // folder, its own DDS domain and HTTP port.
 #include <arpa/inet.h>
+#include <linux/if_ether.h>
+#include <linux/if_packet.h>
 #include <net/if.h>
 #include <netinet/ip.h>
 #include <netinet/udp.h>
-#include <linux/if_ether.h>
-#include <linux/if_packet.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -16,9 +16,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <functional>
 #include <map>
-#include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <thread>
 
 #include "dds_participant.hpp"
@@ -151,6 +151,17 @@ class LoopbackCapture {
   }
 };
 
+/// Moves the writer's publisher to `partition` (PARTITION is changeable). True if accepted.
+bool move_to_partition(fdds::DataWriter* writer, const std::string& partition) {
+  // Participant keeps its publisher to itself; Fast DDS hands it out const only.
+  auto* publisher = const_cast<fdds::Publisher*>(writer->get_publisher());
+  fdds::PublisherQos qos;
+  publisher->get_qos(qos);
+  qos.partition().clear();
+  qos.partition().push_back(partition.c_str());
+  return publisher->set_qos(qos) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK;
+}
+
 class SecurityTest : public ShoreFixture {
  protected:
   void SetUp() override {
@@ -263,8 +274,9 @@ TEST_F(SecurityTest, UnauthenticatedParticipantCanNeitherReadNorInject) {
   options.subscriber_partitions = {"*", ""};
   dds::Participant spy(options, "spy");
   CountingListener counter;
-  spy.reader(spy.topic(dds::kTopicBoatAttitude, fdds::TypeSupport(new msg::BoatAttitudePubSubType())),
-             "attitude_reader", &counter);
+  spy.reader(
+      spy.topic(dds::kTopicBoatAttitude, fdds::TypeSupport(new msg::BoatAttitudePubSubType())),
+      "attitude_reader", &counter);
   ASSERT_TRUE(eventually([&] { return listed_with_data("alpha"); }, seconds(20)));
   // The reader works (it hears the unsecured intruder) yet gets nothing of alpha's while the
   // secured shore does.
@@ -304,8 +316,8 @@ TEST_F(SecurityTest, BoatCertificateCannotPublishAsAnotherBoat) {
     for (const char* id : {"alpha", "bravo"}) {
       m.boat_id(id);
       m.seq(seq);
-      m.t_utc_ns(static_cast<std::uint64_t>(
-          std::chrono::system_clock::now().time_since_epoch() / std::chrono::nanoseconds(1)));
+      m.t_utc_ns(static_cast<std::uint64_t>(std::chrono::system_clock::now().time_since_epoch() /
+                                            std::chrono::nanoseconds(1)));
       m.heel_deg(5.0);
       writer->write(&m);
     }
@@ -321,6 +333,82 @@ TEST_F(SecurityTest, BoatCertificateCannotPublishAsAnotherBoat) {
   }
   EXPECT_TRUE(alpha_seen) << "the forger's writer never reached the shore: the test proves nothing";
   EXPECT_EQ(boats_by_id().count("bravo"), 0u);
+  const auto sessions = sessions_of("bravo");
+  EXPECT_TRUE(sessions.is_array() && sessions.empty()) << sessions.dump();
+}
+
+// 3. A node that creates its writer in its own partition and then moves the publisher to
+// bravo's partition (PARTITION is changeable, and Fast DDS checks the permissions when the writer
+// is created) still never gets bravo to the shore.
+TEST_F(SecurityTest, PartitionSwitchAfterCreationCannotPublishAsAnotherBoat) {
+  dds::DdsOptions options;
+  options.domain = domain_;
+  options.security_dir = pki_ + "/alpha";
+  dds::use_node_partitions(options, "alpha");
+  dds::Participant forger(options, "forger");
+  auto* writer = forger.writer(
+      forger.topic(dds::kTopicBoatAttitude, fdds::TypeSupport(new msg::BoatAttitudePubSubType())),
+      "attitude_writer");
+  msg::BoatAttitude m;
+  m.leds().led_count(6);
+  std::uint64_t seq = 0;
+  const auto write = [&](const char* id) {
+    m.boat_id(id);
+    m.seq(++seq);
+    m.t_utc_ns(static_cast<std::uint64_t>(std::chrono::system_clock::now().time_since_epoch() /
+                                          std::chrono::nanoseconds(1)));
+    writer->write(&m);
+  };
+  // Control: the writer reaches the shore as alpha.
+  ASSERT_TRUE(eventually(
+      [&] {
+        for (int i = 0; i < 5; ++i) write("alpha");
+        return boats_by_id().count("alpha") > 0;
+      },
+      seconds(20)));
+  const bool switched = move_to_partition(writer, dds::node_partition(pki_ + "/alpha", "bravo"));
+  const auto alpha_before = boats_by_id()["alpha"]["seq"].get<std::uint64_t>();
+  const auto deadline = Clock::now() + seconds(6);
+  while (Clock::now() < deadline) {
+    write("alpha");
+    write("bravo");
+    std::this_thread::sleep_for(milliseconds(40));
+  }
+  const auto boats = boats_by_id();
+  EXPECT_EQ(boats.count("bravo"), 0u) << get_json("/api/v1/boats").dump();
+  const auto sessions = sessions_of("bravo");
+  EXPECT_TRUE(sessions.is_array() && sessions.empty()) << sessions.dump();
+  std::printf("partition switch accepted locally: %s; alpha samples after it: %llu\n",
+              switched ? "yes" : "no",
+              static_cast<unsigned long long>(boats.at("alpha")["seq"].get<std::uint64_t>() -
+                                              alpha_before));
+}
+
+// 4. The same switch before the shore has discovered the writer: Fast DDS's access control
+// checks the partitions the writer is first announced with against its signed permissions and
+// never matches it (the shore's check alone would accept bravo in bravo's partition).
+TEST_F(SecurityTest, PartitionSwitchBeforeDiscoveryIsNeverMatched) {
+  dds::DdsOptions options;
+  options.domain = domain_;
+  options.security_dir = pki_ + "/alpha";
+  dds::use_node_partitions(options, "alpha");
+  dds::Participant forger(options, "forger");
+  auto* writer = forger.writer(
+      forger.topic(dds::kTopicBoatAttitude, fdds::TypeSupport(new msg::BoatAttitudePubSubType())),
+      "attitude_writer");
+  ASSERT_TRUE(move_to_partition(writer, dds::node_partition(pki_ + "/alpha", "bravo")));
+  msg::BoatAttitude m;
+  m.leds().led_count(6);
+  m.boat_id("bravo");
+  const auto deadline = Clock::now() + seconds(8);
+  for (std::uint64_t seq = 1; Clock::now() < deadline; ++seq) {
+    m.seq(seq);
+    m.t_utc_ns(static_cast<std::uint64_t>(std::chrono::system_clock::now().time_since_epoch() /
+                                          std::chrono::nanoseconds(1)));
+    writer->write(&m);
+    std::this_thread::sleep_for(milliseconds(40));
+  }
+  EXPECT_EQ(boats_by_id().count("bravo"), 0u) << get_json("/api/v1/boats").dump();
   const auto sessions = sessions_of("bravo");
   EXPECT_TRUE(sessions.is_array() && sessions.empty()) << sessions.dump();
 }
