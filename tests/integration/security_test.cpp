@@ -151,6 +151,51 @@ class LoopbackCapture {
   }
 };
 
+/// A participant in this process with a node's certificate folder, writing BoatAttitude samples
+/// in that node's partition with any boat id: a modified boat_node.
+class Forger {
+ public:
+  Forger(int domain, const std::string& security_dir, const std::string& own_id) {
+    dds::DdsOptions options;
+    options.domain = domain;
+    options.security_dir = security_dir;
+    dds::use_node_partitions(options, own_id);
+    participant_ = std::make_unique<dds::Participant>(options, "forger");
+    writer = participant_->writer(
+        participant_->topic(dds::kTopicBoatAttitude,
+                            fdds::TypeSupport(new msg::BoatAttitudePubSubType())),
+        "attitude_writer");
+    m_.leds().led_count(6);
+    m_.heel_deg(5.0);
+  }
+  /// One sample claiming `boat_id`.
+  void write(const char* boat_id) {
+    m_.boat_id(boat_id);
+    m_.seq(++seq_);
+    m_.t_utc_ns(static_cast<std::uint64_t>(std::chrono::system_clock::now().time_since_epoch() /
+                                           std::chrono::nanoseconds(1)));
+    writer->write(&m_);
+  }
+  /// Writes `ids` every 40 ms for `duration`, or until `stop()` (checked once a second).
+  template <class Stop>
+  void write_for(std::initializer_list<const char*> ids, std::chrono::milliseconds duration,
+                 Stop stop) {
+    const auto deadline = Clock::now() + duration;
+    for (int i = 1; Clock::now() < deadline; ++i) {
+      for (const char* id : ids) write(id);
+      std::this_thread::sleep_for(milliseconds(40));
+      if (i % 25 == 0 && stop()) return;
+    }
+  }
+
+  fdds::DataWriter* writer = nullptr;
+
+ private:
+  std::unique_ptr<dds::Participant> participant_;
+  msg::BoatAttitude m_;
+  std::uint64_t seq_ = 0;
+};
+
 /// Moves the writer's publisher to `partition` (PARTITION is changeable). True if accepted.
 bool move_to_partition(fdds::DataWriter* writer, const std::string& partition) {
   // Participant keeps its publisher to itself; Fast DDS hands it out const only.
@@ -298,39 +343,16 @@ TEST_F(SecurityTest, BoatCertificateCannotPublishAsAnotherBoat) {
 
   // 2. A forger that keeps to alpha's partition but writes bravo's id (a modified node): the shore
   // drops those samples. alpha's own samples from the same writer get through (control).
-  dds::DdsOptions options;
-  options.domain = domain_;
-  options.security_dir = pki_ + "/alpha";
-  dds::use_node_partitions(options, "alpha");
-  dds::Participant forger(options, "forger");
-  auto* writer = forger.writer(
-      forger.topic(dds::kTopicBoatAttitude, fdds::TypeSupport(new msg::BoatAttitudePubSubType())),
-      "attitude_writer");
-  msg::BoatAttitude m;
-  m.leds().led_count(6);
-  m.quality(1.0);
-  m.accel_weight(1.0);
+  Forger forger(domain_, pki_ + "/alpha", "alpha");
   bool alpha_seen = false;
-  const auto deadline = Clock::now() + seconds(20);
-  for (std::uint64_t seq = 1; Clock::now() < deadline; ++seq) {
-    for (const char* id : {"alpha", "bravo"}) {
-      m.boat_id(id);
-      m.seq(seq);
-      m.t_utc_ns(static_cast<std::uint64_t>(std::chrono::system_clock::now().time_since_epoch() /
-                                            std::chrono::nanoseconds(1)));
-      m.heel_deg(5.0);
-      writer->write(&m);
-    }
-    std::this_thread::sleep_for(milliseconds(40));
-    if (seq % 25 == 0) {
-      const auto boats = boats_by_id();
-      EXPECT_EQ(boats.count("bravo"), 0u) << get_json("/api/v1/boats").dump();
-      if (boats.count("alpha")) {
-        if (alpha_seen) break;  // one more second of forged samples after the control passed
-        alpha_seen = true;
-      }
-    }
-  }
+  forger.write_for({"alpha", "bravo"}, seconds(20), [&] {
+    const auto boats = boats_by_id();
+    EXPECT_EQ(boats.count("bravo"), 0u) << get_json("/api/v1/boats").dump();
+    if (boats.count("alpha") == 0) return false;
+    if (alpha_seen) return true;  // one more second of forged samples after the control passed
+    alpha_seen = true;
+    return false;
+  });
   EXPECT_TRUE(alpha_seen) << "the forger's writer never reached the shore: the test proves nothing";
   EXPECT_EQ(boats_by_id().count("bravo"), 0u);
   const auto sessions = sessions_of("bravo");
@@ -341,39 +363,14 @@ TEST_F(SecurityTest, BoatCertificateCannotPublishAsAnotherBoat) {
 // bravo's partition (PARTITION is changeable, and Fast DDS checks the permissions when the writer
 // is created) still never gets bravo to the shore.
 TEST_F(SecurityTest, PartitionSwitchAfterCreationCannotPublishAsAnotherBoat) {
-  dds::DdsOptions options;
-  options.domain = domain_;
-  options.security_dir = pki_ + "/alpha";
-  dds::use_node_partitions(options, "alpha");
-  dds::Participant forger(options, "forger");
-  auto* writer = forger.writer(
-      forger.topic(dds::kTopicBoatAttitude, fdds::TypeSupport(new msg::BoatAttitudePubSubType())),
-      "attitude_writer");
-  msg::BoatAttitude m;
-  m.leds().led_count(6);
-  std::uint64_t seq = 0;
-  const auto write = [&](const char* id) {
-    m.boat_id(id);
-    m.seq(++seq);
-    m.t_utc_ns(static_cast<std::uint64_t>(std::chrono::system_clock::now().time_since_epoch() /
-                                          std::chrono::nanoseconds(1)));
-    writer->write(&m);
-  };
+  Forger forger(domain_, pki_ + "/alpha", "alpha");
   // Control: the writer reaches the shore as alpha.
-  ASSERT_TRUE(eventually(
-      [&] {
-        for (int i = 0; i < 5; ++i) write("alpha");
-        return boats_by_id().count("alpha") > 0;
-      },
-      seconds(20)));
-  const bool switched = move_to_partition(writer, dds::node_partition(pki_ + "/alpha", "bravo"));
+  forger.write_for({"alpha"}, seconds(20), [&] { return boats_by_id().count("alpha") > 0; });
+  ASSERT_EQ(boats_by_id().count("alpha"), 1u);
+  const bool switched =
+      move_to_partition(forger.writer, dds::node_partition(pki_ + "/alpha", "bravo"));
   const auto alpha_before = boats_by_id()["alpha"]["seq"].get<std::uint64_t>();
-  const auto deadline = Clock::now() + seconds(6);
-  while (Clock::now() < deadline) {
-    write("alpha");
-    write("bravo");
-    std::this_thread::sleep_for(milliseconds(40));
-  }
+  forger.write_for({"alpha", "bravo"}, seconds(6), [] { return false; });
   const auto boats = boats_by_id();
   EXPECT_EQ(boats.count("bravo"), 0u) << get_json("/api/v1/boats").dump();
   const auto sessions = sessions_of("bravo");
@@ -388,26 +385,9 @@ TEST_F(SecurityTest, PartitionSwitchAfterCreationCannotPublishAsAnotherBoat) {
 // checks the partitions the writer is first announced with against its signed permissions and
 // never matches it (the shore's check alone would accept bravo in bravo's partition).
 TEST_F(SecurityTest, PartitionSwitchBeforeDiscoveryIsNeverMatched) {
-  dds::DdsOptions options;
-  options.domain = domain_;
-  options.security_dir = pki_ + "/alpha";
-  dds::use_node_partitions(options, "alpha");
-  dds::Participant forger(options, "forger");
-  auto* writer = forger.writer(
-      forger.topic(dds::kTopicBoatAttitude, fdds::TypeSupport(new msg::BoatAttitudePubSubType())),
-      "attitude_writer");
-  ASSERT_TRUE(move_to_partition(writer, dds::node_partition(pki_ + "/alpha", "bravo")));
-  msg::BoatAttitude m;
-  m.leds().led_count(6);
-  m.boat_id("bravo");
-  const auto deadline = Clock::now() + seconds(8);
-  for (std::uint64_t seq = 1; Clock::now() < deadline; ++seq) {
-    m.seq(seq);
-    m.t_utc_ns(static_cast<std::uint64_t>(std::chrono::system_clock::now().time_since_epoch() /
-                                          std::chrono::nanoseconds(1)));
-    writer->write(&m);
-    std::this_thread::sleep_for(milliseconds(40));
-  }
+  Forger forger(domain_, pki_ + "/alpha", "alpha");
+  ASSERT_TRUE(move_to_partition(forger.writer, dds::node_partition(pki_ + "/alpha", "bravo")));
+  forger.write_for({"bravo"}, seconds(8), [] { return false; });
   EXPECT_EQ(boats_by_id().count("bravo"), 0u) << get_json("/api/v1/boats").dump();
   const auto sessions = sessions_of("bravo");
   EXPECT_TRUE(sessions.is_array() && sessions.empty()) << sessions.dump();
