@@ -211,7 +211,7 @@ class SecurityTest : public ShoreFixture {
  protected:
   void SetUp() override {
     pki_ = make_temp_dir();
-    make_pki("", pki_, "alpha bravo");
+    make_pki("--wearable ann", pki_, "alpha bravo");
     // charlie: a certificate that expired in 2020, signed by the same fleet CA.
     make_pki("--start 20200101000000Z --end 20200102000000Z", pki_, "charlie");
     if (HasFatalFailure()) return;
@@ -291,10 +291,12 @@ class SecurityTest : public ShoreFixture {
   bool secured_shore_ = true;
 };
 
-TEST_F(SecurityTest, SecuredShoreListsTwoSecuredBoatsWithLiveData) {
+TEST_F(SecurityTest, SecuredShoreListsTwoSecuredBoatsAndAWearableWithLiveData) {
   EXPECT_NE(shore_->output().find("dds_security=on"), std::string::npos) << shore_->output();
   const double join_s = join_time_s("alpha", [&] { start_node("alpha", "alpha"); });
   start_node("bravo", "bravo");
+  Process wearable({bin_dir() + "/wearable_node", "--domain", std::to_string(domain_),
+                    "--athlete-id", "ann", "--security-dir", pki_ + "/ann"});
   ASSERT_TRUE(eventually([&] { return listed_with_data("alpha") && listed_with_data("bravo"); },
                          seconds(20)))
       << get_json("/api/v1/boats").dump();
@@ -306,6 +308,13 @@ TEST_F(SecurityTest, SecuredShoreListsTwoSecuredBoatsWithLiveData) {
         << id;
     EXPECT_FALSE(second.at(id)["stale"].get<bool>()) << id;
   }
+  EXPECT_TRUE(eventually(
+      [&] {
+        const auto athletes = get_json("/api/v1/athletes");
+        return athletes.is_array() && athletes.size() == 1 && athletes[0]["id"] == "ann";
+      },
+      seconds(20)))
+      << get_json("/api/v1/athletes").dump();
   std::printf("secured join (boat start -> listed at shore): %.2f s\n", join_s);
   RecordProperty("secured_join_ms", static_cast<int>(join_s * 1000));
 }
