@@ -4,6 +4,7 @@
 #include <map>
 #include <mutex>
 
+#include "dds_security.hpp"
 #include "telltalePubSubTypes.h"
 
 namespace telltale::boat {
@@ -71,7 +72,9 @@ BoatDds::BoatDds(const dds::DdsOptions& options, const std::string& boat_id,
     : boat_id_(boat_id),
       callbacks_(std::move(callbacks)),
       listener_(std::make_unique<Listener>(boat_id_, callbacks_)) {
-  participant_ = std::make_unique<dds::Participant>(options, "boat_node " + boat_id);
+  dds::DdsOptions opts = options;
+  dds::use_node_partitions(opts, boat_id);  // secured: publish only in this boat's partition
+  participant_ = std::make_unique<dds::Participant>(opts, "boat_node " + boat_id);
   auto* attitude = participant_->topic(dds::kTopicBoatAttitude,
                                        fdds::TypeSupport(new msg::BoatAttitudePubSubType()));
   attitude_writer_ = participant_->writer(attitude, "attitude_writer");

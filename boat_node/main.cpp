@@ -408,6 +408,9 @@ int main(int argc, char** argv) {
       ->group("Fault injection");
   app.add_option("--dds-profiles", o.dds.profiles_file,
                  "Fast DDS profiles XML (default: $TELLTALE_DDS_PROFILES or deploy/dds/)");
+  app.add_option("--security-dir", o.dds.security_dir,
+                 "DDS Security: this node's folder from deploy/security/make_fleet_pki.sh "
+                 "(default: unsecured)");
   app.add_option("--dds-participant", o.dds.participant_profile,
                  "participant profile in that file")
       ->capture_default_str();

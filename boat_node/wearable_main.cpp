@@ -9,6 +9,7 @@
 
 #include "csv.hpp"
 #include "dds_participant.hpp"
+#include "dds_security.hpp"
 #include "shutdown.hpp"
 #include "telltale/fusion/pdr.hpp"
 #include "telltale/fusion/sim/gait_sim.hpp"
@@ -179,7 +180,9 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   params.height_m = o.height_m;
   auto pdr = std::make_unique<fusion::Pdr>(params);  // 110 kB: not on the stack
 
-  telltale::dds::Participant participant(o.dds, "wearable_node " + o.athlete_id);
+  auto dds_options = o.dds;
+  telltale::dds::use_node_partitions(dds_options, o.athlete_id);  // secured: its own only
+  telltale::dds::Participant participant(dds_options, "wearable_node " + o.athlete_id);
   namespace fdds = eprosima::fastdds::dds;
   auto* motion_writer = participant.writer(
       participant.topic(telltale::dds::kTopicWearableMotion,
@@ -268,6 +271,9 @@ int main(int argc, char** argv) {
   app.add_option("--seed", o.seed, "simulator seed")->capture_default_str();
   app.add_flag("--replay-fast", o.replay_fast, "replay as fast as possible");
   app.add_option("--dds-profiles", o.dds.profiles_file, "Fast DDS profiles XML");
+  app.add_option("--security-dir", o.dds.security_dir,
+                 "DDS Security: this node's folder from deploy/security/make_fleet_pki.sh "
+                 "(default: unsecured)");
   app.add_option("--dds-participant", o.dds.participant_profile, "participant profile")
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);

@@ -1,18 +1,28 @@
 #!/usr/bin/env bash
 # CPU and memory of one boat node (issue 6): 100 Hz simulated IMU, 25 Hz publishing to a shore,
-# session log on, for SECONDS (default 60). Loopback only.
+# session log on, for SECONDS (default 60). Loopback only. --secure: both with DDS Security (a
+# fleet PKI made in the temporary folder by deploy/security/make_fleet_pki.sh).
 set -euo pipefail
+secure=()
+shore_secure=()
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 bin="$root/build/bin"
+if [[ "${1:-}" == --secure ]]; then shift; secure=(1); fi
 seconds=${1:-60}
 domain=$((150 + $$ % 50))
 dir=$(mktemp -d)
 trap 'kill -INT $shore 2>/dev/null || true; wait 2>/dev/null || true; rm -rf "$dir"' EXIT
-"$bin/shore_server" --domain "$domain" --http-port 0 --db "$dir/s.db" --coach-token t >"$dir/shore" 2>&1 &
+if [[ ${#secure[@]} -gt 0 ]]; then
+  "$root/deploy/security/make_fleet_pki.sh" "$dir/pki" bench >/dev/null
+  secure=(--security-dir "$dir/pki/bench")
+  shore_secure=(--security-dir "$dir/pki/shore")
+fi
+"$bin/shore_server" --domain "$domain" --http-port 0 --db "$dir/s.db" --coach-token t \
+  "${shore_secure[@]}" >"$dir/shore" 2>&1 &
 shore=$!
 sleep 1
 "$bin/boat_node" --domain "$domain" --boat-id bench --imu-rate-hz 100 --rate-hz 25 \
-  --log-dir "$dir/log" >"$dir/boat" 2>&1 &
+  --log-dir "$dir/log" "${secure[@]}" >"$dir/boat" 2>&1 &
 boat=$!
 sleep 3  # discovery and start-up
 ticks=$(getconf CLK_TCK)

@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # The demo: a shore server, four simulated boats and a wearable on a private DDS domain (loopback
 # only) and the dashboard. Prints the dashboard link with its token; Ctrl-C stops everything cleanly.
+# --secure: the same with DDS Security, a fleet PKI made in a temporary folder.
 set -euo pipefail
+secure=0
+[[ "${1:-}" == --secure ]] && secure=1
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 echo "building (log: $root/build/build.log)..."
 mkdir -p "$root/build"
@@ -24,19 +27,30 @@ stop() {
 }
 trap 'stop 0' INT TERM
 trap 'stop 1' EXIT
-"$bin/shore_server" --http-port "$port" --db "$db" --coach-token "$token" >"$log/shore" 2>&1 &
+sec() { :; }  # sec NODE: the node's --security-dir flag in secured mode, nothing otherwise
+if [[ $secure == 1 ]]; then
+  "$root/deploy/security/make_fleet_pki.sh" --wearable athlete-1 "$log/pki" \
+    ILCA-1 ILCA-2 ILCA-3 ILCA-4 >/dev/null
+  sec() { echo "--security-dir=$log/pki/$1"; }
+fi
+# shellcheck disable=SC2046  # sec's output is one word or none
+"$bin/shore_server" --http-port "$port" --db "$db" --coach-token "$token" $(sec shore) \
+  >"$log/shore" 2>&1 &
 pids+=($!)
 for _ in $(seq 100); do grep -q "ready" "$log/shore" && break; sleep 0.1; done
 grep -q "ready" "$log/shore" || { cat "$log/shore"; exit 1; }
 for boat in ILCA-1 ILCA-2 ILCA-3 ILCA-4; do
+  # shellcheck disable=SC2046
   "$bin/boat_node" --boat-id "$boat" --group ILCA7 --log-dir "$root/build/demo_boat_log" \
-    >"$log/$boat" 2>&1 &
+    $(sec "$boat") >"$log/$boat" 2>&1 &
   pids+=($!)
 done
-"$bin/wearable_node" --athlete-id athlete-1 --source sim >"$log/athlete-1" 2>&1 &
+# shellcheck disable=SC2046
+"$bin/wearable_node" --athlete-id athlete-1 --source sim $(sec athlete-1) >"$log/athlete-1" 2>&1 &
 pids+=($!)
 url=$(grep -o 'http://[^ ]*' "$log/shore")
-echo "Telltale demo on DDS domain $TELLTALE_DOMAIN: shore + 4 boats + 1 wearable"
+echo "Telltale demo on DDS domain $TELLTALE_DOMAIN: shore + 4 boats + 1 wearable" \
+  "($(grep -o 'dds_security=[a-z]*' "$log/shore"))"
 echo "Dashboard: ${url}#token=${token}"
 echo "Coach token: ${token}   (curl -H 'Authorization: Bearer ${token}' ${url}api/v1/boats)"
 echo "Ctrl-C to stop."

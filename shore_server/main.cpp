@@ -146,8 +146,9 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
   HttpApi api(o.http, {fleet, hub, tokens, store, alarms});
   const int port = api.bind();
   std::thread http_thread([&] { api.serve(); });
-  std::printf("shore_server ready: http://%s:%d/ domain=%d db=%s\n", o.http.bind_address.c_str(),
-              port, dds.domain(), o.store.path.c_str());
+  std::printf("shore_server ready: http://%s:%d/ domain=%d db=%s dds_security=%s\n",
+              o.http.bind_address.c_str(), port, dds.domain(), o.store.path.c_str(),
+              dds.secured() ? "on" : "off");
   std::fflush(stdout);
 
   // Stale sweep: a boat silent for stale_ms is marked stale even if DDS never says so. Every
@@ -211,6 +212,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--dds-profiles", o.dds.profiles_file,
                  "Fast DDS profiles XML (default: $TELLTALE_DDS_PROFILES or deploy/dds/)");
+  app.add_option("--security-dir", o.dds.security_dir,
+                 "DDS Security: the shore's folder from deploy/security/make_fleet_pki.sh "
+                 "(default: unsecured)");
   app.add_option("--dds-participant", o.dds.participant_profile, "participant profile")
       ->capture_default_str();
   o.http.web_dir = TELLTALE_DEFAULT_WEB_DIR;

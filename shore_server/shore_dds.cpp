@@ -3,6 +3,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <algorithm>
 
+#include "dds_security.hpp"
 #include "shutdown.hpp"
 #include "telltalePubSubTypes.h"
 
@@ -88,7 +89,12 @@ const char* pose_name(msg::Pose p) {
 
 class ShoreDds::Listener : public fdds::DataReaderListener {
  public:
-  explicit Listener(const FleetCallbacks& cb) : cb_(cb) {}
+  Listener(const FleetCallbacks& cb, WriterCheck* check) : cb_(cb), check_(check) {}
+
+  /// Unsecured: every sample. Secured: only a sample whose id is its writer's (writer_check.hpp).
+  bool accept(const fdds::SampleInfo& info, const std::string& claimed_id) {
+    return info.valid_data && (!check_ || check_->allowed(info.publication_handle, claimed_id));
+  }
 
   // Readers are told apart by topic name: a callback may arrive before the constructor below has
   // stored the reader pointers.
@@ -99,12 +105,12 @@ class ShoreDds::Listener : public fdds::DataReaderListener {
       const auto& sink = topic == dds::kTopicBoatAttitude ? cb_.on_attitude : cb_.on_backfill;
       msg::BoatAttitude m;
       while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
-        if (info.valid_data && sink) sink(from_wire(m));
+        if (sink && accept(info, m.boat_id().to_string())) sink(from_wire(m));
       }
     } else if (topic == dds::kTopicWearableMotion) {
       msg::WearableMotion m;
       while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
-        if (!info.valid_data || !cb_.on_wearable) continue;
+        if (!cb_.on_wearable || !accept(info, m.athlete_id().to_string())) continue;
         WearableSample w;
         w.athlete_id = m.athlete_id().to_string();
         w.seq = m.seq();
@@ -122,7 +128,7 @@ class ShoreDds::Listener : public fdds::DataReaderListener {
     } else if (topic == dds::kTopicNodeStatus) {
       msg::NodeStatus m;
       while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
-        if (!info.valid_data || !cb_.on_status) continue;
+        if (!cb_.on_status || !accept(info, m.node_id().to_string())) continue;
         NodeStatusInfo s;
         s.kind = kind_name(m.kind());
         s.software_version = m.software_version().to_string();
@@ -150,11 +156,19 @@ class ShoreDds::Listener : public fdds::DataReaderListener {
  private:
   using ReturnCode_t = eprosima::fastrtps::types::ReturnCode_t;
   const FleetCallbacks& cb_;
+  WriterCheck* check_;
 };
 
 ShoreDds::ShoreDds(const dds::DdsOptions& options, FleetCallbacks callbacks)
-    : callbacks_(std::move(callbacks)), listener_(std::make_unique<Listener>(callbacks_)) {
-  participant_ = std::make_unique<dds::Participant>(options, "shore_server");
+    : callbacks_(std::move(callbacks)) {
+  dds::DdsOptions opts = options;
+  if (!opts.security_dir.empty()) {
+    writer_check_ = std::make_unique<WriterCheck>(opts.security_dir);
+    opts.listener = writer_check_.get();
+    dds::use_shore_partitions(opts);
+  }
+  listener_ = std::make_unique<Listener>(callbacks_, writer_check_.get());
+  participant_ = std::make_unique<dds::Participant>(opts, "shore_server");
   participant_->reader(
       participant_->topic(dds::kTopicBoatAttitude,
                           fdds::TypeSupport(new msg::BoatAttitudePubSubType())),

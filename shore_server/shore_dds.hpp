@@ -14,6 +14,7 @@
 #include "dds_participant.hpp"
 #include "telltale/fusion/alarm_engine.hpp"
 #include "fleet.hpp"
+#include "writer_check.hpp"
 
 namespace telltale::shore {
 
@@ -44,10 +45,12 @@ class ShoreDds {
   /// Tells a boat that every sample of run `boot_id` up to `acked_seq` is stored. Thread-safe.
   void publish_ack(const std::string& boat_id, std::uint64_t boot_id, std::uint64_t acked_seq);
   [[nodiscard]] int domain() const { return participant_->domain(); }
+  [[nodiscard]] bool secured() const { return participant_->secured(); }
 
  private:
   class Listener;
   FleetCallbacks callbacks_;
+  std::unique_ptr<WriterCheck> writer_check_;  ///< secured mode only
   std::unique_ptr<Listener> listener_;
   std::unique_ptr<dds::Participant> participant_;
   eprosima::fastdds::dds::DataWriter* rule_writer_ = nullptr;

@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <mutex>
 
+#include "dds_security.hpp"
+
 namespace telltale::dds {
 
 using eprosima::fastdds::dds::DomainParticipantFactory;
@@ -59,11 +61,21 @@ Participant::Participant(const DdsOptions& options, const std::string& name)
     throw DdsError("no participant profile '" + options.participant_profile + "' in " + profiles);
   qos.name(name);
   if (options.customize) options.customize(qos);
-  participant_ = factory->create_participant(static_cast<fdds::DomainId_t>(domain_), qos);
-  if (!participant_) throw DdsError("cannot create DDS participant on domain " +
-                                    std::to_string(domain_));
-  publisher_ = participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
-  subscriber_ = participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
+  secured_ = !options.security_dir.empty();
+  if (secured_) apply_security(options.security_dir, qos);
+  participant_ = factory->create_participant(static_cast<fdds::DomainId_t>(domain_), qos,
+                                             options.listener, fdds::StatusMask::none());
+  if (!participant_)
+    throw DdsError("cannot create DDS participant on domain " + std::to_string(domain_) +
+                   (secured_ ? " (DDS Security refused the files in " + options.security_dir +
+                                   ": expired or foreign certificate, bad signature?)"
+                             : std::string()));
+  fdds::PublisherQos pub_qos = fdds::PUBLISHER_QOS_DEFAULT;
+  for (const auto& p : options.publisher_partitions) pub_qos.partition().push_back(p.c_str());
+  fdds::SubscriberQos sub_qos = fdds::SUBSCRIBER_QOS_DEFAULT;
+  for (const auto& p : options.subscriber_partitions) sub_qos.partition().push_back(p.c_str());
+  publisher_ = participant_->create_publisher(pub_qos);
+  subscriber_ = participant_->create_subscriber(sub_qos);
   if (!publisher_ || !subscriber_) {
     participant_->delete_contained_entities();
     factory->delete_participant(participant_);
@@ -90,7 +102,9 @@ fdds::Topic* Participant::topic(const std::string& topic_name, fdds::TypeSupport
 fdds::DataWriter* Participant::writer(fdds::Topic* t, const std::string& profile,
                                       fdds::DataWriterListener* listener) {
   auto* w = publisher_->create_datawriter_with_profile(t, profile, listener);
-  if (!w) throw DdsError("cannot create writer on " + t->get_name() + " with profile " + profile);
+  if (!w)
+    throw DdsError("cannot create writer on " + t->get_name() + " with profile " + profile +
+                   (secured_ ? " (DDS Security: this node's permissions do not allow it)" : ""));
   return w;
 }
 
@@ -98,7 +112,9 @@ fdds::DataReader* Participant::reader(fdds::Topic* t, const std::string& profile
                                       fdds::DataReaderListener* listener) {
   auto* r = subscriber_->create_datareader_with_profile(t, profile, listener,
                                                         fdds::StatusMask::all());
-  if (!r) throw DdsError("cannot create reader on " + t->get_name() + " with profile " + profile);
+  if (!r)
+    throw DdsError("cannot create reader on " + t->get_name() + " with profile " + profile +
+                   (secured_ ? " (DDS Security: this node's permissions do not allow it)" : ""));
   return r;
 }
 

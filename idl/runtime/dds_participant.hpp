@@ -6,6 +6,7 @@
 
 #include <fastdds/dds/core/status/StatusMask.hpp>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
@@ -18,6 +19,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace telltale::dds {
 
@@ -43,6 +45,14 @@ struct DdsOptions {
   std::string participant_profile = "telltale_loopback";
   /// Applied to the participant QoS after the profile (fault injection in tests).
   std::function<void(eprosima::fastdds::dds::DomainParticipantQos&)> customize;
+  /// Secured mode: a node folder of deploy/security/make_fleet_pki.sh (dds_security.hpp). Empty:
+  /// unsecured, the default.
+  std::string security_dir;
+  /// Partitions of the participant's publisher and subscriber (empty: the default partition).
+  std::vector<std::string> publisher_partitions;
+  std::vector<std::string> subscriber_partitions;
+  /// Discovery callbacks (on_publisher_discovery etc.); no status callbacks. Not owned.
+  eprosima::fastdds::dds::DomainParticipantListener* listener = nullptr;
 };
 
 /// The domain id from the flag or TELLTALE_DOMAIN. Throws DdsError if neither is set or the value
@@ -76,10 +86,12 @@ class Participant {
                                              eprosima::fastdds::dds::DataReaderListener* listener);
 
   [[nodiscard]] int domain() const { return domain_; }
+  [[nodiscard]] bool secured() const { return secured_; }
   [[nodiscard]] eprosima::fastdds::dds::DomainParticipant* get() const { return participant_; }
 
  private:
   int domain_ = 0;
+  bool secured_ = false;
   eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
