@@ -377,7 +377,8 @@ Pdr::Pdr(Params params, const PoseNetwork& net, const StepLengthModel& lengths)
         return p;
       }()),
       features_(params.feature_window_s),
-      heading_(params.heading) {}
+      heading_(params.heading),
+      mag_cal_(params.hard_iron) {}
 
 const StepDiagnostics& Pdr::step_diagnostics() const {
   return params_.mount == StepMount::kFoot ? foot_steps_.diagnostics() : phone_steps_.diagnostics();
@@ -607,7 +608,14 @@ const PdrOutput& Pdr::update(const ImuSample& s, const Eigen::Vector3d& mag_uT) 
   }
   // Into the walking frame of the pose in force (eqs. (14)-(15)).
   const Eigen::Matrix3d m = foot ? Eigen::Matrix3d::Identity() : pose_rotation(applied_pose_);
-  heading_.update(s.t_s, m * s.gyro_body_rad_s, m * s.acc_body_m_s2, m * mag_uT);
+  Eigen::Vector3d mag = mag_uT;
+  if (params_.calibrate_mag && mag.allFinite()) {
+    // The hard-iron residual rotates with the phone, so its heading error changes with the
+    // walking direction and does not cancel around a loop: remove it before the heading.
+    mag_cal_.update(s.t_s, s.gyro_body_rad_s, mag);
+    mag = mag_cal_.corrected(mag);
+  }
+  heading_.update(s.t_s, m * s.gyro_body_rad_s, m * s.acc_body_m_s2, m * mag);
   if (heading_.initialised()) {
     sum_sin_ += std::sin(heading_.heading_rad());
     sum_cos_ += std::cos(heading_.heading_rad());

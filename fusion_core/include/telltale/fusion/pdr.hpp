@@ -24,6 +24,7 @@
 #include <string_view>
 #include <vector>
 
+#include "telltale/fusion/hard_iron.hpp"
 #include "telltale/fusion/imu_sample.hpp"
 #include "telltale/fusion/phone_pose.hpp"
 #include "telltale/fusion/steps.hpp"
@@ -211,6 +212,8 @@ struct PdrParams {
   double straight_deg = 10.0;          ///< 3 steps within this of their mean are "straight"
   int pose_confirm_steps = 3;          ///< identical classifications before the pose changes
   HeadingFilterParams heading;
+  bool calibrate_mag = true;  ///< online hard-iron calibration (hard_iron.hpp) before the heading
+  HardIronParams hard_iron;
 };
 
 /// Everything a node publishes after a sample.
@@ -247,6 +250,7 @@ class Pdr {
   [[nodiscard]] const PdrOutput& output() const { return out_; }
   [[nodiscard]] const Diagnostics& diagnostics() const { return diag_; }
   [[nodiscard]] const StepDiagnostics& step_diagnostics() const;
+  [[nodiscard]] const HardIronCalibrator& mag_calibration() const { return mag_cal_; }
   /// Step frequencies seen at each step so far are not stored (no heap); for calibration, collect
   /// `output().step_hz` at every step in the caller.
 
@@ -263,6 +267,7 @@ class Pdr {
   AdaptiveStepDetector foot_steps_;
   PoseFeatureWindow features_;
   HeadingFilter heading_;
+  HardIronCalibrator mag_cal_;
   Diagnostics diag_;
   PdrOutput out_;
   PhonePose applied_pose_ = PhonePose::kHandHeld;
