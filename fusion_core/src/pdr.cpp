@@ -283,12 +283,17 @@ Eigen::Matrix3d pose_rotation(PhonePose pose) {
 
 // --- heading ----------------------------------------------------------------------------------
 double HeadingFilter::magnetic_heading_rad(const Eigen::Vector3d& mag, const Eigen::Vector3d& up) {
+  return magnetic_heading_rad(mag, up, Eigen::Vector3d::UnitX());
+}
+
+double HeadingFilter::magnetic_heading_rad(const Eigen::Vector3d& mag, const Eigen::Vector3d& up,
+                                           const Eigen::Vector3d& axis) {
   const Eigen::Vector3d north = mag - mag.dot(up) * up;
   const double nn = north.norm();
   if (!(nn > 1e-6)) return std::nan("");
   const Eigen::Vector3d n = north / nn;
   const Eigen::Vector3d e = n.cross(up);
-  const Eigen::Vector3d x = Eigen::Vector3d::UnitX() - up.x() * up;
+  const Eigen::Vector3d x = axis - axis.dot(up) * up;
   if (x.norm() < 0.3) return std::nan("");  // x within ~17 deg of vertical: no heading
   return wrap_2pi(std::atan2(x.dot(e), x.dot(n)));
 }
@@ -440,6 +445,7 @@ void Pdr::on_step(double t_s) {
           settling_ = false;
           correlated_steps_ = 0;
           switch_steps_ = 0;
+          pre_switch_tilts_ = tilts_;
           ++diag_.switches;
           // If the 3 steps before the switch were straight, their mean heading stands in for
           // the heading during the switch.
@@ -478,6 +484,7 @@ void Pdr::on_step(double t_s) {
       }
       waves_[slot] = w;
       tilts_[slot] = tilt;
+      last_slot_ = slot;
       ++wave_count_;
     }
     // Pose: classify the feature window at every step. A pose can only change around a detected
@@ -541,6 +548,10 @@ void Pdr::on_step(double t_s) {
   double heading = heading_.heading_rad();
   if (sum_sin_ != 0.0 || sum_cos_ != 0.0) heading = wrap_2pi(std::atan2(sum_sin_, sum_cos_));
   sum_sin_ = sum_cos_ = 0.0;
+  const double step_heading = heading;
+  const Eigen::Vector2d step_axis_x = axis_sum_[0], step_axis_z = axis_sum_[1];
+  axis_sum_[0].setZero();
+  axis_sum_[1].setZero();
   const bool replaced = switching_ && have_replacement_;
   if (replaced) {
     heading = replacement_heading_rad_;
@@ -565,25 +576,81 @@ void Pdr::on_step(double t_s) {
   out_.x_m += (len + pending_m_) * std::sin(heading);
   out_.y_m += (len + pending_m_) * std::cos(heading);
   pending_m_ = 0.0;
-  if (replaced && switch_steps_ < static_cast<int>(switch_len_m_.size()))
-    switch_len_m_[static_cast<std::size_t>(switch_steps_++)] = len;
+  if (switching_ && switch_steps_ < static_cast<int>(switch_.size())) {
+    SwitchStep& r = switch_[static_cast<std::size_t>(switch_steps_++)];
+    r.length_m = len;
+    r.laid_rad = heading;
+    r.old_frame_rad = step_heading;
+    r.slot = last_slot_;
+    r.tilt = tilts_[last_slot_];
+    r.axis_sum = {step_axis_x, step_axis_z};
+  }
   if (!switching_ && switch_steps_ > 0) {
-    // First step after a switch (our addition to seed 003): if the walker turned while the
-    // pre-switch heading stood in, the heading after the switch tells by how much; the switch
-    // steps are re-laid with headings interpolated from the old to the new one.
-    const double turn = std::remainder(heading - replacement_heading_rad_, kTwoPi);
-    if (std::abs(turn) > params_.straight_deg * M_PI / 180.0) {
-      const double n = static_cast<double>(switch_steps_);
-      for (int k = 0; k < switch_steps_; ++k) {
-        const double l = switch_len_m_[static_cast<std::size_t>(k)];
-        const double h = replacement_heading_rad_ + turn * (k + 0.5) / n;
-        out_.x_m += l * (std::sin(h) - std::sin(replacement_heading_rad_));
-        out_.y_m += l * (std::cos(h) - std::cos(replacement_heading_rad_));
-      }
-    }
+    relay_switch_steps(heading);
     switch_steps_ = 0;
   }
   out_.heading_deg = heading * 180.0 / M_PI;
+}
+
+void Pdr::relay_switch_steps(double heading_after) {
+  // First step after a pose switch (our addition to seed 003). While the phone was moved, the
+  // steps were laid with the heading from before the switch; now the new pose is known, each
+  // switch step is given the heading it really had:
+  //  - steps whose gravity direction (sensor frame) already matches the new steady one (same
+  //    foot: an arm swing alternates): the phone was in its new place, so the walking
+  //    direction is the new pose's forward axis, from that step's field and gyro-tracked up
+  //    (a turn during the settling steps is then measured, not interpolated);
+  //  - steps still in the old orientation: the heading filter's heading in the old frame;
+  //  - the steps of the movement itself: interpolated between those.
+  const double tol = std::cos(params_.switch_tilt_deg * M_PI / 180.0);
+  const std::size_t axis = pose_rotation(applied_pose_)(0, 0) > 0.5 ? 0 : 1;
+  const auto n = static_cast<std::size_t>(switch_steps_);
+  std::array<double, kMaxSwitchSteps> h{};
+  std::array<bool, kMaxSwitchSteps> known{};
+  bool moved = false;
+  for (std::size_t k = 0; k < n; ++k) {
+    const SwitchStep& r = switch_[k];
+    known[k] = false;
+    if (r.tilt.dot(tilts_[r.slot]) > tol) {
+      const Eigen::Vector2d& v = r.axis_sum[axis];
+      if (v.norm() > 1e-9) {
+        h[k] = wrap_2pi(std::atan2(v.x(), v.y()));
+        known[k] = true;
+      }
+      moved = true;
+    } else if (!moved && r.tilt.dot(pre_switch_tilts_[r.slot]) > tol) {
+      h[k] = r.old_frame_rad;
+      known[k] = true;
+    } else {
+      moved = true;
+    }
+  }
+  // Interpolate the unknown ones between the nearest known headings (the replacement heading
+  // before the first, the heading after the switch after the last).
+  double before = have_replacement_ ? replacement_heading_rad_ : switch_[0].laid_rad;
+  std::size_t before_k = 0;
+  bool have_before_k = false;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (known[k]) {
+      before = h[k];
+      before_k = k;
+      have_before_k = true;
+      continue;
+    }
+    std::size_t next = k;
+    while (next < n && !known[next]) ++next;
+    const double after = next < n ? h[next] : heading_after;
+    const double span =
+        static_cast<double>(next) - (have_before_k ? static_cast<double>(before_k) : -1.0);
+    const double pos =
+        static_cast<double>(k) - (have_before_k ? static_cast<double>(before_k) : -1.0);
+    h[k] = before + std::remainder(after - before, kTwoPi) * pos / span;
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    const SwitchStep& r = switch_[k];
+    out_.x_m += r.length_m * (std::sin(h[k]) - std::sin(r.laid_rad));
+    out_.y_m += r.length_m * (std::cos(h[k]) - std::cos(r.laid_rad));
+  }
 }
 
 const PdrOutput& Pdr::update(const ImuSample& s, const Eigen::Vector3d& mag_uT) {
@@ -616,6 +683,19 @@ const PdrOutput& Pdr::update(const ImuSample& s, const Eigen::Vector3d& mag_uT) 
     mag = mag_cal_.corrected(mag);
   }
   heading_.update(s.t_s, m * s.gyro_body_rad_s, m * s.acc_body_m_s2, m * mag);
+  if (!foot && mag.allFinite() && heading_.initialised()) {
+    // Walking direction of the two forward axes the poses use (sensor x: hand-held, arm swing;
+    // sensor -z: call, pocket), from the field and the gyro-tracked up (sensor frame), summed
+    // as unit vectors over the step: a switch's steps are re-laid with them (relay_switch_steps).
+    const Eigen::Vector3d up = m.transpose() * heading_.state().up;
+    const Eigen::Vector3d north = mag - mag.dot(up) * up;
+    const Eigen::Vector3d east = north.cross(up);
+    const Eigen::Vector3d x = Eigen::Vector3d::UnitX() - up.x() * up;
+    const Eigen::Vector3d z = -Eigen::Vector3d::UnitZ() + up.z() * up;
+    const Eigen::Vector2d hx(x.dot(east), x.dot(north)), hz(z.dot(east), z.dot(north));
+    if (hx.norm() > 1e-9) axis_sum_[0] += hx.normalized();
+    if (hz.norm() > 1e-9) axis_sum_[1] += hz.normalized();
+  }
   if (heading_.initialised()) {
     sum_sin_ += std::sin(heading_.heading_rad());
     sum_cos_ += std::cos(heading_.heading_rad());

@@ -188,6 +188,10 @@ class HeadingFilter {
   /// (same frame); NaN when x is near vertical or the field is degenerate.
   [[nodiscard]] static double magnetic_heading_rad(const Eigen::Vector3d& mag,
                                                    const Eigen::Vector3d& up);
+  /// The same for any unit axis of that frame (its horizontal projection's heading).
+  [[nodiscard]] static double magnetic_heading_rad(const Eigen::Vector3d& mag,
+                                                   const Eigen::Vector3d& up,
+                                                   const Eigen::Vector3d& axis);
 
  private:
   Params params_;
@@ -283,9 +287,27 @@ class Pdr {
   bool settling_ = false;  ///< switch over, waiting for the new pose to be confirmed
   int settling_steps_ = 0;
   bool pose_known_ = false;
-  double pending_m_ = 0.0;                 ///< distance walked before the first heading
-  std::array<double, 32> switch_len_m_{};  ///< steps laid with the replacement heading
+  double pending_m_ = 0.0;  ///< distance walked before the first heading
+  /// A step walked during a pose switch, re-laid when the switch is over.
+  struct SwitchStep {
+    double length_m = 0.0;
+    double laid_rad = 0.0;       ///< heading it was laid with
+    double old_frame_rad = 0.0;  ///< heading filter's heading (pose before the switch)
+    Eigen::Vector3d tilt = Eigen::Vector3d::UnitZ();  ///< mean gravity direction, sensor frame
+    std::size_t slot = 0;                             ///< which foot (waves_/tilts_ slot)
+    std::array<Eigen::Vector2d, 2> axis_sum{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
+  };
+  static constexpr std::size_t kMaxSwitchSteps = 32;
+  void relay_switch_steps(double heading_after);
+  std::array<SwitchStep, kMaxSwitchSteps> switch_{};
   int switch_steps_ = 0;
+  std::array<Eigen::Vector3d, 2> pre_switch_tilts_{
+      Eigen::Vector3d::UnitZ(),
+      Eigen::Vector3d::UnitZ()};  ///< both feet's gravity before the switch
+  std::size_t last_slot_ = 0;
+  /// Over the current step, sums of unit (east, north) vectors of the horizontal sensor x and
+  /// -z axes: the walking direction if the pose's forward axis is that one.
+  std::array<Eigen::Vector2d, 2> axis_sum_{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
   int wave_count_ = 0;
   double last_step_t_s_ = -1.0;
   double interval_ema_s_ = 0.0;
