@@ -405,8 +405,23 @@ Pdr::Wave Pdr::step_wave(double t0, double t1) const {
 void Pdr::on_step(double t_s) {
   const bool foot = params_.mount == StepMount::kFoot;
   const double per_event = foot ? 2.0 : 1.0;  // a foot sensor sees one event per two steps
+  // Steps the detector missed (our addition): its thresholds follow the last steps' peaks and
+  // valleys, so after an arm swing the smaller steps of the next pose go unseen until its
+  // memory resets (4-9 steps lost per arm-swing exit, measured; not always while a switch is
+  // detected). A gap of about n step intervals while the phone kept moving like a walk
+  // (acceleration energy over the last window) counts n - 1 more steps; a stop does not.
+  int missed = 0;
+  if (!foot && last_step_t_s_ >= 0.0 && interval_ema_s_ > 0.0) {
+    const double gap = t_s - last_step_t_s_;
+    const double ratio = gap / interval_ema_s_;
+    if (ratio > params_.fill_min_ratio && gap < params_.fill_max_gap_s &&
+        features_.features().acc_energy > params_.fill_min_energy)
+      missed = static_cast<int>(std::lround(ratio)) - 1;
+  }
+  diag_.filled_steps += static_cast<unsigned>(missed);
+  out_.steps += static_cast<std::size_t>(missed);
   if (last_step_t_s_ >= 0.0) {
-    const double interval = (t_s - last_step_t_s_) / per_event;
+    const double interval = (t_s - last_step_t_s_) / per_event / (1.0 + missed);
     if (interval < 2.0)
       interval_ema_s_ = interval_ema_s_ > 0.0 ? 0.5 * interval_ema_s_ + 0.5 * interval : interval;
   }
@@ -564,7 +579,7 @@ void Pdr::on_step(double t_s) {
   }
   // Eq. (13) and eq. (11). The first step has no frequency yet: the person's usual walk.
   const double hz = out_.step_hz > 0.0 ? out_.step_hz : 1.8;
-  const double len = per_event * lengths_.length_m(applied_pose_, params_.height_m, hz);
+  const double len = (per_event + missed) * lengths_.length_m(applied_pose_, params_.height_m, hz);
   out_.last_step_length_m = len;
   out_.distance_m += len;
   if (!foot && (!pose_known_ || !heading_.initialised())) {

@@ -215,6 +215,9 @@ struct PdrParams {
                                        ///< the walking frame's up is not plausible
   double straight_deg = 10.0;          ///< 3 steps within this of their mean are "straight"
   int pose_confirm_steps = 3;          ///< identical classifications before the pose changes
+  double fill_min_ratio = 1.6;         ///< a gap this many step intervals long has missed steps...
+  double fill_max_gap_s = 4.0;         ///< ...if shorter than this...
+  double fill_min_energy = 0.5;        ///< ...and the phone's acceleration energy says walking
   HeadingFilterParams heading;
   bool calibrate_mag = true;  ///< online hard-iron calibration (hard_iron.hpp) before the heading
   HardIronParams hard_iron;
@@ -245,6 +248,7 @@ class Pdr {
     unsigned switches = 0;           ///< pose switches detected by cross-correlation
     unsigned pose_changes = 0;       ///< classified pose changes applied
     unsigned replaced_headings = 0;  ///< steps that used the pre-switch heading
+    unsigned filled_steps = 0;       ///< steps added for gaps the detector left
   };
   /// `net` and `lengths` default to the built-in model; they are copied.
   explicit Pdr(Params params = {}, const PoseNetwork& net = builtin_pose_network(),
