@@ -218,6 +218,8 @@ struct PdrParams {
   double fill_min_ratio = 1.6;         ///< a gap this many step intervals long has missed steps...
   double fill_max_gap_s = 4.0;         ///< ...if shorter than this...
   double fill_min_energy = 0.5;        ///< ...and the phone's acceleration energy says walking
+  bool walking_direction = true;       ///< correct the phone's yaw from the acceleration pattern
+  int walking_direction_steps = 16;    ///< steps in a pose before the correction applies
   HeadingFilterParams heading;
   bool calibrate_mag = true;  ///< online hard-iron calibration (hard_iron.hpp) before the heading
   HardIronParams hard_iron;
@@ -303,6 +305,12 @@ class Pdr {
   };
   static constexpr std::size_t kMaxSwitchSteps = 32;
   void relay_switch_steps(double heading_after);
+  void reset_walking_direction();
+  // Correlation of the horizontal acceleration with d(vertical)/dt in the pose's walking frame.
+  double yaw_fwd_ = 0.0, yaw_left_ = 0.0;
+  int yaw_steps_ = 0;
+  double last_av_ = 0.0, last_av_t_ = 0.0;
+  bool have_av_ = false;
   std::array<SwitchStep, kMaxSwitchSteps> switch_{};
   int switch_steps_ = 0;
   std::array<Eigen::Vector3d, 2> pre_switch_tilts_{
