@@ -132,7 +132,9 @@ TEST(StepLengthCalibration, RecoversKnownCoefficientsAndStaysNearThePriorWithOne
 
 // Given a walker with a phone held in hand on a straight line with ideal sensors, when the PDR
 // runs, then the step count and the straight-line distance are right within 5 % and the track
-// points the right way.
+// points the right way. Direction budget 2 deg: 1.0 deg off without the online hard-iron
+// calibration, 1.6 deg with it (on a straight walk it learns from the hand's wobble alone and
+// its 1-sigma 0.2 uT is ~0.6 deg; on loops it removes 2-4 deg per pose).
 TEST(Pdr, StraightWalkHandHeld) {
   auto sc = *sim::make_gait_scenario("phone-hand-held-walk", 11);
   sc.path = {{500.0, 0.0}};
@@ -148,7 +150,7 @@ TEST(Pdr, StraightWalkHandHeld) {
   const auto& out = pdr.output();
   EXPECT_NEAR(static_cast<double>(out.steps), static_cast<double>(run.step_times_s.size()), 1.0);
   EXPECT_NEAR(out.distance_m, run.distance_m, 0.05 * run.distance_m);
-  EXPECT_NEAR(std::atan2(out.x_m, out.y_m) / kDeg, 60.0, 1.5);
+  EXPECT_NEAR(std::atan2(out.x_m, out.y_m) / kDeg, 60.0, 2.0);
   EXPECT_EQ(out.pose, PhonePose::kHandHeld);
   EXPECT_GT(out.cadence_spm, 80.0);
 }
@@ -193,11 +195,12 @@ TEST(Pdr, DetectsPoseSwitchesAndEndsInTheTruePose) {
 
 // Closed loops with pose switches (people held out of training). The issue asks for end-point
 // error <= 2 % of the distance in >= 90 % of walks (seed 003: 85 %). With this simulator's sensor
-// error model that is NOT reached: the measured figures (fusion_cli steps-eval --tables pdr) are
-// about 30 % of walks within 2 %, median 3.7 %; with ideal sensors and one pose the median is
-// 1.0 %. The per-pose heading bias of a 1 uT hard-iron residual and 2 deg of phone yaw (2-4 deg,
-// different in every pose) is what stands between; see /work/notes/issue-5.md. This test holds the
-// line at what is measured so a regression shows.
+// error model that is NOT reached. Measured (fusion_cli steps-eval --tables pdr, seeds
+// 2001-2040): 18 of 40 walks within 2 %, median 2.16 % (before the online hard-iron calibration,
+// the switch re-laying, the gap filling and the walking-direction correction: 13 of 40, 3.71 %).
+// What is left: accelerometer bias (tilt x tan(dip)), per-pose step-length differences, the
+// first leg before any turn calibrates the magnetometer; see /work/notes/s2-pdr.md. These 20
+// walks measure median 1.89 %, 11 within 2 %, 18th 3.77 %; the test holds that line.
 TEST(Pdr, ClosedLoopsWithPoseSwitchesMeasuredFigures) {
   std::vector<double> err;
   for (int i = 0; i < 20; ++i)
@@ -206,9 +209,9 @@ TEST(Pdr, ClosedLoopsWithPoseSwitchesMeasuredFigures) {
   const auto within = std::count_if(err.begin(), err.end(), [](double e) { return e <= 0.02; });
   RecordProperty("within_2_percent", std::to_string(within));
   RecordProperty("median_percent", std::to_string(100 * err[10]));
-  EXPECT_LE(err[10], 0.045);
-  EXPECT_GE(within, 5);
-  EXPECT_LE(err[17], 0.09);
+  EXPECT_LE(err[10], 0.022);
+  EXPECT_GE(within, 10);
+  EXPECT_LE(err[17], 0.045);
 }
 
 TEST(Pdr, ClosedLoopsWithIdealSensorsInOnePose) {
