@@ -59,7 +59,7 @@ void HardIronCalibrator::update(double t_s, const Eigen::Vector3d& gyro, const E
     const Eigen::Vector3d r = y - a * state_.offset_uT;
     const Eigen::Matrix3d s =
         var * Eigen::Matrix3d::Identity() + a * state_.covariance * a.transpose();
-    if (r.dot(s.ldlt().solve(r)) > params_.gate_chi2) {
+    if (r.dot(s.inverse() * r) > params_.gate_chi2) {
       ++diag_.rejected_gate;
     } else {
       state_.info.noalias() += a.transpose() * a / var;
