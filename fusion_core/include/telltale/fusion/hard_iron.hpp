@@ -33,6 +33,8 @@ struct HardIronParams {
   double gyro_bias_rad_s = 0.005;  ///< uncorrected gyro bias assumed when weighting, rad/s
   double prior_uT = 3.0;           ///< prior standard deviation of each hard-iron component, uT
   double lag_s = 0.5;              ///< time between the two samples of a pair
+  double min_rotation_deg = 5.0;   ///< pairs that turned less are not used (see the source)
+  double apply_sigma_uT = 1.0;     ///< directions known better than this are applied
   double gate_chi2 = 16.0;         ///< innovation gate (squared Mahalanobis distance, 3 dof)
   std::size_t solve_every = 10;    ///< pairs between two solutions of the 3x3 system
 };
@@ -44,9 +46,10 @@ class HardIronCalibrator {
   struct State {
     Eigen::Matrix3d info = Eigen::Matrix3d::Zero();  ///< normal matrix incl. the prior
     Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
-    Eigen::Vector3d offset_uT = Eigen::Vector3d::Zero();   ///< current estimate of b
-    Eigen::Vector3d sigma_uT = Eigen::Vector3d::Zero();    ///< its standard deviation per axis
-    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< of the estimate, uT^2
+    Eigen::Vector3d estimate_uT = Eigen::Vector3d::Zero();  ///< least-squares estimate of b
+    Eigen::Vector3d offset_uT = Eigen::Vector3d::Zero();    ///< its well-determined part (applied)
+    Eigen::Vector3d sigma_uT = Eigen::Vector3d::Zero();     ///< its standard deviation per axis
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();   ///< of the estimate, uT^2
     Eigen::Quaterniond attitude = Eigen::Quaterniond::Identity();  ///< gyro-integrated
     Eigen::Vector3d last_gyro = Eigen::Vector3d::Zero();
     double last_t_s = 0.0;
@@ -56,7 +59,8 @@ class HardIronCalibrator {
   };
   struct Diagnostics {
     std::size_t rejected_non_finite = 0;
-    std::size_t rejected_gate = 0;  ///< pairs refused as magnetically disturbed
+    std::size_t rejected_gate = 0;   ///< pairs refused as magnetically disturbed
+    std::size_t small_rotation = 0;  ///< pairs that turned less than min_rotation_deg
   };
   explicit HardIronCalibrator(Params params = {});
   /// Feeds one sample: time, gyro (rad/s, sensor frame; NaN = no gyro, nothing is learned),
