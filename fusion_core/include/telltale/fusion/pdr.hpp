@@ -11,6 +11,12 @@
 /// consecutive step waveforms, with the mean heading of the 3 straight steps before the switch used
 /// during it -> step length L = a h + b f + c per pose (eq. (13)) -> position (eq. (11)).
 ///
+/// Our additions (each measured on closed loops, see /work/notes/s2-pdr.md): online gyro-aided
+/// hard-iron calibration of the magnetometer (hard_iron.hpp); a switch's steps re-laid with the
+/// heading each really had once the new pose is known; steps the detector left in a gap of
+/// several intervals counted; the phone's yaw from the walking direction removed using the
+/// step's acceleration pattern.
+///
 /// Frames: the phone's sensor axes are whatever the phone has; the walking frame is x forward, y
 /// left, z up with `v_walking = M_pose v_sensor` (M = I for hand-held and arm swing). Position is
 /// x east, y north (m) from the start; heading clockwise from north.
