@@ -23,6 +23,8 @@ double wrap_2pi(double a) {
 
 double sigmoid(double x) { return 1.0 / (1.0 + std::exp(-x)); }
 
+bool gyro_ok(const ImuSample& s) { return s.gyro_body_rad_s.allFinite(); }
+
 }  // namespace
 
 // --- features ---------------------------------------------------------------------------------
@@ -283,12 +285,17 @@ Eigen::Matrix3d pose_rotation(PhonePose pose) {
 
 // --- heading ----------------------------------------------------------------------------------
 double HeadingFilter::magnetic_heading_rad(const Eigen::Vector3d& mag, const Eigen::Vector3d& up) {
+  return magnetic_heading_rad(mag, up, Eigen::Vector3d::UnitX());
+}
+
+double HeadingFilter::magnetic_heading_rad(const Eigen::Vector3d& mag, const Eigen::Vector3d& up,
+                                           const Eigen::Vector3d& axis) {
   const Eigen::Vector3d north = mag - mag.dot(up) * up;
   const double nn = north.norm();
   if (!(nn > 1e-6)) return std::nan("");
   const Eigen::Vector3d n = north / nn;
   const Eigen::Vector3d e = n.cross(up);
-  const Eigen::Vector3d x = Eigen::Vector3d::UnitX() - up.x() * up;
+  const Eigen::Vector3d x = axis - axis.dot(up) * up;
   if (x.norm() < 0.3) return std::nan("");  // x within ~17 deg of vertical: no heading
   return wrap_2pi(std::atan2(x.dot(e), x.dot(n)));
 }
@@ -377,7 +384,8 @@ Pdr::Pdr(Params params, const PoseNetwork& net, const StepLengthModel& lengths)
         return p;
       }()),
       features_(params.feature_window_s),
-      heading_(params.heading) {}
+      heading_(params.heading),
+      mag_cal_(params.hard_iron) {}
 
 const StepDiagnostics& Pdr::step_diagnostics() const {
   return params_.mount == StepMount::kFoot ? foot_steps_.diagnostics() : phone_steps_.diagnostics();
@@ -399,8 +407,23 @@ Pdr::Wave Pdr::step_wave(double t0, double t1) const {
 void Pdr::on_step(double t_s) {
   const bool foot = params_.mount == StepMount::kFoot;
   const double per_event = foot ? 2.0 : 1.0;  // a foot sensor sees one event per two steps
+  // Steps the detector missed (our addition): its thresholds follow the last steps' peaks and
+  // valleys, so after an arm swing the smaller steps of the next pose go unseen until its
+  // memory resets (4-9 steps lost per arm-swing exit, measured; not always while a switch is
+  // detected). A gap of about n step intervals while the phone kept moving like a walk
+  // (acceleration energy over the last window) counts n - 1 more steps; a stop does not.
+  int missed = 0;
+  if (!foot && last_step_t_s_ >= 0.0 && interval_ema_s_ > 0.0) {
+    const double gap = t_s - last_step_t_s_;
+    const double ratio = gap / interval_ema_s_;
+    if (ratio > params_.fill_min_ratio && gap < params_.fill_max_gap_s &&
+        features_.features().acc_energy > params_.fill_min_energy)
+      missed = static_cast<int>(std::lround(ratio)) - 1;
+  }
+  diag_.filled_steps += static_cast<unsigned>(missed);
+  out_.steps += static_cast<std::size_t>(missed);
   if (last_step_t_s_ >= 0.0) {
-    const double interval = (t_s - last_step_t_s_) / per_event;
+    const double interval = (t_s - last_step_t_s_) / per_event / (1.0 + missed);
     if (interval < 2.0)
       interval_ema_s_ = interval_ema_s_ > 0.0 ? 0.5 * interval_ema_s_ + 0.5 * interval : interval;
   }
@@ -439,6 +462,8 @@ void Pdr::on_step(double t_s) {
           settling_ = false;
           correlated_steps_ = 0;
           switch_steps_ = 0;
+          pre_switch_tilts_ = tilts_;
+          reset_walking_direction();
           ++diag_.switches;
           // If the 3 steps before the switch were straight, their mean heading stands in for
           // the heading during the switch.
@@ -477,6 +502,7 @@ void Pdr::on_step(double t_s) {
       }
       waves_[slot] = w;
       tilts_[slot] = tilt;
+      last_slot_ = slot;
       ++wave_count_;
     }
     // Pose: classify the feature window at every step. A pose can only change around a detected
@@ -526,6 +552,7 @@ void Pdr::on_step(double t_s) {
           sum_sin_ = sum_cos_ = 0.0;
         }
         if (pose_known_ && candidate_pose_ != applied_pose_) ++diag_.pose_changes;
+        if (candidate_pose_ != applied_pose_) reset_walking_direction();
         applied_pose_ = candidate_pose_;
         pose_known_ = true;
       }
@@ -540,6 +567,14 @@ void Pdr::on_step(double t_s) {
   double heading = heading_.heading_rad();
   if (sum_sin_ != 0.0 || sum_cos_ != 0.0) heading = wrap_2pi(std::atan2(sum_sin_, sum_cos_));
   sum_sin_ = sum_cos_ = 0.0;
+  ++yaw_steps_;
+  if (!foot && params_.walking_direction && yaw_steps_ >= params_.walking_direction_steps &&
+      yaw_fwd_ > 0.0)
+    heading = wrap_2pi(heading - std::atan2(yaw_left_, yaw_fwd_));
+  const double step_heading = heading;
+  const Eigen::Vector2d step_axis_x = axis_sum_[0], step_axis_z = axis_sum_[1];
+  axis_sum_[0].setZero();
+  axis_sum_[1].setZero();
   const bool replaced = switching_ && have_replacement_;
   if (replaced) {
     heading = replacement_heading_rad_;
@@ -552,7 +587,7 @@ void Pdr::on_step(double t_s) {
   }
   // Eq. (13) and eq. (11). The first step has no frequency yet: the person's usual walk.
   const double hz = out_.step_hz > 0.0 ? out_.step_hz : 1.8;
-  const double len = per_event * lengths_.length_m(applied_pose_, params_.height_m, hz);
+  const double len = (per_event + missed) * lengths_.length_m(applied_pose_, params_.height_m, hz);
   out_.last_step_length_m = len;
   out_.distance_m += len;
   if (!foot && (!pose_known_ || !heading_.initialised())) {
@@ -564,25 +599,87 @@ void Pdr::on_step(double t_s) {
   out_.x_m += (len + pending_m_) * std::sin(heading);
   out_.y_m += (len + pending_m_) * std::cos(heading);
   pending_m_ = 0.0;
-  if (replaced && switch_steps_ < static_cast<int>(switch_len_m_.size()))
-    switch_len_m_[static_cast<std::size_t>(switch_steps_++)] = len;
+  if (switching_ && switch_steps_ < static_cast<int>(switch_.size())) {
+    SwitchStep& r = switch_[static_cast<std::size_t>(switch_steps_++)];
+    r.length_m = len;
+    r.laid_rad = heading;
+    r.old_frame_rad = step_heading;
+    r.slot = last_slot_;
+    r.tilt = tilts_[last_slot_];
+    r.axis_sum = {step_axis_x, step_axis_z};
+  }
   if (!switching_ && switch_steps_ > 0) {
-    // First step after a switch (our addition to seed 003): if the walker turned while the
-    // pre-switch heading stood in, the heading after the switch tells by how much; the switch
-    // steps are re-laid with headings interpolated from the old to the new one.
-    const double turn = std::remainder(heading - replacement_heading_rad_, kTwoPi);
-    if (std::abs(turn) > params_.straight_deg * M_PI / 180.0) {
-      const double n = static_cast<double>(switch_steps_);
-      for (int k = 0; k < switch_steps_; ++k) {
-        const double l = switch_len_m_[static_cast<std::size_t>(k)];
-        const double h = replacement_heading_rad_ + turn * (k + 0.5) / n;
-        out_.x_m += l * (std::sin(h) - std::sin(replacement_heading_rad_));
-        out_.y_m += l * (std::cos(h) - std::cos(replacement_heading_rad_));
-      }
-    }
+    relay_switch_steps(heading);
     switch_steps_ = 0;
   }
   out_.heading_deg = heading * 180.0 / M_PI;
+}
+
+void Pdr::reset_walking_direction() {
+  yaw_fwd_ = yaw_left_ = 0.0;
+  yaw_steps_ = 0;
+  have_av_ = false;
+}
+
+void Pdr::relay_switch_steps(double heading_after) {
+  // First step after a pose switch (our addition to seed 003). While the phone was moved, the
+  // steps were laid with the heading from before the switch; now the new pose is known, each
+  // switch step is given the heading it really had:
+  //  - steps whose gravity direction (sensor frame) already matches the new steady one (same
+  //    foot: an arm swing alternates): the phone was in its new place, so the walking
+  //    direction is the new pose's forward axis, from that step's field and gyro-tracked up
+  //    (a turn during the settling steps is then measured, not interpolated);
+  //  - steps still in the old orientation: the heading filter's heading in the old frame;
+  //  - the steps of the movement itself: interpolated between those.
+  const double tol = std::cos(params_.switch_tilt_deg * M_PI / 180.0);
+  const std::size_t axis = pose_rotation(applied_pose_)(0, 0) > 0.5 ? 0 : 1;
+  const auto n = static_cast<std::size_t>(switch_steps_);
+  std::array<double, kMaxSwitchSteps> h{};
+  std::array<bool, kMaxSwitchSteps> known{};
+  bool moved = false;
+  for (std::size_t k = 0; k < n; ++k) {
+    const SwitchStep& r = switch_[k];
+    known[k] = false;
+    if (r.tilt.dot(tilts_[r.slot]) > tol) {
+      const Eigen::Vector2d& v = r.axis_sum[axis];
+      if (v.norm() > 1e-9) {
+        h[k] = wrap_2pi(std::atan2(v.x(), v.y()));
+        known[k] = true;
+      }
+      moved = true;
+    } else if (!moved && r.tilt.dot(pre_switch_tilts_[r.slot]) > tol) {
+      h[k] = r.old_frame_rad;
+      known[k] = true;
+    } else {
+      moved = true;
+    }
+  }
+  // Interpolate the unknown ones between the nearest known headings (the replacement heading
+  // before the first, the heading after the switch after the last).
+  double before = have_replacement_ ? replacement_heading_rad_ : switch_[0].laid_rad;
+  std::size_t before_k = 0;
+  bool have_before_k = false;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (known[k]) {
+      before = h[k];
+      before_k = k;
+      have_before_k = true;
+      continue;
+    }
+    std::size_t next = k;
+    while (next < n && !known[next]) ++next;
+    const double after = next < n ? h[next] : heading_after;
+    const double span =
+        static_cast<double>(next) - (have_before_k ? static_cast<double>(before_k) : -1.0);
+    const double pos =
+        static_cast<double>(k) - (have_before_k ? static_cast<double>(before_k) : -1.0);
+    h[k] = before + std::remainder(after - before, kTwoPi) * pos / span;
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    const SwitchStep& r = switch_[k];
+    out_.x_m += r.length_m * (std::sin(h[k]) - std::sin(r.laid_rad));
+    out_.y_m += r.length_m * (std::cos(h[k]) - std::cos(r.laid_rad));
+  }
 }
 
 const PdrOutput& Pdr::update(const ImuSample& s, const Eigen::Vector3d& mag_uT) {
@@ -607,7 +704,54 @@ const PdrOutput& Pdr::update(const ImuSample& s, const Eigen::Vector3d& mag_uT) 
   }
   // Into the walking frame of the pose in force (eqs. (14)-(15)).
   const Eigen::Matrix3d m = foot ? Eigen::Matrix3d::Identity() : pose_rotation(applied_pose_);
-  heading_.update(s.t_s, m * s.gyro_body_rad_s, m * s.acc_body_m_s2, m * mag_uT);
+  Eigen::Vector3d mag = mag_uT;
+  if (params_.calibrate_mag && mag.allFinite()) {
+    // The hard-iron residual rotates with the phone, so its heading error changes with the
+    // walking direction and does not cancel around a loop: remove it before the heading.
+    mag_cal_.update(s.t_s, s.gyro_body_rad_s, mag);
+    mag = mag_cal_.corrected(mag);
+  }
+  heading_.update(s.t_s, m * s.gyro_body_rad_s, m * s.acc_body_m_s2, m * mag);
+  if (!foot && !switching_ && params_.walking_direction && gyro_ok(s)) {
+    // Walking direction from the acceleration pattern of the step (our addition): the trunk
+    // brakes after heel strike and speeds up before the next one, so the forward acceleration
+    // is in quadrature with the vertical one, correlated with its time derivative; sideways
+    // sway is at half the step frequency and a tilt error leaks the vertical in phase, both
+    // uncorrelated with it. The angle of that correlation in the horizontal plane of the pose's
+    // walking frame is how far the phone is yawed from the walking direction (2 deg rms per
+    // pose in the simulator, and what a hand really does).
+    const Eigen::Vector3d& up = heading_.state().up;
+    const Eigen::Vector3d a = m * s.acc_body_m_s2;
+    const double av = a.dot(up);
+    if (have_av_) {
+      const double dav = (av - last_av_) / (s.t_s - last_av_t_);
+      Eigen::Vector3d fwd = Eigen::Vector3d::UnitX() - up.x() * up;
+      if (fwd.norm() > 0.3) {
+        fwd.normalize();
+        const Eigen::Vector3d left = up.cross(fwd);
+        yaw_fwd_ += a.dot(fwd) * dav;
+        yaw_left_ += a.dot(left) * dav;
+      }
+    }
+    last_av_ = av;
+    last_av_t_ = s.t_s;
+    have_av_ = true;
+  } else {
+    have_av_ = false;
+  }
+  if (!foot && mag.allFinite() && heading_.initialised()) {
+    // Walking direction of the two forward axes the poses use (sensor x: hand-held, arm swing;
+    // sensor -z: call, pocket), from the field and the gyro-tracked up (sensor frame), summed
+    // as unit vectors over the step: a switch's steps are re-laid with them (relay_switch_steps).
+    const Eigen::Vector3d up = m.transpose() * heading_.state().up;
+    const Eigen::Vector3d north = mag - mag.dot(up) * up;
+    const Eigen::Vector3d east = north.cross(up);
+    const Eigen::Vector3d x = Eigen::Vector3d::UnitX() - up.x() * up;
+    const Eigen::Vector3d z = -Eigen::Vector3d::UnitZ() + up.z() * up;
+    const Eigen::Vector2d hx(x.dot(east), x.dot(north)), hz(z.dot(east), z.dot(north));
+    if (hx.norm() > 1e-9) axis_sum_[0] += hx.normalized();
+    if (hz.norm() > 1e-9) axis_sum_[1] += hz.normalized();
+  }
   if (heading_.initialised()) {
     sum_sin_ += std::sin(heading_.heading_rad());
     sum_cos_ += std::cos(heading_.heading_rad());

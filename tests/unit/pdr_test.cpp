@@ -193,11 +193,13 @@ TEST(Pdr, DetectsPoseSwitchesAndEndsInTheTruePose) {
 
 // Closed loops with pose switches (people held out of training). The issue asks for end-point
 // error <= 2 % of the distance in >= 90 % of walks (seed 003: 85 %). With this simulator's sensor
-// error model that is NOT reached: the measured figures (fusion_cli steps-eval --tables pdr) are
-// about 30 % of walks within 2 %, median 3.7 %; with ideal sensors and one pose the median is
-// 1.0 %. The per-pose heading bias of a 1 uT hard-iron residual and 2 deg of phone yaw (2-4 deg,
-// different in every pose) is what stands between; see /work/notes/issue-5.md. This test holds the
-// line at what is measured so a regression shows.
+// error model that is NOT reached. Measured (fusion_cli steps-eval --tables pdr, seeds
+// 2001-2040): 20 of 40 walks within 2 %, median 2.08 %, 90th percentile 3.86 % (before the online
+// hard-iron calibration, the switch re-laying, the gap filling and the walking-direction
+// correction: 13 of 40, 3.71 %, 6.95 %). What is left: accelerometer and gyro bias (tilt x
+// tan(dip)), per-person and per-pose step-length errors, the legs walked before a turn
+// calibrates the magnetometer; see /work/notes/s2-pdr.md. These 20 walks measure median 1.83 %,
+// 12 within 2 %, 18th 3.77 %; the test holds that line.
 TEST(Pdr, ClosedLoopsWithPoseSwitchesMeasuredFigures) {
   std::vector<double> err;
   for (int i = 0; i < 20; ++i)
@@ -206,9 +208,9 @@ TEST(Pdr, ClosedLoopsWithPoseSwitchesMeasuredFigures) {
   const auto within = std::count_if(err.begin(), err.end(), [](double e) { return e <= 0.02; });
   RecordProperty("within_2_percent", std::to_string(within));
   RecordProperty("median_percent", std::to_string(100 * err[10]));
-  EXPECT_LE(err[10], 0.045);
-  EXPECT_GE(within, 5);
-  EXPECT_LE(err[17], 0.09);
+  EXPECT_LE(err[10], 0.021);
+  EXPECT_GE(within, 11);
+  EXPECT_LE(err[17], 0.045);
 }
 
 TEST(Pdr, ClosedLoopsWithIdealSensorsInOnePose) {

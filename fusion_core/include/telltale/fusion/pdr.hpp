@@ -11,6 +11,12 @@
 /// consecutive step waveforms, with the mean heading of the 3 straight steps before the switch used
 /// during it -> step length L = a h + b f + c per pose (eq. (13)) -> position (eq. (11)).
 ///
+/// Our additions (each measured on closed loops, see /work/notes/s2-pdr.md): online gyro-aided
+/// hard-iron calibration of the magnetometer (hard_iron.hpp); a switch's steps re-laid with the
+/// heading each really had once the new pose is known; steps the detector left in a gap of
+/// several intervals counted; the phone's yaw from the walking direction removed using the
+/// step's acceleration pattern.
+///
 /// Frames: the phone's sensor axes are whatever the phone has; the walking frame is x forward, y
 /// left, z up with `v_walking = M_pose v_sensor` (M = I for hand-held and arm swing). Position is
 /// x east, y north (m) from the start; heading clockwise from north.
@@ -24,6 +30,7 @@
 #include <string_view>
 #include <vector>
 
+#include "telltale/fusion/hard_iron.hpp"
 #include "telltale/fusion/imu_sample.hpp"
 #include "telltale/fusion/phone_pose.hpp"
 #include "telltale/fusion/steps.hpp"
@@ -187,6 +194,10 @@ class HeadingFilter {
   /// (same frame); NaN when x is near vertical or the field is degenerate.
   [[nodiscard]] static double magnetic_heading_rad(const Eigen::Vector3d& mag,
                                                    const Eigen::Vector3d& up);
+  /// The same for any unit axis of that frame (its horizontal projection's heading).
+  [[nodiscard]] static double magnetic_heading_rad(const Eigen::Vector3d& mag,
+                                                   const Eigen::Vector3d& up,
+                                                   const Eigen::Vector3d& axis);
 
  private:
   Params params_;
@@ -210,7 +221,14 @@ struct PdrParams {
                                        ///< the walking frame's up is not plausible
   double straight_deg = 10.0;          ///< 3 steps within this of their mean are "straight"
   int pose_confirm_steps = 3;          ///< identical classifications before the pose changes
+  double fill_min_ratio = 1.6;         ///< a gap this many step intervals long has missed steps...
+  double fill_max_gap_s = 4.0;         ///< ...if shorter than this...
+  double fill_min_energy = 0.5;        ///< ...and the phone's acceleration energy says walking
+  bool walking_direction = true;       ///< correct the phone's yaw from the acceleration pattern
+  int walking_direction_steps = 16;    ///< steps in a pose before the correction applies
   HeadingFilterParams heading;
+  bool calibrate_mag = true;  ///< online hard-iron calibration (hard_iron.hpp) before the heading
+  HardIronParams hard_iron;
 };
 
 /// Everything a node publishes after a sample.
@@ -238,6 +256,7 @@ class Pdr {
     unsigned switches = 0;           ///< pose switches detected by cross-correlation
     unsigned pose_changes = 0;       ///< classified pose changes applied
     unsigned replaced_headings = 0;  ///< steps that used the pre-switch heading
+    unsigned filled_steps = 0;       ///< steps added for gaps the detector left
   };
   /// `net` and `lengths` default to the built-in model; they are copied.
   explicit Pdr(Params params = {}, const PoseNetwork& net = builtin_pose_network(),
@@ -247,6 +266,7 @@ class Pdr {
   [[nodiscard]] const PdrOutput& output() const { return out_; }
   [[nodiscard]] const Diagnostics& diagnostics() const { return diag_; }
   [[nodiscard]] const StepDiagnostics& step_diagnostics() const;
+  [[nodiscard]] const HardIronCalibrator& mag_calibration() const { return mag_cal_; }
   /// Step frequencies seen at each step so far are not stored (no heap); for calibration, collect
   /// `output().step_hz` at every step in the caller.
 
@@ -263,6 +283,7 @@ class Pdr {
   AdaptiveStepDetector foot_steps_;
   PoseFeatureWindow features_;
   HeadingFilter heading_;
+  HardIronCalibrator mag_cal_;
   Diagnostics diag_;
   PdrOutput out_;
   PhonePose applied_pose_ = PhonePose::kHandHeld;
@@ -278,9 +299,33 @@ class Pdr {
   bool settling_ = false;  ///< switch over, waiting for the new pose to be confirmed
   int settling_steps_ = 0;
   bool pose_known_ = false;
-  double pending_m_ = 0.0;                 ///< distance walked before the first heading
-  std::array<double, 32> switch_len_m_{};  ///< steps laid with the replacement heading
+  double pending_m_ = 0.0;  ///< distance walked before the first heading
+  /// A step walked during a pose switch, re-laid when the switch is over.
+  struct SwitchStep {
+    double length_m = 0.0;
+    double laid_rad = 0.0;       ///< heading it was laid with
+    double old_frame_rad = 0.0;  ///< heading filter's heading (pose before the switch)
+    Eigen::Vector3d tilt = Eigen::Vector3d::UnitZ();  ///< mean gravity direction, sensor frame
+    std::size_t slot = 0;                             ///< which foot (waves_/tilts_ slot)
+    std::array<Eigen::Vector2d, 2> axis_sum{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
+  };
+  static constexpr std::size_t kMaxSwitchSteps = 32;
+  void relay_switch_steps(double heading_after);
+  void reset_walking_direction();
+  // Correlation of the horizontal acceleration with d(vertical)/dt in the pose's walking frame.
+  double yaw_fwd_ = 0.0, yaw_left_ = 0.0;
+  int yaw_steps_ = 0;
+  double last_av_ = 0.0, last_av_t_ = 0.0;
+  bool have_av_ = false;
+  std::array<SwitchStep, kMaxSwitchSteps> switch_{};
   int switch_steps_ = 0;
+  std::array<Eigen::Vector3d, 2> pre_switch_tilts_{
+      Eigen::Vector3d::UnitZ(),
+      Eigen::Vector3d::UnitZ()};  ///< both feet's gravity before the switch
+  std::size_t last_slot_ = 0;
+  /// Over the current step, sums of unit (east, north) vectors of the horizontal sensor x and
+  /// -z axes: the walking direction if the pose's forward axis is that one.
+  std::array<Eigen::Vector2d, 2> axis_sum_{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
   int wave_count_ = 0;
   double last_step_t_s_ = -1.0;
   double interval_ema_s_ = 0.0;
