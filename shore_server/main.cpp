@@ -211,6 +211,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--dds-profiles", o.dds.profiles_file,
                  "Fast DDS profiles XML (default: $TELLTALE_DDS_PROFILES or deploy/dds/)");
+  app.add_option("--dds-peer", o.dds.peers,
+                 "unicast discovery peer (IPv4), repeatable: networks without multicast "
+                 "(default: $TELLTALE_DDS_PEERS, comma-separated)");
   app.add_option("--dds-participant", o.dds.participant_profile, "participant profile")
       ->capture_default_str();
   o.http.web_dir = TELLTALE_DEFAULT_WEB_DIR;
