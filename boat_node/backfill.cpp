@@ -25,19 +25,25 @@ void Backfiller::on_ack(std::uint64_t boot_id, std::uint64_t acked_seq) {
   cv_.notify_all();
 }
 
-void Backfiller::send_range(std::uint64_t first, std::uint64_t last) {
+std::uint64_t Backfiller::send_range(std::uint64_t first, std::uint64_t last) {
   constexpr std::uint64_t kChunk = 250;
   const auto chunk_period = std::chrono::milliseconds(
       static_cast<long>(1000 * kChunk / std::max<std::size_t>(config_.max_per_second, 1)));
+  std::uint64_t sent_through = first - 1;
   for (std::uint64_t from = first; from <= last && !stop_.load(); from += kChunk) {
     const auto started = std::chrono::steady_clock::now();
     for (const auto& r : reader_.read(from, std::min(last, from + kChunk - 1))) {
-      if (!send_(r)) return;  // the shore went away again: the next receipt decides
+      if (!send_(r)) {  // the shore went away again: the next receipt decides
+        send_failures_.fetch_add(1);
+        return sent_through;
+      }
       resent_.fetch_add(1);
+      sent_through = r.seq;
     }
     std::unique_lock lock(mutex_);
     cv_.wait_until(lock, started + chunk_period, [this] { return stop_.load(); });
   }
+  return last;
 }
 
 void Backfiller::run() {
@@ -60,8 +66,9 @@ void Backfiller::run() {
       first = sent_through_ + 1;
       if (first > last) continue;
     }
-    send_range(first, last);
-    sent_through_ = last;
+    // Only what was written counts as sent: after a failed write the rest goes on the next
+    // round (200 ms), not after resend_after (that wait outlasted the drain at shutdown).
+    sent_through_ = send_range(first, last);
     sent_at_ = now;
   }
 }

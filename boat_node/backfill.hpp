@@ -42,11 +42,14 @@ class Backfiller {
 
   [[nodiscard]] std::uint64_t acked() const { return acked_.load(); }
   [[nodiscard]] std::uint64_t resent() const { return resent_.load(); }
+  /// Backfill writes that failed (the writer's history full: the shore not acknowledging).
+  [[nodiscard]] std::uint64_t send_failures() const { return send_failures_.load(); }
   [[nodiscard]] bool shore_seen() const { return shore_seen_.load(); }
 
  private:
   void run();
-  void send_range(std::uint64_t first, std::uint64_t last);
+  /// Returns the last seq written (first - 1 if none).
+  std::uint64_t send_range(std::uint64_t first, std::uint64_t last);
 
   BackfillConfig config_;
   SessionLogReader reader_;
@@ -54,6 +57,7 @@ class Backfiller {
   std::atomic<std::uint64_t> published_{0};
   std::atomic<std::uint64_t> acked_{0};
   std::atomic<std::uint64_t> resent_{0};
+  std::atomic<std::uint64_t> send_failures_{0};
   std::atomic<bool> shore_seen_{false};
   std::atomic<bool> draining_{false};
   std::atomic<bool> force_resend_{false};
