@@ -47,6 +47,9 @@ std::uint64_t Backfiller::send_range(std::uint64_t first, std::uint64_t last) {
 }
 
 void Backfiller::run() {
+  std::uint64_t last_acked = 0;
+  auto acked_moved_at = std::chrono::steady_clock::now();
+  std::chrono::steady_clock::time_point full_resend_at{};
   while (!stop_.load()) {
     {
       std::unique_lock lock(mutex_);
@@ -56,20 +59,31 @@ void Backfiller::run() {
     if (force_resend_.exchange(false)) sent_through_ = 0;
     const std::uint64_t published = published_.load();
     const std::uint64_t acked = acked_.load();
+    const auto now = std::chrono::steady_clock::now();
+    if (acked != last_acked) {
+      last_acked = acked;
+      acked_moved_at = now;
+    }
     const std::uint64_t lag = draining_.load() ? 0 : config_.lag;
     if (published <= acked + lag) continue;
     const std::uint64_t last = published - lag;
-    // Do not resend a range still on its way unless the receipt has stalled for a while.
     std::uint64_t first = acked + 1;
-    const auto now = std::chrono::steady_clock::now();
-    if (sent_through_ >= first && now - sent_at_ < config_.resend_after) {
-      first = sent_through_ + 1;
-      if (first > last) continue;
+    // What was sent and not yet acknowledged is on its way: send only what is new, unless the
+    // receipt has not moved for resend_after (the link was cut, the shore restarted): then all
+    // of it again, at most once per resend_after. The timer is the receipt's, not the last send:
+    // while the boat sails, new samples are sent every round and would otherwise postpone the
+    // resend for as long as the boat sails.
+    if (sent_through_ >= first) {
+      const bool stalled = now - acked_moved_at >= config_.resend_after &&
+                           now - full_resend_at >= config_.resend_after;
+      if (stalled) {
+        full_resend_at = now;
+      } else {
+        first = sent_through_ + 1;
+        if (first > last) continue;
+      }
     }
-    // Only what was written counts as sent: after a failed write the rest goes on the next
-    // round (200 ms), not after resend_after (that wait outlasted the drain at shutdown).
     sent_through_ = send_range(first, last);
-    sent_at_ = now;
   }
 }
 

@@ -6,7 +6,7 @@
 /// When the node is more than `lag` samples ahead of that receipt (the newest samples may still
 /// be in flight), a thread of its own reads the missing range from the log and writes it on the
 /// reliable backfill topic at a bounded rate; the same range is sent again only if the receipt
-/// has not moved past it within `resend_after`. At shutdown `drain()` sends up to the last
+/// has not moved for `resend_after`. At shutdown `drain()` sends up to the last
 /// sample and waits for the receipt. The sensor loop only stores an atomic counter.
 
 #include <atomic>
@@ -63,7 +63,6 @@ class Backfiller {
   std::atomic<bool> force_resend_{false};
   std::atomic<bool> stop_{false};
   std::uint64_t sent_through_ = 0;
-  std::chrono::steady_clock::time_point sent_at_{};
   std::mutex mutex_;
   std::condition_variable cv_;
   std::thread thread_;
