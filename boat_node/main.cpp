@@ -384,12 +384,13 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   if (o.console && tty) std::printf("\n");
   // Hand the shore what it is missing before going (bounded wait).
   const bool complete = backfiller->drain(std::chrono::seconds(3));
-  std::printf("boat_node stopped: boat=%s published=%llu resent=%llu shore_has_all=%s bad_samples=%u "
-              "acked=%llu backfill_failures=%llu\n",
-              o.boat_id.c_str(), static_cast<unsigned long long>(seq),
-              static_cast<unsigned long long>(backfiller->resent()), complete ? "yes" : "no",
-              bad_samples, static_cast<unsigned long long>(backfiller->acked()),
-              static_cast<unsigned long long>(backfiller->send_failures()));
+  std::printf(
+      "boat_node stopped: boat=%s published=%llu resent=%llu shore_has_all=%s bad_samples=%u "
+      "acked=%llu backfill_failures=%llu\n",
+      o.boat_id.c_str(), static_cast<unsigned long long>(seq),
+      static_cast<unsigned long long>(backfiller->resent()), complete ? "yes" : "no", bad_samples,
+      static_cast<unsigned long long>(backfiller->acked()),
+      static_cast<unsigned long long>(backfiller->send_failures()));
 }
 
 }  // namespace

@@ -461,8 +461,9 @@ void Store::merge_sessions(const std::string& boat_id) {
       std::chrono::duration_cast<std::chrono::nanoseconds>(config_.session_gap).count());
   std::vector<SessionInfo> all;
   {
-    Stmt q(db_, "SELECT id, boat_id, start_ns, end_ns, samples FROM sessions WHERE boat_id = ? "
-                "ORDER BY start_ns");
+    Stmt q(db_,
+           "SELECT id, boat_id, start_ns, end_ns, samples FROM sessions WHERE boat_id = ? "
+           "ORDER BY start_ns");
     q.bind(1, boat_id);
     while (q.step()) all.push_back(session_from(q));
   }
@@ -478,9 +479,8 @@ void Store::merge_sessions(const std::string& boat_id) {
     Stmt del(db_, "DELETE FROM sessions WHERE id = ?");
     del.bind(1, next.id);
     del.step();
-    if (auto it = open_sessions_.find(boat_id); it != open_sessions_.end() &&
-                                                 (it->second.id == next.id ||
-                                                  it->second.id == prev.id))
+    if (auto it = open_sessions_.find(boat_id);
+        it != open_sessions_.end() && (it->second.id == next.id || it->second.id == prev.id))
       it->second = prev;
     all[i] = prev;  // the merged session is the one the next comparison extends
   }

@@ -61,9 +61,11 @@ class CrashTest : public ShoreFixture {
   /// new events to acknowledge. Returns the acknowledged event ids.
   std::vector<std::uint64_t> raise_and_ack(int cycle) {
     auto c = client();
-    const nlohmann::json rules = nlohmann::json::array(
-        {{{"id", "crash-" + std::to_string(cycle)}, {"quantity", "heel"}, {"min_deg", 89.0},
-          {"max_deg", 90.0}, {"level", "alarm"}}});
+    const nlohmann::json rules = nlohmann::json::array({{{"id", "crash-" + std::to_string(cycle)},
+                                                         {"quantity", "heel"},
+                                                         {"min_deg", 89.0},
+                                                         {"max_deg", 90.0},
+                                                         {"level", "alarm"}}});
     auto put = c.Put("/api/v1/alarms/rules", bearer(), rules.dump(), "application/json");
     EXPECT_TRUE(put && put->status == 200) << (put ? put->body : "no answer");
     std::vector<std::uint64_t> ids;
@@ -105,7 +107,8 @@ class CrashTest : public ShoreFixture {
       while (sqlite3_step(st) == SQLITE_ROW)
         integrity += reinterpret_cast<const char*>(sqlite3_column_text(st, 0));
       sqlite3_finalize(st);
-      sqlite3_prepare_v2(db, "SELECT MAX(t_utc_ns) FROM attitude WHERE boat_id = ? AND t_utc_ns < ?",
+      sqlite3_prepare_v2(db,
+                         "SELECT MAX(t_utc_ns) FROM attitude WHERE boat_id = ? AND t_utc_ns < ?",
                          -1, &st, nullptr);
       for (int i = 0; i < kBoats; ++i) {
         sqlite3_reset(st);
@@ -145,7 +148,8 @@ class CrashTest : public ShoreFixture {
 TEST_F(CrashTest, TwentyKillsDuringIngest) {
   const std::size_t shm_before = shm_entries();
   unsigned seed = static_cast<unsigned>(std::random_device{}());
-  if (const char* env = std::getenv("TELLTALE_CRASH_SEED")) seed = static_cast<unsigned>(std::stoul(env));
+  if (const char* env = std::getenv("TELLTALE_CRASH_SEED"))
+    seed = static_cast<unsigned>(std::stoul(env));
   std::printf("[crash] seed=%u (TELLTALE_CRASH_SEED=%u repeats it)\n", seed, seed);
   std::mt19937 rng(seed);
   std::uniform_int_distribution<int> run_ms(100, 2500);
@@ -170,11 +174,12 @@ TEST_F(CrashTest, TwentyKillsDuringIngest) {
     for (const double ms : loss_ms) cycle_loss = std::max(cycle_loss, ms);
     worst_loss_ms = std::max(worst_loss_ms, cycle_loss);
     // Durability window: --commit-ms, plus one publish period (40 ms) and delivery/scheduling.
-    EXPECT_LE(cycle_loss, kCommitMs + 40 + 200) << "cycle " << cycle << ": newest stored sample "
-                                                << cycle_loss << " ms before the kill";
-    std::printf("[crash] cycle %2d: killed after %4d ms, integrity %s, newest stored %.0f ms "
-                "before the kill\n",
-                cycle, wait_ms, integrity.c_str(), cycle_loss);
+    EXPECT_LE(cycle_loss, kCommitMs + 40 + 200)
+        << "cycle " << cycle << ": newest stored sample " << cycle_loss << " ms before the kill";
+    std::printf(
+        "[crash] cycle %2d: killed after %4d ms, integrity %s, newest stored %.0f ms "
+        "before the kill\n",
+        cycle, wait_ms, integrity.c_str(), cycle_loss);
     ASSERT_NO_FATAL_FAILURE(start_shore());
     // Every acknowledgement answered before any kill so far is still there.
     const auto events = get_json("/api/v1/alarms/events?limit=10000");
@@ -213,11 +218,11 @@ TEST_F(CrashTest, TwentyKillsDuringIngest) {
   shore_->stop(SIGTERM);
   const std::size_t shm_after = shm_entries();
   EXPECT_LE(shm_after, shm_before) << "/dev/shm grew across the crashes";
-  std::printf("[crash] %d kills in %.0f s, acks kept %zu/%zu, worst loss at a kill %.0f ms "
-              "(window %d ms), /dev/shm entries %zu -> %zu\n",
-              kCycles,
-              std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count(),
-              acked.size(), acked.size(), worst_loss_ms, kCommitMs, shm_before, shm_after);
+  std::printf(
+      "[crash] %d kills in %.0f s, acks kept %zu/%zu, worst loss at a kill %.0f ms "
+      "(window %d ms), /dev/shm entries %zu -> %zu\n",
+      kCycles, std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count(),
+      acked.size(), acked.size(), worst_loss_ms, kCommitMs, shm_before, shm_after);
   std::fflush(stdout);
 }
 

@@ -58,7 +58,8 @@ NetnsFleet::NetnsFleet(int boats) {
   created_.push_back(shore_ns_);
   run_command({ip_bin(), "-n", shore_ns_, "link", "set", "lo", "up"});
   run_command({ip_bin(), "-n", shore_ns_, "link", "add", "br0", "type", "bridge"});
-  run_command({ip_bin(), "-n", shore_ns_, "addr", "add", std::string(kShoreIp) + "/24", "dev", "br0"});
+  run_command(
+      {ip_bin(), "-n", shore_ns_, "addr", "add", std::string(kShoreIp) + "/24", "dev", "br0"});
   run_command({ip_bin(), "-n", shore_ns_, "link", "set", "br0", "up"});
   for (int i = 0; i < boats; ++i) {
     const std::string ns = prefix_ + "b" + std::to_string(i);
@@ -141,7 +142,7 @@ void NetnsFleet::restore_link(int i) {
 
 namespace {
 std::vector<std::string> loss_rule(const char* op, const char* chain, double p) {
-  return {op, chain, "-m", "statistic", "--mode", "random", "--probability", std::to_string(p),
+  return {op,   chain, "-m", "statistic", "--mode", "random", "--probability", std::to_string(p),
           "-j", "DROP"};
 }
 }  // namespace
@@ -162,18 +163,18 @@ void NetnsFleet::clear_loss(int i) {
 void NetnsFleet::set_delay(int i, int delay_ms) {
   delays_.resize(boat_ns_.size());
   auto& helper = delays_[idx(i)];
-  helper = std::make_unique<Process>(in_ns(boat_ns(i), {bin_dir() + "/nfq_delay", "--queue",
-                                                        std::to_string(kDelayQueue), "--delay-ms",
-                                                        std::to_string(delay_ms)}));
+  helper = std::make_unique<Process>(
+      in_ns(boat_ns(i), {bin_dir() + "/nfq_delay", "--queue", std::to_string(kDelayQueue),
+                         "--delay-ms", std::to_string(delay_ms)}));
   if (!helper->wait_for_line("nfq_delay ready", std::chrono::seconds(10)))
     throw NetnsError("nfq_delay did not start: " + helper->output());
-  iptables(boat_ns(i),
-           {"-A", "OUTPUT", "-o", "eth0", "-j", "NFQUEUE", "--queue-num", std::to_string(kDelayQueue)});
+  iptables(boat_ns(i), {"-A", "OUTPUT", "-o", "eth0", "-j", "NFQUEUE", "--queue-num",
+                        std::to_string(kDelayQueue)});
 }
 
 std::string NetnsFleet::clear_delay(int i) {
-  iptables(boat_ns(i),
-           {"-D", "OUTPUT", "-o", "eth0", "-j", "NFQUEUE", "--queue-num", std::to_string(kDelayQueue)});
+  iptables(boat_ns(i), {"-D", "OUTPUT", "-o", "eth0", "-j", "NFQUEUE", "--queue-num",
+                        std::to_string(kDelayQueue)});
   auto& helper = delays_.at(idx(i));
   helper->stop(SIGTERM);
   auto line = helper->wait_for_line("nfq_delay stopped", std::chrono::seconds(1));

@@ -4,13 +4,14 @@
 // sample the boat published (seq 1..N, each once), the live view shows fresh data again without
 // restarting anything, and a boat that went silent was marked stale meanwhile.
 // Needs root; fails (never skips) without it.
+#include "netns.hpp"
+
 #include <signal.h>
 #include <sqlite3.h>
 
 #include <cstdio>
 #include <set>
 
-#include "netns.hpp"
 #include "shore_fixture.hpp"
 
 namespace telltale::testing {
@@ -33,7 +34,7 @@ double seconds_since(Steady::time_point t) {
 struct Watch {
   std::string fault;
   bool seen_stale = false;
-  double recovery_s = -1;  ///< link restored -> fresh, non-stale data on /api/v1/boats
+  double recovery_s = -1;   ///< link restored -> fresh, non-stale data on /api/v1/boats
   double caught_up_s = -1;  ///< link restored -> the store holds all but the newest 2.4 s
   long published = -1;
   long stored = -1;
@@ -70,13 +71,14 @@ class NetnsTest : public ShoreFixture {
       boats_.push_back(std::make_unique<Process>(NetnsFleet::in_ns(
           fleet_->boat_ns(i),
           {bin_dir() + "/boat_node", "--domain", std::to_string(domain_), "--boat-id", id(i),
-           "--log-dir", dir_ + "/log_" + id(i), "--dds-participant", "telltale_lan",
-           "--dds-peer", NetnsFleet::kShoreIp})));
+           "--log-dir", dir_ + "/log_" + id(i), "--dds-participant", "telltale_lan", "--dds-peer",
+           NetnsFleet::kShoreIp})));
       ASSERT_TRUE(boats_.back()->wait_for_line("boat_node ready: ", 20s))
           << boats_.back()->output();
     }
     // Discovery by unicast peers only: every boat reaches the shore.
-    ASSERT_TRUE(eventually([&] { return fresh_boats(0).size() == static_cast<std::size_t>(boat_count); }, 40s))
+    ASSERT_TRUE(eventually(
+        [&] { return fresh_boats(0).size() == static_cast<std::size_t>(boat_count); }, 40s))
         << "boats seen: " << boats().size();
   }
 
@@ -186,11 +188,11 @@ class NetnsTest : public ShoreFixture {
 
   void report(const std::vector<Watch>& w) const {
     for (std::size_t i = 0; i < w.size(); ++i)
-      std::printf("[netns] %s %-16s published=%ld stored=%ld stale_seen=%s live_after_s=%.1f "
-                  "stored_after_s=%.1f\n",
-                  id(static_cast<int>(i)).c_str(), w[i].fault.c_str(), w[i].published,
-                  w[i].stored, w[i].seen_stale ? "yes" : "no", w[i].recovery_s,
-                  w[i].caught_up_s);
+      std::printf(
+          "[netns] %s %-16s published=%ld stored=%ld stale_seen=%s live_after_s=%.1f "
+          "stored_after_s=%.1f\n",
+          id(static_cast<int>(i)).c_str(), w[i].fault.c_str(), w[i].published, w[i].stored,
+          w[i].seen_stale ? "yes" : "no", w[i].recovery_s, w[i].caught_up_s);
     std::fflush(stdout);
   }
 
@@ -201,8 +203,8 @@ class NetnsTest : public ShoreFixture {
 // 200 ms delay on the boat's egress, and an address change (after which the fault is permanent).
 TEST_F(NetnsTest, FaultsShareOneFleet) {
   ASSERT_NO_FATAL_FAILURE(start_fleet(5));
-  std::vector<Watch> w = {{"link cut 30 s"}, {"loss 20 %"}, {"loss 30 %"}, {"delay 200 ms"},
-                          {"address change"}};
+  std::vector<Watch> w = {
+      {"link cut 30 s"}, {"loss 20 %"}, {"loss 30 %"}, {"delay 200 ms"}, {"address change"}};
   std::this_thread::sleep_for(3s);
   fleet_->cut_link(0);
   fleet_->set_loss(1, 0.2);

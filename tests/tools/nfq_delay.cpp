@@ -129,8 +129,8 @@ int main(int argc, char** argv) {
     if (!st.held.empty()) {
       const auto due = st.held.front().arrived + st.delay;
       timeout_ms = static_cast<int>(std::clamp<long long>(
-          std::chrono::duration_cast<std::chrono::milliseconds>(due - Clock::now()).count() + 1,
-          0, 100));
+          std::chrono::duration_cast<std::chrono::milliseconds>(due - Clock::now()).count() + 1, 0,
+          100));
     }
     pollfd p{fd, POLLIN, 0};
     if (poll(&p, 1, timeout_ms) > 0 && (p.revents & POLLIN)) {

@@ -134,7 +134,8 @@ TEST_F(StoreTest, BackfillThatClosesTheGapMergesTheSessions) {
   for (std::uint64_t i = 0; i <= 10; ++i) store.enqueue(sample("b", 7, i + 1, kT0 + i * kSecond));
   store.flush();
   // Cut from 10 s to 300 s; live again from 300 s.
-  for (std::uint64_t i = 300; i <= 305; ++i) store.enqueue(sample("b", 7, i + 1, kT0 + i * kSecond));
+  for (std::uint64_t i = 300; i <= 305; ++i)
+    store.enqueue(sample("b", 7, i + 1, kT0 + i * kSecond));
   store.flush();
   ASSERT_EQ(store.sessions(std::string("b"), 0, UINT64_MAX).size(), 2u);
   // Backfill of the cut, oldest first, in a few batches.
