@@ -13,6 +13,7 @@
 #include <random>
 
 #include "shore_fixture.hpp"
+#include "stored_seqs.hpp"
 
 namespace telltale::testing {
 namespace {
@@ -128,20 +129,7 @@ class CrashTest : public ShoreFixture {
   }
 
   long count_seqs(const std::string& boat, long max_seq) const {
-    sqlite3* db = nullptr;
-    long n = -1;
-    if (sqlite3_open_v2(db_path().c_str(), &db, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK) {
-      sqlite3_stmt* st = nullptr;
-      sqlite3_prepare_v2(
-          db, "SELECT COUNT(DISTINCT seq) FROM attitude WHERE boat_id = ? AND seq BETWEEN 1 AND ?",
-          -1, &st, nullptr);
-      sqlite3_bind_text(st, 1, boat.c_str(), -1, SQLITE_TRANSIENT);
-      sqlite3_bind_int64(st, 2, max_seq);
-      if (sqlite3_step(st) == SQLITE_ROW) n = sqlite3_column_int64(st, 0);
-      sqlite3_finalize(st);
-    }
-    sqlite3_close(db);
-    return n;
+    return stored_seqs(db_path(), boat, max_seq);
   }
 };
 
