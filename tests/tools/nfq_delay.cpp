@@ -6,7 +6,8 @@
 //
 // Packets leave in arrival order, each `delay` after it arrived (a pure delay line: no jitter, no
 // reordering, no loss while the queue stays under --max-held). Stops on SIGINT/SIGTERM, letting
-// every held packet go first, and prints how many packets it held and for how long.
+// every held packet go first (counted as flushed, outside the hold statistics), and prints how
+// many packets it held and for how long.
 #include <arpa/inet.h>
 #include <libnetfilter_queue/libnetfilter_queue.h>
 #include <linux/netfilter.h>
@@ -41,6 +42,7 @@ struct State {
   std::size_t max_held = 10000;
   unsigned long long packets = 0;
   unsigned long long overflow = 0;
+  unsigned long long flushed = 0;
   double hold_sum_ms = 0.0;
   double hold_max_ms = 0.0;
   double hold_min_ms = 1e9;
@@ -66,6 +68,10 @@ void release(nfq_q_handle* queue, State& st, bool all) {
         std::chrono::duration<double, std::milli>(now - st.held.front().arrived).count();
     nfq_set_verdict(queue, st.held.front().id, NF_ACCEPT, 0, nullptr);
     st.held.pop_front();
+    if (all && held_ms < static_cast<double>(st.delay.count())) {
+      ++st.flushed;  // let go early at shutdown: not a measure of the delay line
+      continue;
+    }
     ++st.packets;
     st.hold_sum_ms += held_ms;
     st.hold_max_ms = std::max(st.hold_max_ms, held_ms);
@@ -143,8 +149,10 @@ int main(int argc, char** argv) {
   release(queue, st, true);
   nfq_destroy_queue(queue);
   nfq_close(handle);
-  std::printf("nfq_delay stopped: packets=%llu overflow=%llu hold_ms_min=%.1f mean=%.1f max=%.1f\n",
-              st.packets, st.overflow, st.packets ? st.hold_min_ms : 0.0,
-              st.packets ? st.hold_sum_ms / static_cast<double>(st.packets) : 0.0, st.hold_max_ms);
+  std::printf(
+      "nfq_delay stopped: packets=%llu overflow=%llu flushed=%llu hold_ms_min=%.1f mean=%.1f "
+      "max=%.1f\n",
+      st.packets, st.overflow, st.flushed, st.packets ? st.hold_min_ms : 0.0,
+      st.packets ? st.hold_sum_ms / static_cast<double>(st.packets) : 0.0, st.hold_max_ms);
   return 0;
 }
