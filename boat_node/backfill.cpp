@@ -4,6 +4,10 @@
 
 namespace telltale::boat {
 
+namespace {
+constexpr std::int64_t kReceiptSilence_ns = 3'000'000'000;  ///< three missed receipts
+}  // namespace
+
 Backfiller::Backfiller(BackfillConfig config, SessionLogReader reader,
                        std::function<bool(const LogRecord&)> send)
     : config_(config), reader_(std::move(reader)), send_(std::move(send)) {
@@ -18,6 +22,13 @@ Backfiller::~Backfiller() {
 
 void Backfiller::on_ack(std::uint64_t boot_id, std::uint64_t acked_seq) {
   if (boot_id != config_.boot_id) return;  // a receipt for an earlier run of this boat
+  // Receipts come every second; after a silence (a cut link, a shore restart) the shore is back
+  // and the range it missed goes at once instead of at the next resend_after.
+  const std::int64_t now_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                  std::chrono::steady_clock::now().time_since_epoch())
+                                  .count();
+  const std::int64_t prev_ns = last_ack_ns_.exchange(now_ns);
+  if (prev_ns != 0 && now_ns - prev_ns > kReceiptSilence_ns) force_resend_.store(true);
   shore_seen_.store(true);
   std::uint64_t prev = acked_.load();
   while (acked_seq > prev && !acked_.compare_exchange_weak(prev, acked_seq)) {

@@ -6,8 +6,9 @@
 /// When the node is more than `lag` samples ahead of that receipt (the newest samples may still
 /// be in flight), a thread of its own reads the missing range from the log and writes it on the
 /// reliable backfill topic at a bounded rate; the same range is sent again only if the receipt
-/// has not moved for `resend_after`. At shutdown `drain()` sends up to the last
-/// sample and waits for the receipt. The sensor loop only stores an atomic counter.
+/// has not moved for `resend_after`, or at once when receipts resume after a silence (the shore
+/// is back). At shutdown `drain()` sends up to the last sample and waits for the receipt. The
+/// sensor loop only stores an atomic counter.
 
 #include <atomic>
 #include <chrono>
@@ -58,6 +59,7 @@ class Backfiller {
   std::atomic<std::uint64_t> acked_{0};
   std::atomic<std::uint64_t> resent_{0};
   std::atomic<std::uint64_t> send_failures_{0};
+  std::atomic<std::int64_t> last_ack_ns_{0};  ///< steady clock of the latest receipt
   std::atomic<bool> shore_seen_{false};
   std::atomic<bool> draining_{false};
   std::atomic<bool> force_resend_{false};
