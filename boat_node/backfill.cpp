@@ -4,6 +4,10 @@
 
 namespace telltale::boat {
 
+namespace {
+constexpr std::int64_t kReceiptSilence_ns = 3'000'000'000;  ///< three missed receipts
+}  // namespace
+
 Backfiller::Backfiller(BackfillConfig config, SessionLogReader reader,
                        std::function<bool(const LogRecord&)> send)
     : config_(config), reader_(std::move(reader)), send_(std::move(send)) {
@@ -18,6 +22,13 @@ Backfiller::~Backfiller() {
 
 void Backfiller::on_ack(std::uint64_t boot_id, std::uint64_t acked_seq) {
   if (boot_id != config_.boot_id) return;  // a receipt for an earlier run of this boat
+  // Receipts come every second; after a silence (a cut link, a shore restart) the shore is back
+  // and the range it missed goes at once instead of at the next resend_after.
+  const std::int64_t now_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                  std::chrono::steady_clock::now().time_since_epoch())
+                                  .count();
+  const std::int64_t prev_ns = last_ack_ns_.exchange(now_ns);
+  if (prev_ns != 0 && now_ns - prev_ns > kReceiptSilence_ns) force_resend_.store(true);
   shore_seen_.store(true);
   std::uint64_t prev = acked_.load();
   while (acked_seq > prev && !acked_.compare_exchange_weak(prev, acked_seq)) {
@@ -25,22 +36,31 @@ void Backfiller::on_ack(std::uint64_t boot_id, std::uint64_t acked_seq) {
   cv_.notify_all();
 }
 
-void Backfiller::send_range(std::uint64_t first, std::uint64_t last) {
+std::uint64_t Backfiller::send_range(std::uint64_t first, std::uint64_t last) {
   constexpr std::uint64_t kChunk = 250;
   const auto chunk_period = std::chrono::milliseconds(
       static_cast<long>(1000 * kChunk / std::max<std::size_t>(config_.max_per_second, 1)));
+  std::uint64_t sent_through = first - 1;
   for (std::uint64_t from = first; from <= last && !stop_.load(); from += kChunk) {
     const auto started = std::chrono::steady_clock::now();
     for (const auto& r : reader_.read(from, std::min(last, from + kChunk - 1))) {
-      if (!send_(r)) return;  // the shore went away again: the next receipt decides
+      if (!send_(r)) {  // the shore went away again: the next receipt decides
+        send_failures_.fetch_add(1);
+        return sent_through;
+      }
       resent_.fetch_add(1);
+      sent_through = r.seq;
     }
     std::unique_lock lock(mutex_);
     cv_.wait_until(lock, started + chunk_period, [this] { return stop_.load(); });
   }
+  return last;
 }
 
 void Backfiller::run() {
+  std::uint64_t last_acked = 0;
+  auto acked_moved_at = std::chrono::steady_clock::now();
+  std::chrono::steady_clock::time_point full_resend_at{};
   while (!stop_.load()) {
     {
       std::unique_lock lock(mutex_);
@@ -50,19 +70,31 @@ void Backfiller::run() {
     if (force_resend_.exchange(false)) sent_through_ = 0;
     const std::uint64_t published = published_.load();
     const std::uint64_t acked = acked_.load();
+    const auto now = std::chrono::steady_clock::now();
+    if (acked != last_acked) {
+      last_acked = acked;
+      acked_moved_at = now;
+    }
     const std::uint64_t lag = draining_.load() ? 0 : config_.lag;
     if (published <= acked + lag) continue;
     const std::uint64_t last = published - lag;
-    // Do not resend a range still on its way unless the receipt has stalled for a while.
     std::uint64_t first = acked + 1;
-    const auto now = std::chrono::steady_clock::now();
-    if (sent_through_ >= first && now - sent_at_ < config_.resend_after) {
-      first = sent_through_ + 1;
-      if (first > last) continue;
+    // What was sent and not yet acknowledged is on its way: send only what is new, unless the
+    // receipt has not moved for resend_after (the link was cut, the shore restarted): then all
+    // of it again, at most once per resend_after. The timer is the receipt's, not the last send:
+    // while the boat sails, new samples are sent every round and would otherwise postpone the
+    // resend for as long as the boat sails.
+    if (sent_through_ >= first) {
+      const bool stalled = now - acked_moved_at >= config_.resend_after &&
+                           now - full_resend_at >= config_.resend_after;
+      if (stalled) {
+        full_resend_at = now;
+      } else {
+        first = sent_through_ + 1;
+        if (first > last) continue;
+      }
     }
-    send_range(first, last);
-    sent_through_ = last;
-    sent_at_ = now;
+    sent_through_ = send_range(first, last);
   }
 }
 

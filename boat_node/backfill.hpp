@@ -6,8 +6,9 @@
 /// When the node is more than `lag` samples ahead of that receipt (the newest samples may still
 /// be in flight), a thread of its own reads the missing range from the log and writes it on the
 /// reliable backfill topic at a bounded rate; the same range is sent again only if the receipt
-/// has not moved past it within `resend_after`. At shutdown `drain()` sends up to the last
-/// sample and waits for the receipt. The sensor loop only stores an atomic counter.
+/// has not moved for `resend_after`, or at once when receipts resume after a silence (the shore
+/// is back). At shutdown `drain()` sends up to the last sample and waits for the receipt. The
+/// sensor loop only stores an atomic counter.
 
 #include <atomic>
 #include <chrono>
@@ -42,11 +43,14 @@ class Backfiller {
 
   [[nodiscard]] std::uint64_t acked() const { return acked_.load(); }
   [[nodiscard]] std::uint64_t resent() const { return resent_.load(); }
+  /// Backfill writes that failed (the writer's history full: the shore not acknowledging).
+  [[nodiscard]] std::uint64_t send_failures() const { return send_failures_.load(); }
   [[nodiscard]] bool shore_seen() const { return shore_seen_.load(); }
 
  private:
   void run();
-  void send_range(std::uint64_t first, std::uint64_t last);
+  /// Returns the last seq written (first - 1 if none).
+  std::uint64_t send_range(std::uint64_t first, std::uint64_t last);
 
   BackfillConfig config_;
   SessionLogReader reader_;
@@ -54,12 +58,13 @@ class Backfiller {
   std::atomic<std::uint64_t> published_{0};
   std::atomic<std::uint64_t> acked_{0};
   std::atomic<std::uint64_t> resent_{0};
+  std::atomic<std::uint64_t> send_failures_{0};
+  std::atomic<std::int64_t> last_ack_ns_{0};  ///< steady clock of the latest receipt
   std::atomic<bool> shore_seen_{false};
   std::atomic<bool> draining_{false};
   std::atomic<bool> force_resend_{false};
   std::atomic<bool> stop_{false};
   std::uint64_t sent_through_ = 0;
-  std::chrono::steady_clock::time_point sent_at_{};
   std::mutex mutex_;
   std::condition_variable cv_;
   std::thread thread_;

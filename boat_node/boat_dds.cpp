@@ -69,12 +69,17 @@ class BoatDds::Listener : public fdds::DataReaderListener {
 
 BoatDds::BoatDds(const dds::DdsOptions& options, const std::string& boat_id,
                  BoatDdsCallbacks callbacks)
-    : boat_id_(boat_id),
+    : options_(options),
+      boat_id_(boat_id),
       callbacks_(std::move(callbacks)),
       listener_(std::make_unique<Listener>(boat_id_, callbacks_)) {
-  dds::DdsOptions opts = options;
-  dds::use_node_partitions(opts, boat_id);  // secured: publish only in this boat's partition
-  participant_ = std::make_unique<dds::Participant>(opts, "boat_node " + boat_id);
+  dds::use_node_partitions(options_, boat_id_);  // secured: publish only in this boat's partition
+  join();
+  domain_ = participant_->domain();
+}
+
+void BoatDds::join() {
+  participant_ = std::make_unique<dds::Participant>(options_, "boat_node " + boat_id_);
   auto* attitude = participant_->topic(dds::kTopicBoatAttitude,
                                        fdds::TypeSupport(new msg::BoatAttitudePubSubType()));
   attitude_writer_ = participant_->writer(attitude, "attitude_writer");
@@ -98,8 +103,29 @@ BoatDds::BoatDds(const dds::DdsOptions& options, const std::string& boat_id,
 
 BoatDds::~BoatDds() { participant_.reset(); }
 
-bool BoatDds::publish(msg::BoatAttitude& sample) { return attitude_writer_->write(&sample); }
-bool BoatDds::backfill(msg::BoatAttitude& sample) { return backfill_writer_->write(&sample); }
-bool BoatDds::publish(msg::NodeStatus& status) { return status_writer_->write(&status); }
+void BoatDds::rejoin() {
+  std::unique_lock lock(mutex_);
+  participant_.reset();  // its readers go first: no callback runs during the swap
+  attitude_writer_ = backfill_writer_ = status_writer_ = nullptr;
+  try {
+    join();
+  } catch (const dds::DdsError&) {
+    participant_.reset();
+    attitude_writer_ = backfill_writer_ = status_writer_ = nullptr;
+  }
+}
+
+bool BoatDds::publish(msg::BoatAttitude& sample) {
+  std::shared_lock lock(mutex_);
+  return attitude_writer_ && attitude_writer_->write(&sample);
+}
+bool BoatDds::backfill(msg::BoatAttitude& sample) {
+  std::shared_lock lock(mutex_);
+  return backfill_writer_ && backfill_writer_->write(&sample);
+}
+bool BoatDds::publish(msg::NodeStatus& status) {
+  std::shared_lock lock(mutex_);
+  return status_writer_ && status_writer_->write(&status);
+}
 
 }  // namespace telltale::boat

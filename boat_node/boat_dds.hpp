@@ -7,6 +7,7 @@
 
 #include <functional>
 #include <memory>
+#include <shared_mutex>
 #include <string>
 #include <vector>
 
@@ -36,10 +37,21 @@ class BoatDds {
   /// Reliable; may block up to the profile's max_blocking_time when the shore is slow.
   bool backfill(msg::BoatAttitude& sample);
   bool publish(msg::NodeStatus& status);
-  [[nodiscard]] int domain() const { return participant_->domain(); }
+  [[nodiscard]] int domain() const { return domain_; }
+
+  /// Leaves the domain and joins it again with a new participant. For when the host's addresses
+  /// changed: Fast DDS announces the addresses it found when the participant was created, so the
+  /// shore's receipts and rules would keep going to an address the boat no longer has. Writes
+  /// wait meanwhile (they return false if joining fails; the next rejoin() tries again).
+  void rejoin();
 
  private:
   class Listener;
+  void join();
+
+  dds::DdsOptions options_;
+  int domain_ = 0;
+  std::shared_mutex mutex_;  ///< writers share it; rejoin() takes it alone
   std::string boat_id_;
   BoatDdsCallbacks callbacks_;
   std::unique_ptr<Listener> listener_;

@@ -1,13 +1,19 @@
 // boat_node: runs the fusion core on a boat's sensors and publishes heel, pitch and heading over
 // DDS; logs every published sample to disk and backfills the shore after a link outage.
+#include <arpa/inet.h>
+#include <ifaddrs.h>
+#include <net/if.h>
+#include <netinet/in.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/rtps/transport/test_UDPv4TransportDescriptor.h>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <functional>
 #include <limits>
@@ -83,6 +89,29 @@ void inject_link_drop(Options& o) {
     qos.transport().user_transports.push_back(lossy);
     qos.transport().use_builtin_transports = false;
   };
+}
+
+/// The host's IPv4 addresses on interfaces that are up (loopback excluded), sorted: when this
+/// changes (a new DHCP lease, another radio) the node rejoins the DDS domain.
+std::string local_addresses() {
+  ifaddrs* list = nullptr;
+  if (getifaddrs(&list) != 0) return {};
+  std::vector<std::string> out;
+  for (const ifaddrs* a = list; a; a = a->ifa_next) {
+    if (!a->ifa_addr || a->ifa_addr->sa_family != AF_INET || (a->ifa_flags & IFF_LOOPBACK) ||
+        !(a->ifa_flags & IFF_UP))
+      continue;
+    sockaddr_in in{};
+    std::memcpy(&in, a->ifa_addr, sizeof in);
+    char text[INET_ADDRSTRLEN] = {};
+    inet_ntop(AF_INET, &in.sin_addr, text, sizeof text);
+    out.emplace_back(text);
+  }
+  freeifaddrs(list);
+  std::sort(out.begin(), out.end());
+  std::string joined;
+  for (const auto& s : out) joined += s + " ";
+  return joined;
 }
 
 const std::regex kId("[A-Za-z0-9_-]{1,32}");
@@ -236,6 +265,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   auto next_status = start;
   auto next_console = start;
   auto next_flush = start + std::chrono::seconds(1);
+  std::string addresses = local_addresses();
 
   while (!shutdown.stop_requested()) {
     const auto sample = source->next();
@@ -326,6 +356,12 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
     }
     if (now >= next_status) {
       next_status = now + std::chrono::seconds(1);
+      if (std::string current = local_addresses(); current != addresses) {
+        addresses = std::move(current);
+        dds.rejoin();
+        std::printf("boat_node rejoined the DDS domain: addresses now %s\n", addresses.c_str());
+        std::fflush(stdout);
+      }
       std::uint32_t h = health;
       if (heading && heading->degraded()) h |= telltale::msg::SENSOR_HEADING_DEGRADED;
       const auto& diag = filter.diagnostics();
@@ -348,10 +384,13 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   if (o.console && tty) std::printf("\n");
   // Hand the shore what it is missing before going (bounded wait).
   const bool complete = backfiller->drain(std::chrono::seconds(3));
-  std::printf("boat_node stopped: boat=%s published=%llu resent=%llu shore_has_all=%s bad_samples=%u\n",
-              o.boat_id.c_str(), static_cast<unsigned long long>(seq),
-              static_cast<unsigned long long>(backfiller->resent()), complete ? "yes" : "no",
-              bad_samples);
+  std::printf(
+      "boat_node stopped: boat=%s published=%llu resent=%llu shore_has_all=%s bad_samples=%u "
+      "acked=%llu backfill_failures=%llu\n",
+      o.boat_id.c_str(), static_cast<unsigned long long>(seq),
+      static_cast<unsigned long long>(backfiller->resent()), complete ? "yes" : "no", bad_samples,
+      static_cast<unsigned long long>(backfiller->acked()),
+      static_cast<unsigned long long>(backfiller->send_failures()));
 }
 
 }  // namespace
@@ -411,6 +450,9 @@ int main(int argc, char** argv) {
   app.add_option("--security-dir", o.dds.security_dir,
                  "DDS Security: this node's folder from deploy/security/make_fleet_pki.sh "
                  "(default: unsecured)");
+  app.add_option("--dds-peer", o.dds.peers,
+                 "unicast discovery peer (IPv4), repeatable: networks without multicast "
+                 "(default: $TELLTALE_DDS_PEERS, comma-separated)");
   app.add_option("--dds-participant", o.dds.participant_profile,
                  "participant profile in that file")
       ->capture_default_str();

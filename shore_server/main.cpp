@@ -215,6 +215,9 @@ int main(int argc, char** argv) {
   app.add_option("--security-dir", o.dds.security_dir,
                  "DDS Security: the shore's folder from deploy/security/make_fleet_pki.sh "
                  "(default: unsecured)");
+  app.add_option("--dds-peer", o.dds.peers,
+                 "unicast discovery peer (IPv4), repeatable: networks without multicast "
+                 "(default: $TELLTALE_DDS_PEERS, comma-separated)");
   app.add_option("--dds-participant", o.dds.participant_profile, "participant profile")
       ->capture_default_str();
   o.http.web_dir = TELLTALE_DEFAULT_WEB_DIR;

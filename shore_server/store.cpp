@@ -388,6 +388,8 @@ bool Store::commit(std::vector<AttitudeSample>& batch) {
       up.step();
     }
     dirty_sessions_.clear();
+    for (const auto& boat : backfilled_) merge_sessions(boat);
+    backfilled_.clear();
     exec(db_, "COMMIT");
     // On disk now: these samples may be acknowledged to their boats.
     for (const auto& s : batch) track_receipt(s);
@@ -399,6 +401,7 @@ bool Store::commit(std::vector<AttitudeSample>& batch) {
     sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
     open_sessions_.clear();  // reload from disk: the rolled-back changes are gone
     dirty_sessions_.clear();
+    backfilled_.clear();
     // Keep the batch for the next attempt (disk full, locked): nothing already received is lost
     // while the process lives.
     std::lock_guard lock(mutex_);
@@ -428,7 +431,9 @@ void Store::extend_session(const std::string& boat_id, std::uint64_t t_ns) {
       return;
     }
     if (t_ns < s.start_ns) {
-      // Backfill older than the latest session: extend the session it belongs to, if any.
+      // Backfill older than the latest session: extend the session it belongs to, if any. It may
+      // close the gap to its neighbour: merge_sessions() joins them before the commit.
+      backfilled_.insert(boat_id);
       Stmt q(db_, "UPDATE sessions SET start_ns = MIN(start_ns, ?1), end_ns = MAX(end_ns, ?1), "
                   "samples = samples + 1 WHERE id = (SELECT id FROM sessions WHERE boat_id = ?2 "
                   "AND start_ns <= ?1 + ?3 AND end_ns + ?3 >= ?1 LIMIT 1)");
@@ -446,6 +451,39 @@ void Store::extend_session(const std::string& boat_id, std::uint64_t t_ns) {
   ins.step();
   open_sessions_[boat_id] = {sqlite3_last_insert_rowid(db_), boat_id, t_ns, t_ns, 1};
   dirty_sessions_.insert(boat_id);
+}
+
+void Store::merge_sessions(const std::string& boat_id) {
+  // A link cut longer than the session gap splits a boat's activity in two: live data after the
+  // cut opens a new session before the backfill of the cut arrives. Once the backfill has closed
+  // the gap, the two are one session again.
+  const auto gap = static_cast<std::uint64_t>(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(config_.session_gap).count());
+  std::vector<SessionInfo> all;
+  {
+    Stmt q(db_,
+           "SELECT id, boat_id, start_ns, end_ns, samples FROM sessions WHERE boat_id = ? "
+           "ORDER BY start_ns");
+    q.bind(1, boat_id);
+    while (q.step()) all.push_back(session_from(q));
+  }
+  for (std::size_t i = 1; i < all.size(); ++i) {
+    SessionInfo& prev = all[i - 1];
+    const SessionInfo& next = all[i];
+    if (next.start_ns > prev.end_ns + gap) continue;
+    prev.end_ns = std::max(prev.end_ns, next.end_ns);
+    prev.samples += next.samples;
+    Stmt up(db_, "UPDATE sessions SET end_ns = ?, samples = ? WHERE id = ?");
+    up.bind_u(1, prev.end_ns).bind(2, prev.samples).bind(3, prev.id);
+    up.step();
+    Stmt del(db_, "DELETE FROM sessions WHERE id = ?");
+    del.bind(1, next.id);
+    del.step();
+    if (auto it = open_sessions_.find(boat_id);
+        it != open_sessions_.end() && (it->second.id == next.id || it->second.id == prev.id))
+      it->second = prev;
+    all[i] = prev;  // the merged session is the one the next comparison extends
+  }
 }
 
 void Store::track_receipt(const AttitudeSample& s) {

@@ -141,6 +141,9 @@ class Store {
   void extend_session(const std::string& boat_id, std::uint64_t t_ns);
   void apply_retention();
   void track_receipt(const AttitudeSample& sample);
+  /// Joins this boat's sessions that backfill has brought within the session gap of each other.
+  void merge_sessions(const std::string& boat_id);
+  std::set<std::string> backfilled_;  ///< boats with backfill older than their open session
 
   struct Receipt {
     bool known = false;

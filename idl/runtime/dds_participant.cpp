@@ -2,6 +2,8 @@
 
 #include <cstdlib>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/rtps/common/Locator.h>
+#include <fastrtps/utils/IPLocator.h>
 #include <fastrtps/types/TypesBase.h>
 #include <filesystem>
 #include <mutex>
@@ -40,6 +42,33 @@ std::string resolve_profiles_file(const std::string& flag) {
   return path;
 }
 
+namespace {
+
+/// Peers from the options, else from TELLTALE_DDS_PEERS, appended to the initial peers. Port 0
+/// lets Fast DDS probe the well-known ports of the first participant ids on each address.
+void add_initial_peers(std::vector<std::string> peers, fdds::DomainParticipantQos& qos) {
+  if (peers.empty()) {
+    if (const char* env = std::getenv("TELLTALE_DDS_PEERS"); env && *env) {
+      std::string list = env;
+      for (std::size_t start = 0; start <= list.size();) {
+        const std::size_t comma = std::min(list.find(',', start), list.size());
+        if (comma > start) peers.push_back(list.substr(start, comma - start));
+        start = comma + 1;
+      }
+    }
+  }
+  for (const auto& peer : peers) {
+    if (!eprosima::fastrtps::rtps::IPLocator::isIPv4(peer))
+      throw DdsError("DDS peer is not an IPv4 address: " + peer);
+    eprosima::fastrtps::rtps::Locator_t locator;
+    locator.kind = LOCATOR_KIND_UDPv4;
+    eprosima::fastrtps::rtps::IPLocator::setIPv4(locator, peer);
+    qos.wire_protocol().builtin.initialPeersList.push_back(locator);
+  }
+}
+
+}  // namespace
+
 Participant::Participant(const DdsOptions& options, const std::string& name)
     : domain_(resolve_domain(options.domain)) {
   auto* factory = DomainParticipantFactory::get_instance();
@@ -60,6 +89,7 @@ Participant::Participant(const DdsOptions& options, const std::string& name)
       ReturnCode_t::RETCODE_OK)
     throw DdsError("no participant profile '" + options.participant_profile + "' in " + profiles);
   qos.name(name);
+  add_initial_peers(options.peers, qos);
   if (options.customize) options.customize(qos);
   secured_ = !options.security_dir.empty();
   if (secured_) apply_security(options.security_dir, qos);

@@ -43,6 +43,9 @@ struct DdsOptions {
   std::optional<int> domain;            ///< flag; else TELLTALE_DOMAIN; else an error
   std::string profiles_file;            ///< flag; else TELLTALE_DDS_PROFILES; else the build's
   std::string participant_profile = "telltale_loopback";
+  /// Unicast discovery peers (IPv4 addresses) added to the profile's initial peers: discovery on a
+  /// network without multicast. Flag --dds-peer; else TELLTALE_DDS_PEERS (comma-separated).
+  std::vector<std::string> peers;
   /// Applied to the participant QoS after the profile (fault injection in tests).
   std::function<void(eprosima::fastdds::dds::DomainParticipantQos&)> customize;
   /// Secured mode: a node folder of deploy/security/make_fleet_pki.sh (dds_security.hpp). Empty:

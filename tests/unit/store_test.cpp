@@ -127,5 +127,33 @@ TEST_F(StoreTest, ReceiptsSurviveARestart) {
   EXPECT_EQ(store.acks()[0].acked_seq, 7u);
 }
 
+// A link cut longer than the session gap: live data after the cut opens a second session; when
+// the backfill of the cut closes the gap, the two become one session holding every sample.
+TEST_F(StoreTest, BackfillThatClosesTheGapMergesTheSessions) {
+  Store store(config());
+  for (std::uint64_t i = 0; i <= 10; ++i) store.enqueue(sample("b", 7, i + 1, kT0 + i * kSecond));
+  store.flush();
+  // Cut from 10 s to 300 s; live again from 300 s.
+  for (std::uint64_t i = 300; i <= 305; ++i)
+    store.enqueue(sample("b", 7, i + 1, kT0 + i * kSecond));
+  store.flush();
+  ASSERT_EQ(store.sessions(std::string("b"), 0, UINT64_MAX).size(), 2u);
+  // Backfill of the cut, oldest first, in a few batches.
+  for (std::uint64_t from = 11; from < 300; from += 100) {
+    for (std::uint64_t i = from; i < std::min<std::uint64_t>(from + 100, 300); ++i)
+      store.enqueue(sample("b", 7, i + 1, kT0 + i * kSecond));
+    store.flush();
+  }
+  // Live data keeps extending the merged session.
+  store.enqueue(sample("b", 7, 307, kT0 + 306 * kSecond));
+  store.flush();
+  const auto sessions = store.sessions(std::string("b"), 0, UINT64_MAX);
+  ASSERT_EQ(sessions.size(), 1u);
+  EXPECT_EQ(sessions[0].start_ns, kT0);
+  EXPECT_EQ(sessions[0].end_ns, kT0 + 306 * kSecond);
+  EXPECT_EQ(sessions[0].samples, 307);
+  EXPECT_EQ(store.count("b"), 307);
+}
+
 }  // namespace
 }  // namespace telltale::shore

@@ -1,0 +1,31 @@
+#pragma once
+/// \file
+/// What the shore's database holds of a boat, read from the file with a read-only connection
+/// (the shore keeps running): for tests that compare it with what the boat published.
+
+#include <sqlite3.h>
+
+#include <string>
+
+namespace telltale::testing {
+
+/// How many distinct seqs in 1..max_seq the database at `db_path` holds for the boat; -1 if the
+/// file cannot be read.
+inline long stored_seqs(const std::string& db_path, const std::string& boat, long max_seq) {
+  sqlite3* db = nullptr;
+  long n = -1;
+  if (sqlite3_open_v2(db_path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK) {
+    sqlite3_stmt* st = nullptr;
+    sqlite3_prepare_v2(
+        db, "SELECT COUNT(DISTINCT seq) FROM attitude WHERE boat_id = ? AND seq BETWEEN 1 AND ?",
+        -1, &st, nullptr);
+    sqlite3_bind_text(st, 1, boat.c_str(), -1, SQLITE_TRANSIENT);
+    sqlite3_bind_int64(st, 2, max_seq);
+    if (sqlite3_step(st) == SQLITE_ROW) n = sqlite3_column_int64(st, 0);
+    sqlite3_finalize(st);
+  }
+  sqlite3_close(db);
+  return n;
+}
+
+}  // namespace telltale::testing
