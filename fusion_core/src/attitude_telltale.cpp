@@ -38,7 +38,9 @@ TelltaleAttitudeFilter::TelltaleAttitudeFilter(Params params) : params_(params) 
             1.0 / p.bias_motion_tau_s,
             1.0 / (p.nonin_high_m_s2 - p.nonin_low_m_s2),
             1.0 / (p.turn_high_m_s2 - p.turn_low_m_s2),
-            1.0 / p.turn_rate_rad_s};
+            1.0 / p.turn_rate_rad_s,
+            1.0 / p.g_m_s2,
+            1.0 / (p.g_m_s2 * p.g_m_s2)};
 }
 
 void TelltaleAttitudeFilter::initialise(const ImuSample& s) {
@@ -181,11 +183,18 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // is this one unit vector rather than a rotation.
   const double l2 = state_.acc_lp2_i.squaredNorm();
   if (l2 > 0.25 * p.g_m_s2 * p.g_m_s2) {
-    const Eigen::Vector3d target = state_.acc_lp2_i / std::sqrt(l2);
+    // Only the target's direction matters (a norm off by e moves the result by ~w e theta), so
+    // near g one Newton step from 1/g stands in for the square root and the division.
+    const double l2_rel = l2 * k.inv_g2;
+    const Eigen::Vector3d target =
+        state_.acc_lp2_i *
+        (std::abs(l2_rel - 1.0) < 0.1 ? k.inv_g * (1.5 - 0.5 * l2_rel) : 1.0 / std::sqrt(l2));
     const Eigen::Vector3d moved = up_i + w * (target - up_i);
     const double m2 = moved.squaredNorm();
     if (m2 > 1e-6) {  // not a half-turn away (an upside-down start at w ~ 0.5)
-      state_.up_i = moved / std::sqrt(m2);
+      // Steps are small in steady state (|moved| = 1 - O(w theta^2)): there a Newton step to unit
+      // length is exact to (1 - m2)^2 < 1e-6; a large step takes the square root.
+      state_.up_i = moved * (std::abs(m2 - 1.0) < 1e-3 ? 1.5 - 0.5 * m2 : 1.0 / std::sqrt(m2));
       // Bias in motion: this step's correction is the small rotation w (target x up) of frame I,
       // which is minus the residual bias times dt, seen in the body frame; integrate it slowly
       // (bias_motion_tau_s) so it never fights the low-pass.

@@ -117,7 +117,7 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
   /// update multiplies instead of dividing.
   struct Rates {
     double rest_lp, rest_bias, nonin_lp, nonin_release, turn_lp, turn_release, acc, acc_rest,
-        bias_motion, nonin_range, turn_range, turn_rate;
+        bias_motion, nonin_range, turn_range, turn_rate, inv_g, inv_g2;
   };
   Params params_;
   Rates rates_{};
