@@ -41,7 +41,10 @@ json boat_object(const BoatView& v) {
       {"accel_weight", finite_or_null(static_cast<double>(s.accel_weight))},
       {"quality", finite_or_null(static_cast<double>(s.quality))},
       {"leds",
-       {{"left", s.leds[0]}, {"right", s.leds[1]}, {"up", s.leds[2]}, {"down", s.leds[3]},
+       {{"left", s.leds[0]},
+        {"right", s.leds[1]},
+        {"up", s.leds[2]},
+        {"down", s.leds[3]},
         {"count", s.led_count}}},
       {"alarm_state", v.alarm_state},
       {"stale", v.stale},
@@ -86,7 +89,8 @@ T field(const json& j, const char* name, const T& fallback, bool required) {
     if (!std::isfinite(d)) throw HttpError(400, std::string("rule: '") + name + "' must be finite");
     return d;
   } else if constexpr (std::is_same_v<T, bool>) {
-    if (!v.is_boolean()) throw HttpError(400, std::string("rule: '") + name + "' must be true/false");
+    if (!v.is_boolean())
+      throw HttpError(400, std::string("rule: '") + name + "' must be true/false");
     return v.get<bool>();
   } else {
     if (!v.is_string()) throw HttpError(400, std::string("rule: '") + name + "' must be a string");
@@ -97,7 +101,7 @@ T field(const json& j, const char* name, const T& fallback, bool required) {
 
 AlarmRule rule_from_json(const json& j) {
   if (!j.is_object()) throw HttpError(400, "rule: expected an object");
-  static const std::set<std::string> kKnown = {"id",     "scope",          "quantity", "min_deg",
+  static const std::set<std::string> kKnown = {"id",      "scope",  "quantity",       "min_deg",
                                                "max_deg", "hold_s", "hysteresis_deg", "level",
                                                "enabled"};
   for (const auto& [key, value] : j.items())
@@ -118,6 +122,26 @@ AlarmRule rule_from_json(const json& j) {
   r.enabled = field<bool>(j, "enabled", true, false);
   if (const std::string why = r.validate(); !why.empty()) throw HttpError(400, "rule: " + why);
   return r;
+}
+
+std::vector<AlarmRule> rules_from_body(const std::string& body) {
+  json parsed;
+  try {
+    parsed = json::parse(body);
+  } catch (const json::parse_error&) {
+    throw HttpError(400, "body is not valid JSON");
+  }
+  if (!parsed.is_array()) throw HttpError(400, "body must be a JSON array of rules");
+  if (parsed.size() > kMaxRules)
+    throw HttpError(400, "at most " + std::to_string(kMaxRules) + " rules");
+  std::vector<AlarmRule> rules;
+  std::set<std::string> ids;
+  for (const auto& j : parsed) {
+    rules.push_back(rule_from_json(j));
+    if (!ids.insert(rules.back().id).second)
+      throw HttpError(400, "duplicate rule id '" + rules.back().id + "'");
+  }
+  return rules;
 }
 
 json event_object(const AlarmEvent& e) {
