@@ -41,10 +41,7 @@ json boat_object(const BoatView& v) {
       {"accel_weight", finite_or_null(static_cast<double>(s.accel_weight))},
       {"quality", finite_or_null(static_cast<double>(s.quality))},
       {"leds",
-       {{"left", s.leds[0]},
-        {"right", s.leds[1]},
-        {"up", s.leds[2]},
-        {"down", s.leds[3]},
+       {{"left", s.leds[0]}, {"right", s.leds[1]}, {"up", s.leds[2]}, {"down", s.leds[3]},
         {"count", s.led_count}}},
       {"alarm_state", v.alarm_state},
       {"stale", v.stale},
@@ -89,8 +86,7 @@ T field(const json& j, const char* name, const T& fallback, bool required) {
     if (!std::isfinite(d)) throw HttpError(400, std::string("rule: '") + name + "' must be finite");
     return d;
   } else if constexpr (std::is_same_v<T, bool>) {
-    if (!v.is_boolean())
-      throw HttpError(400, std::string("rule: '") + name + "' must be true/false");
+    if (!v.is_boolean()) throw HttpError(400, std::string("rule: '") + name + "' must be true/false");
     return v.get<bool>();
   } else {
     if (!v.is_string()) throw HttpError(400, std::string("rule: '") + name + "' must be a string");
@@ -101,7 +97,7 @@ T field(const json& j, const char* name, const T& fallback, bool required) {
 
 AlarmRule rule_from_json(const json& j) {
   if (!j.is_object()) throw HttpError(400, "rule: expected an object");
-  static const std::set<std::string> kKnown = {"id",      "scope",  "quantity",       "min_deg",
+  static const std::set<std::string> kKnown = {"id",     "scope",          "quantity", "min_deg",
                                                "max_deg", "hold_s", "hysteresis_deg", "level",
                                                "enabled"};
   for (const auto& [key, value] : j.items())
