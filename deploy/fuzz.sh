@@ -42,7 +42,7 @@ for t in "${targets[@]}"; do
   ran=$(($(date +%s) - t0))
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
-  cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | cut -d' ' -f2)
+  cov=$({ grep -o 'cov: [0-9]*' "$log" || true; } | tail -1 | cut -d' ' -f2)
   found=$(($(find "$crashes" -type f | wc -l) - before))
   if [ "$status" -ne 0 ] && [ "$found" -eq 0 ]; then found=1; fi  # died without an artifact
   summary+=$(printf '\n%-18s %8s %12s %10s %8s %8s' "$t" "$ran" "${execs:-?}" "${rate:-?}" \
