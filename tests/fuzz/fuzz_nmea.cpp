@@ -87,17 +87,9 @@ Assembled assemble(std::string_view bytes, std::uint8_t seed, bool datagram) {
   NmeaLineAssembler a;
   Assembled out;
   const auto on_line = [&](std::string_view l) { out.lines.emplace_back(l); };
-  std::uint32_t state = seed;
-  std::size_t pos = 0;
-  while (pos < bytes.size()) {
-    std::size_t n = bytes.size() - pos;
-    if (seed != 0) {
-      state = state * 1103515245u + 12345u;
-      n = std::min<std::size_t>(n, 1 + (state >> 16) % 97);
-    }
+  telltale::fuzz::feed_in_pieces(bytes.size(), seed, 97, [&](std::size_t pos, std::size_t n) {
     a.feed(bytes.data() + pos, n, on_line);
-    pos += n;
-  }
+  });
   if (datagram) a.end_of_record(on_line);
   out.stats = a.stats();
   return out;

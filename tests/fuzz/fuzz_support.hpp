@@ -3,6 +3,7 @@
 /// Helpers shared by the libFuzzer targets: a reader over the fuzzer's bytes and an invariant
 /// check that aborts (libFuzzer then keeps the input as a crash file).
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -63,6 +64,23 @@ class Input {
   const std::uint8_t* data_;
   std::size_t size_;
 };
+
+/// Calls feed(offset, length) over [0, size) in pieces, as reads from a device end anywhere: whole
+/// when `seed` is 0, else pieces of 1..max_piece bytes from a small generator seeded by `seed`.
+template <class Feed>
+void feed_in_pieces(std::size_t size, std::uint8_t seed, std::size_t max_piece, Feed feed) {
+  std::uint32_t state = seed;
+  std::size_t pos = 0;
+  while (pos < size) {
+    std::size_t n = size - pos;
+    if (seed != 0) {
+      state = state * 1103515245u + 12345u;
+      n = std::min<std::size_t>(n, 1 + (state >> 16) % max_piece);
+    }
+    feed(pos, n);
+    pos += n;
+  }
+}
 
 /// Equal as the same number or both NaN.
 inline bool same(double a, double b) { return (std::isnan(a) && std::isnan(b)) || a == b; }

@@ -31,17 +31,10 @@ struct Decoded {
 Decoded decode(std::span<const std::uint8_t> bytes, std::uint8_t seed) {
   Decoded out;
   WitMotionDecoder d([&](const WitSample& s) { out.samples.push_back(s); });
-  std::uint32_t state = seed;
-  std::size_t pos = 0;
-  while (pos < bytes.size()) {
-    std::size_t n = bytes.size() - pos;
-    if (seed != 0) {
-      state = state * 1103515245u + 12345u;
-      n = std::min<std::size_t>(n, 1 + (state >> 16) % 23);
-    }
+  // Pieces of up to 23 bytes: about two packets, so cuts fall inside and between them.
+  telltale::fuzz::feed_in_pieces(bytes.size(), seed, 23, [&](std::size_t pos, std::size_t n) {
     d.feed(bytes.subspan(pos, n), 1.0);
-    pos += n;
-  }
+  });
   d.flush();
   out.stats = d.stats();
   return out;
