@@ -17,7 +17,10 @@ cmake --build "$build" -j"$(nproc)"
 "$root/deploy/web_deps.sh" || echo "test_sanitized: web/ npm packages not installed" >&2
 built=$(date +%s)
 # Exported, so every process a test starts (shore_server, boat_node, ...) inherits them.
-export ASAN_OPTIONS="halt_on_error=1:abort_on_error=0:detect_leaks=1:detect_stack_use_after_return=1:strict_string_checks=1:check_initialization_order=1:print_summary=1"
+# new_delete_type_mismatch=0: Fast DDS 2.9.1 itself deletes its StatisticsWriterImpl writers
+# through a base of the wrong size (RTPSWriter::~RTPSWriter, seen on every participant shutdown);
+# ASan cannot suppress that per library. Our code is covered by -Wnon-virtual-dtor -Werror.
+export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1:detect_stack_use_after_return=1:strict_string_checks=1:check_initialization_order=1:new_delete_type_mismatch=0"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1:report_error_type=1"
 export LSAN_OPTIONS="suppressions=$root/deploy/sanitizers/lsan.supp:print_suppressions=0"
 cd "$build"
