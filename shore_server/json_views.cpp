@@ -120,6 +120,28 @@ AlarmRule rule_from_json(const json& j) {
   return r;
 }
 
+std::vector<AlarmRule> rules_from_body(const std::string& body) {
+  json parsed;
+  try {
+    parsed = json::parse(body);
+  } catch (const json::exception&) {
+    // Not only parse_error: a number beyond double ("1e400") is an out_of_range, which used to
+    // escape as a 500 (found by tests/fuzz/fuzz_rest).
+    throw HttpError(400, "body is not valid JSON");
+  }
+  if (!parsed.is_array()) throw HttpError(400, "body must be a JSON array of rules");
+  if (parsed.size() > kMaxRules)
+    throw HttpError(400, "at most " + std::to_string(kMaxRules) + " rules");
+  std::vector<AlarmRule> rules;
+  std::set<std::string> ids;
+  for (const auto& j : parsed) {
+    rules.push_back(rule_from_json(j));
+    if (!ids.insert(rules.back().id).second)
+      throw HttpError(400, "duplicate rule id '" + rules.back().id + "'");
+  }
+  return rules;
+}
+
 json event_object(const AlarmEvent& e) {
   json j = {{"id", e.id},
             {"boat_id", e.boat_id},

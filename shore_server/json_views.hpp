@@ -2,14 +2,15 @@
 /// \file
 /// The JSON shapes of the REST API and the live stream (described in openapi.json), in one place.
 
+#include <cstddef>
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
-#include "telltale/fusion/alarm_engine.hpp"
 #include "fleet.hpp"
 #include "store.hpp"
+#include "telltale/fusion/alarm_engine.hpp"
 
 namespace telltale::shore {
 
@@ -23,6 +24,12 @@ namespace telltale::shore {
 [[nodiscard]] nlohmann::json rule_object(const AlarmRule& rule);
 /// A rule from its JSON; throws HttpError 400 naming the field that is wrong.
 [[nodiscard]] AlarmRule rule_from_json(const nlohmann::json& j);
+/// Most rules one PUT /api/v1/alarms/rules may set.
+inline constexpr std::size_t kMaxRules = 200;
+/// The rules of a PUT /api/v1/alarms/rules body: a JSON array of at most kMaxRules rules with
+/// distinct ids. Throws HttpError 400 (broken JSON, not an array, too many, a bad rule, a
+/// duplicate id) and nothing else, whatever the bytes.
+[[nodiscard]] std::vector<AlarmRule> rules_from_body(const std::string& body);
 [[nodiscard]] nlohmann::json event_object(const AlarmEvent& event);
 [[nodiscard]] nlohmann::json session_object(const SessionInfo& session);
 [[nodiscard]] nlohmann::json athlete_object(const AthleteView& view);

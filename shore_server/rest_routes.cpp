@@ -6,7 +6,6 @@
 #include <array>
 #include <cmath>
 #include <nlohmann/json.hpp>
-#include <set>
 
 #include "http_api.hpp"
 #include "json_views.hpp"
@@ -19,7 +18,6 @@ namespace {
 using nlohmann::json;
 
 constexpr std::int64_t kMaxPointsLimit = 100000;
-constexpr std::size_t kMaxRules = 200;
 
 Principal who(const ShoreContext& ctx, const httplib::Request& req) {
   return authenticate(ctx.tokens, req.get_header_value("Authorization"),
@@ -419,23 +417,7 @@ void register_rest_routes(httplib::Server& server, ShoreContext& ctx) {
     const std::string type = req.get_header_value("Content-Type");
     if (type.rfind("application/json", 0) != 0)
       throw HttpError(415, "body must be application/json");
-    json body;
-    try {
-      body = json::parse(req.body);
-    } catch (const json::parse_error&) {
-      throw HttpError(400, "body is not valid JSON");
-    }
-    if (!body.is_array()) throw HttpError(400, "body must be a JSON array of rules");
-    if (body.size() > kMaxRules)
-      throw HttpError(400, "at most " + std::to_string(kMaxRules) + " rules");
-    std::vector<AlarmRule> rules;
-    std::set<std::string> ids;
-    for (const auto& j : body) {
-      rules.push_back(rule_from_json(j));
-      if (!ids.insert(rules.back().id).second)
-        throw HttpError(400, "duplicate rule id '" + rules.back().id + "'");
-    }
-    ctx.alarms.put_rules(std::move(rules), utc_now_ns());
+    ctx.alarms.put_rules(rules_from_body(req.body), utc_now_ns());
     json arr = json::array();
     for (const auto& r : ctx.alarms.rules()) arr.push_back(rule_object(r));
     res.set_content(arr.dump(), "application/json");

@@ -49,8 +49,8 @@ class SignedMeanWindow {
   void reset();
   /// Adds (t, v) and drops samples older than t - window_s (or the oldest when full).
   void push(double t_s, double v, double window_s);
-  [[nodiscard]] double positive_mean() const { return n_pos_ ? sum_pos_ / n_pos_ : 0.0; }
-  [[nodiscard]] double negative_mean() const { return n_neg_ ? sum_neg_ / n_neg_ : 0.0; }
+  [[nodiscard]] double positive_mean() const { return n_pos_ > 0.0 ? sum_pos_ / n_pos_ : 0.0; }
+  [[nodiscard]] double negative_mean() const { return n_neg_ > 0.0 ? sum_neg_ / n_neg_ : 0.0; }
   [[nodiscard]] std::size_t size() const { return size_; }
 
  private:

@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (tests/fuzz, clang, ASan + UBSan) into build-fuzz/ and runs each for
+# a bounded time: deploy/fuzz.sh [SECONDS_PER_TARGET (default 45)] [TARGET...]
+# Prints per target the seconds run, executions, exec/s, coverage (libFuzzer's cov: edges) and
+# crashes; fails if any target crashed. Crash inputs are kept in build-fuzz/crashes/<target>/
+# (replay one: build-fuzz/bin/<target> FILE). Inputs that found new coverage accumulate in
+# build-fuzz/corpus/<target>/ across runs; the seeds stay in tests/fuzz/corpus/<target>/.
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+build="$root/build-fuzz"
+seconds=${1:-45}
+shift || true
+targets=("$@")
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_csv fuzz_nmea fuzz_witmotion fuzz_session_log fuzz_rest)
+"$root/deploy/bootstrap.sh"
+
+start=$(date +%s)
+CC=clang CXX=clang++ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DTELLTALE_FUZZ=ON -DBUILD_TESTING=OFF -DTELLTALE_BUILD_BENCHMARKS=OFF >/dev/null
+cmake --build "$build" -j"$(nproc)" --target "${targets[@]}"
+echo "fuzz: build $(($(date +%s) - start)) s"
+
+# Leaks are findings too; UBSan stops at the first report like ASan does.
+export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1"
+export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
+failed=0
+summary=$(printf '%-18s %8s %12s %10s %8s %8s\n' target seconds executions exec/s cov crashes)
+for t in "${targets[@]}"; do
+  corpus="$build/corpus/$t"
+  crashes="$build/crashes/$t"
+  log="$build/logs/$t.log"
+  mkdir -p "$corpus" "$crashes" "$(dirname "$log")"
+  dict=()
+  [ -f "$root/tests/fuzz/dict/$t.dict" ] && dict=(-dict="$root/tests/fuzz/dict/$t.dict")
+  before=$(find "$crashes" -type f | wc -l)
+  t0=$(date +%s)
+  status=0
+  # -timeout: one input taking over 10 s is a hang, reported like a crash.
+  "$build/bin/$t" -max_total_time="$seconds" -timeout=10 -print_final_stats=1 \
+    -artifact_prefix="$crashes/" "${dict[@]}" "$corpus" "$root/tests/fuzz/corpus/$t" \
+    >"$log" 2>&1 || status=$?
+  ran=$(($(date +%s) - t0))
+  execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
+  rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
+  cov=$({ grep -o 'cov: [0-9]*' "$log" || true; } | tail -1 | cut -d' ' -f2)
+  found=$(($(find "$crashes" -type f | wc -l) - before))
+  if [ "$status" -ne 0 ] && [ "$found" -eq 0 ]; then found=1; fi  # died without an artifact
+  summary+=$(printf '\n%-18s %8s %12s %10s %8s %8s' "$t" "$ran" "${execs:-?}" "${rate:-?}" \
+    "${cov:-?}" "$found")
+  if [ "$found" -ne 0 ]; then
+    failed=1
+    echo "fuzz: $t crashed (status $status); log $log; inputs in $crashes/:" >&2
+    grep -E 'ERROR|INVARIANT|SUMMARY|Test unit written' "$log" | head -20 >&2 || true
+  fi
+done
+echo "$summary"
+[ "$failed" -eq 0 ] || { echo "fuzz: FAILED (crash inputs kept under $build/crashes)" >&2; exit 1; }
+echo "fuzz: all targets ran without a crash"
