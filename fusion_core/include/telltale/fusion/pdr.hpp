@@ -15,7 +15,8 @@
 /// hard-iron calibration of the magnetometer (hard_iron.hpp); a switch's steps re-laid with the
 /// heading each really had once the new pose is known; steps the detector left in a gap of
 /// several intervals counted; the phone's yaw from the walking direction removed using the
-/// step's acceleration pattern.
+/// step's acceleration pattern (shrunk toward 0 while the pose is young); a personal step-length
+/// factor from one calibration walk of known length (PdrParams::step_scale; s2-pdr2.md).
 ///
 /// Frames: the phone's sensor axes are whatever the phone has; the walking frame is x forward, y
 /// left, z up with `v_walking = M_pose v_sensor` (M = I for hand-held and arm swing). Position is
