@@ -15,18 +15,22 @@ struct PdrOptions {
   std::string in;
   std::string out;
   double height_m = 0.0;
+  double step_scale = 1.0;
   std::string mount = "phone";
 };
 
 void run_pdr(const PdrOptions& o) {
   if (!(o.height_m > 0.5 && o.height_m < 2.5))
     throw UsageError("--height-m must be a body height in metres (0.5-2.5)");
+  if (!(o.step_scale >= 0.5 && o.step_scale <= 1.5))
+    throw UsageError("--step-scale must be a personal factor between 0.5 and 1.5");
   if (o.mount != "phone" && o.mount != "body" && o.mount != "foot")
     throw UsageError("unknown mount '" + o.mount + "' (phone, body, foot)");
   bool has_gyro = false, has_mag = false;
   const auto records = read_imu_csv(o.in, false, &has_gyro, &has_mag);
   fusion::PdrParams params;
   params.height_m = o.height_m;
+  params.step_scale.fill(o.step_scale);
   params.mount = o.mount == "foot" ? fusion::StepMount::kFoot : fusion::StepMount::kBody;
   fusion::Pdr pdr(params);
   io::CsvWriter track(o.out, {"t_s", "x_m", "y_m", "heading_deg", "pose", "steps", "distance_m",
@@ -73,6 +77,10 @@ void register_pdr(CLI::App& app) {
                   "track CSV, one row per step: t_s,x_m (east),y_m (north),heading_deg,pose "
                   "(0 hand-held, 1 call, 2 pocket, 3 arm swing),steps,distance_m,...")
       ->required();
+  cmd->add_option("--step-scale", opts->step_scale,
+                  "personal step-length factor: known length / distance_m of this command on a "
+                  "calibration walk (e.g. 100 m hand-held)")
+      ->capture_default_str();
   cmd->add_option("--mount", opts->mount, "phone | body | foot")->capture_default_str();
   cmd->callback([opts] { run_pdr(*opts); });
 }

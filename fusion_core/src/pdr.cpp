@@ -570,7 +570,9 @@ void Pdr::on_step(double t_s) {
   ++yaw_steps_;
   if (!foot && params_.walking_direction && yaw_steps_ >= params_.walking_direction_steps &&
       yaw_fwd_ > 0.0)
-    heading = wrap_2pi(heading - std::atan2(yaw_left_, yaw_fwd_));
+    heading = wrap_2pi(heading - static_cast<double>(yaw_steps_) /
+                                     (yaw_steps_ + params_.walking_direction_prior_steps) *
+                                     std::atan2(yaw_left_, yaw_fwd_));
   const double step_heading = heading;
   const Eigen::Vector2d step_axis_x = axis_sum_[0], step_axis_z = axis_sum_[1];
   axis_sum_[0].setZero();
@@ -587,7 +589,8 @@ void Pdr::on_step(double t_s) {
   }
   // Eq. (13) and eq. (11). The first step has no frequency yet: the person's usual walk.
   const double hz = out_.step_hz > 0.0 ? out_.step_hz : 1.8;
-  const double len = (per_event + missed) * lengths_.length_m(applied_pose_, params_.height_m, hz);
+  const double len = (per_event + missed) * lengths_.length_m(applied_pose_, params_.height_m, hz) *
+                     params_.step_scale[static_cast<std::size_t>(applied_pose_)];
   out_.last_step_length_m = len;
   out_.distance_m += len;
   if (!foot && (!pose_known_ || !heading_.initialised())) {

@@ -68,7 +68,23 @@ std::vector<CalibrationWalk> simulate_calibration_walks(std::uint64_t first, int
 
 namespace telltale::fusion::sim {
 
-LoopWalkResult simulate_pdr_loop(std::uint64_t seed, LoopVariant variant) {
+double personal_step_scale(const Person& person, std::uint64_t seed, PhonePose pose,
+                           double length_m) {
+  GaitScenario sc;
+  sc.site = SensorSite::kPhone;
+  sc.rate_hz = 50.0;
+  sc.closed = true;  // the walk ends at the second mark
+  sc.path = {{length_m, 0.0}};
+  sc.segments = {{Gait::kWalk, pose, 1e6}};
+  const auto run = simulate_gait(sc, person, seed);
+  PdrParams params;
+  params.height_m = person.height_m;
+  Pdr pdr(params);
+  for (const auto& s : run.samples) (void)pdr.update(s.imu, s.mag_uT);
+  return pdr.output().distance_m > 0.0 ? run.distance_m / pdr.output().distance_m : 1.0;
+}
+
+LoopWalkResult simulate_pdr_loop(std::uint64_t seed, LoopVariant variant, bool calibrate) {
   auto sc = *make_gait_scenario("loop", seed);
   Person person = random_person(seed);
   if (variant == LoopVariant::kSinglePose)
@@ -80,9 +96,13 @@ LoopWalkResult simulate_pdr_loop(std::uint64_t seed, LoopVariant variant) {
   const auto run = simulate_gait(sc, person, seed);
   PdrParams params;
   params.height_m = person.height_m;
+  // The calibration walk's seed is far from every loop seed, so its noise and biases are its own.
+  if (calibrate) params.step_scale.fill(personal_step_scale(person, seed + 1000003));
   Pdr pdr(params);
   for (const auto& s : run.samples) (void)pdr.update(s.imu, s.mag_uT);
   LoopWalkResult r;
+  r.step_scale = params.step_scale[0];
+  r.distance_error_fraction = pdr.output().distance_m / run.distance_m - 1.0;
   const auto& last = run.samples.back();
   r.distance_m = run.distance_m;
   r.end_error_m = std::hypot(pdr.output().x_m - last.x_m, pdr.output().y_m - last.y_m);

@@ -34,11 +34,21 @@ struct PoseWindowSet {
 
 namespace telltale::fusion::sim {
 
+/// The personal step-length calibration an athlete does once: walk a straight, known `length_m`
+/// (e.g. 100 m between two marks on a pontoon) at a normal pace with the phone in `pose`, then
+/// step_scale = known length / PDR distance. `seed` draws that walk's noise and sensor biases
+/// (another run than the evaluated one). Returns the factor for PdrParams::step_scale.
+[[nodiscard]] double personal_step_scale(const Person& person, std::uint64_t seed,
+                                         PhonePose pose = PhonePose::kHandHeld,
+                                         double length_m = 100.0);
+
 /// One closed-loop PDR walk ("loop" scenario of the gait simulator) run through a Pdr.
 struct LoopWalkResult {
-  double distance_m = 0.0;      ///< true distance walked
-  double end_error_m = 0.0;     ///< |estimated end - true end|
-  double error_fraction = 0.0;  ///< end_error_m / distance_m
+  double distance_m = 0.0;               ///< true distance walked
+  double end_error_m = 0.0;              ///< |estimated end - true end|
+  double error_fraction = 0.0;           ///< end_error_m / distance_m
+  double distance_error_fraction = 0.0;  ///< (PDR distance - true distance) / true distance
+  double step_scale = 1.0;               ///< the personal factor from the calibration walk
   std::size_t steps_true = 0;
   std::size_t steps_counted = 0;
   unsigned switches_true = 0;  ///< pose changes in the schedule
@@ -50,7 +60,11 @@ enum class LoopVariant {
   kIdealSensors,  ///< pose switches, no biases, no hard iron, no misalignment (noise only)
 };
 /// Person and loop drawn from `seed` (people seeds 2001+ are not in the training range 1..23).
+/// Protocol: before the loop the person does one calibration walk of 100 m hand-held
+/// (personal_step_scale, its own noise seed, never the evaluated walk), unless `calibrate` is
+/// false (the population step-length model alone).
 [[nodiscard]] LoopWalkResult simulate_pdr_loop(std::uint64_t seed,
-                                               LoopVariant variant = LoopVariant::kAsSimulated);
+                                               LoopVariant variant = LoopVariant::kAsSimulated,
+                                               bool calibrate = true);
 
 }  // namespace telltale::fusion::sim
