@@ -27,6 +27,7 @@ struct Options {
   std::string source = "sim";
   std::string mount = "phone";
   double height_m = 1.75;
+  double step_scale = 1.0;  ///< personal factor from a calibration walk (fusion_cli pdr)
   double rate_hz = 2.0;
   std::uint64_t seed = 1;
   bool replay_fast = false;
@@ -170,6 +171,8 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
     throw std::invalid_argument("athlete id must be 1-32 of [A-Za-z0-9_-]");
   if (!(o.height_m >= 1.0 && o.height_m <= 2.5))
     throw std::invalid_argument("--height-m must be in 1.0..2.5");
+  if (!(o.step_scale >= 0.5 && o.step_scale <= 1.5))
+    throw std::invalid_argument("--step-scale must be in 0.5..1.5");
   if (!(o.rate_hz > 0 && o.rate_hz <= 50)) throw std::invalid_argument("--rate-hz in (0, 50]");
   if (o.mount != "phone" && o.mount != "foot")
     throw std::invalid_argument("--mount is phone or foot");
@@ -178,6 +181,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   fusion::PdrParams params;
   params.mount = foot ? fusion::StepMount::kFoot : fusion::StepMount::kBody;
   params.height_m = o.height_m;
+  params.step_scale.fill(o.step_scale);
   auto pdr = std::make_unique<fusion::Pdr>(params);  // 110 kB: not on the stack
 
   auto dds_options = o.dds;
@@ -266,6 +270,10 @@ int main(int argc, char** argv) {
   app.add_option("--mount", o.mount, "phone (carried) or foot (toe-mounted module)")
       ->capture_default_str();
   app.add_option("--height-m", o.height_m, "athlete's height (step length model)")
+      ->capture_default_str();
+  app.add_option("--step-scale", o.step_scale,
+                 "personal step-length factor: known length / distance measured by "
+                 "`fusion_cli pdr` on a calibration walk")
       ->capture_default_str();
   app.add_option("--rate-hz", o.rate_hz, "publish rate")->capture_default_str();
   app.add_option("--seed", o.seed, "simulator seed")->capture_default_str();
