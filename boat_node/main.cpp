@@ -1,19 +1,19 @@
 // boat_node: runs the fusion core on a boat's sensors and publishes heel, pitch and heading over
 // DDS; logs every published sample to disk and backfills the shore after a link outage.
 #include <arpa/inet.h>
+#include <fastdds/rtps/transport/test_UDPv4TransportDescriptor.h>
 #include <ifaddrs.h>
 #include <net/if.h>
 #include <netinet/in.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
-#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
-#include <fastdds/rtps/transport/test_UDPv4TransportDescriptor.h>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fstream>
 #include <functional>
 #include <limits>
@@ -25,6 +25,7 @@
 #include "boat_dds.hpp"
 #include "console.hpp"
 #include "csv.hpp"
+#include "dds_cli.hpp"
 #include "heading_input.hpp"
 #include "imu_source.hpp"
 #include "session_log.hpp"
@@ -63,7 +64,7 @@ struct Options {
   double default_max_heel_deg = 30.0;
   double gyro_range_dps = 250.0;  ///< L3G4200D default, as in the paper's instrument
   double acc_range_g = 2.0;       ///< LSM303DLH default
-  std::string fault_drop_link;  ///< "START_S:DURATION_S"
+  std::string fault_drop_link;    ///< "START_S:DURATION_S"
 };
 
 /// Fault injection for tests: every packet this node sends is dropped from START_S to
@@ -173,8 +174,8 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
     heading = std::make_unique<telltale::boat::HeadingInput>(o.headings, o.variation_deg);
 
   std::random_device rd;
-  const std::uint64_t boot_id = (static_cast<std::uint64_t>(rd()) << 32) ^ rd() ^
-                                static_cast<std::uint64_t>(getpid());
+  const std::uint64_t boot_id =
+      (static_cast<std::uint64_t>(rd()) << 32) ^ rd() ^ static_cast<std::uint64_t>(getpid());
   telltale::boat::SessionLog log({o.log_dir, o.boat_id, boot_id, 100000,
                                   static_cast<std::uint64_t>(o.log_max_mb * 1024 * 1024)});
 
@@ -190,8 +191,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   };
   callbacks.on_rules = [&](std::vector<telltale::fusion::AlarmRule> rules) {
     shore_rules = true;
-    alarms.set_rules(rules.empty() ? default_rules(o) : std::move(rules),
-                     telltale::utc_now_ns());
+    alarms.set_rules(rules.empty() ? default_rules(o) : std::move(rules), telltale::utc_now_ns());
   };
   callbacks.on_event = [&](const telltale::msg::AlarmEvent& e) {
     silenced = e.phase() == telltale::msg::ALARM_PHASE_SILENCED;
@@ -224,8 +224,8 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       telltale::boat::BackfillConfig{boot_id, static_cast<std::uint64_t>(2 * o.rate_hz), 2500,
                                      std::chrono::milliseconds(5000)},
       telltale::boat::SessionLogReader(o.log_dir, o.boat_id, boot_id),
-      [&fill, &dds, backfill_msg = telltale::msg::BoatAttitude()](
-          const telltale::boat::LogRecord& r) mutable {
+      [&fill, &dds,
+       backfill_msg = telltale::msg::BoatAttitude()](const telltale::boat::LogRecord& r) mutable {
         fill(r, backfill_msg);
         return dds.backfill(backfill_msg);
       });
@@ -274,8 +274,8 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
     const double t = sample->t_s - first_t;
     if (source->real_time()) {
       // Pace on the sample clock; a stop request wakes the wait.
-      const auto due = start + std::chrono::duration_cast<Clock::duration>(
-                                   std::chrono::duration<double>(t));
+      const auto due =
+          start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(t));
       if (shutdown.wait_for(due - Clock::now())) break;
     }
     const auto now = Clock::now();
@@ -326,7 +326,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       r.yaw_rate_deg_s = fused.yaw_rate_rad_s * kRadToDeg;
       r.accel_weight = static_cast<float>(fused.acc_weight);
       r.quality = static_cast<float>(health == telltale::msg::SENSOR_OK ? fused.quality
-                                                                         : 0.5 * fused.quality);
+                                                                        : 0.5 * fused.quality);
       alarms.evaluate(o.boat_id, o.group, r.t_utc_ns, heel, pitch);
       const AlarmLevel level = alarms.level_of(o.boat_id);
       const auto leds = telltale::fusion::led_panel(heel, pitch, led_params);
@@ -343,10 +343,11 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       if (!silenced) hook.on_level(o.boat_id, level, heel, now);
       if (o.console && now >= next_console) {
         next_console = now + std::chrono::milliseconds(200);
-        std::printf("%s%s", telltale::boat::render_panel(o.boat_id, heel, pitch, leds,
-                                                         o.leds_per_bar, level, tty)
-                                .c_str(),
-                    tty ? "\r" : "\n");
+        std::printf(
+            "%s%s",
+            telltale::boat::render_panel(o.boat_id, heel, pitch, leds, o.leds_per_bar, level, tty)
+                .c_str(),
+            tty ? "\r" : "\n");
         std::fflush(stdout);
       }
     }
@@ -399,12 +400,12 @@ int main(int argc, char** argv) {
   telltale::ShutdownSignal shutdown;  // first: every later thread inherits the blocked signals
   Options o;
   int domain = -1;
-  CLI::App app{"Telltale boat node: IMU (+ heading sensors) -> fusion core -> DDS, with a session "
-               "log and backfill"};
+  CLI::App app{
+      "Telltale boat node: IMU (+ heading sensors) -> fusion core -> DDS, with a session "
+      "log and backfill"};
   app.set_config("--config", "", "read options from this file (INI/TOML: key = value)");
   app.add_option("--domain", domain, "DDS domain id (default: $TELLTALE_DOMAIN)");
-  app.add_option("--boat-id", o.boat_id, "fleet-unique boat id, 1-32 of [A-Za-z0-9_-]")
-      ->required();
+  app.add_option("--boat-id", o.boat_id, "fleet-unique boat id, 1-32 of [A-Za-z0-9_-]")->required();
   app.add_option("--group", o.group, "fleet group or class (alarm rules can target it)");
   app.add_option("--source", o.source, "IMU: sim | replay:FILE.csv | witmotion:DEVICE[@BAUD]")
       ->capture_default_str();
@@ -429,15 +430,17 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--axis-remap", o.axis_remap, "boat axes from sensor axes, e.g. x=-y,y=x,z=z")
       ->capture_default_str();
-  app.add_option("--mount-file", o.mount_file, "heel/pitch zero offsets (read, and written by "
-                                               "--calibrate-s)");
+  app.add_option("--mount-file", o.mount_file,
+                 "heel/pitch zero offsets (read, and written by "
+                 "--calibrate-s)");
   app.add_option("--calibrate-s", o.calibrate_s,
                  "with the boat level at the dock: average this long and store the offsets");
   app.add_flag("--console", o.console, "show the LED panel on the console");
   app.add_option("--warn-command", o.warn_command,
                  "command run when the alarm level rises (TELLTALE_LEVEL etc. in its environment)");
   app.add_option("--led-step-deg", o.led_step_deg, "degrees per LED")->capture_default_str();
-  app.add_option("--leds-per-bar", o.leds_per_bar, "LEDs per bar")->capture_default_str()
+  app.add_option("--leds-per-bar", o.leds_per_bar, "LEDs per bar")
+      ->capture_default_str()
       ->check(CLI::Range(1, 20));
   app.add_option("--default-max-heel-deg", o.default_max_heel_deg,
                  "local alarm when no shore has pushed rules: |heel| above this for 2 s")
@@ -445,17 +448,7 @@ int main(int argc, char** argv) {
   app.add_option("--fault-drop-link", o.fault_drop_link,
                  "testing: drop every packet this node sends from START_S for DURATION_S")
       ->group("Fault injection");
-  app.add_option("--dds-profiles", o.dds.profiles_file,
-                 "Fast DDS profiles XML (default: $TELLTALE_DDS_PROFILES or deploy/dds/)");
-  app.add_option("--security-dir", o.dds.security_dir,
-                 "DDS Security: this node's folder from deploy/security/make_fleet_pki.sh "
-                 "(default: unsecured)");
-  app.add_option("--dds-peer", o.dds.peers,
-                 "unicast discovery peer (IPv4), repeatable: networks without multicast "
-                 "(default: $TELLTALE_DDS_PEERS, comma-separated)");
-  app.add_option("--dds-participant", o.dds.participant_profile,
-                 "participant profile in that file")
-      ->capture_default_str();
+  telltale::dds::add_dds_options(app, o.dds);
   CLI11_PARSE(app, argc, argv);
   if (domain >= 0) o.dds.domain = domain;
   try {

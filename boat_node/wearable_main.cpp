@@ -8,6 +8,7 @@
 #include <regex>
 
 #include "csv.hpp"
+#include "dds_cli.hpp"
 #include "dds_participant.hpp"
 #include "dds_security.hpp"
 #include "shutdown.hpp"
@@ -49,7 +50,8 @@ class WearableSource {
 /// The gait simulator, walk after walk (each with its own seed), time continuing.
 class SimWearable : public WearableSource {
  public:
-  SimWearable(std::string scenario, std::uint64_t seed) : scenario_(std::move(scenario)), seed_(seed) {
+  SimWearable(std::string scenario, std::uint64_t seed)
+      : scenario_(std::move(scenario)), seed_(seed) {
     if (!fusion::sim::make_gait_scenario(scenario_, seed_))
       throw std::invalid_argument("unknown gait scenario '" + scenario_ + "'");
   }
@@ -82,9 +84,16 @@ class ReplayWearable : public WearableSource {
  public:
   ReplayWearable(const std::string& path, bool fast)
       : reader_(path,
-                {{"t_s"}, {"ax_m_s2"}, {"ay_m_s2"}, {"az_m_s2"}, {"gx_rad_s", false, false},
-                 {"gy_rad_s", false, false}, {"gz_rad_s", false, false}, {"mx_uT", false, false},
-                 {"my_uT", false, false}, {"mz_uT", false, false}},
+                {{"t_s"},
+                 {"ax_m_s2"},
+                 {"ay_m_s2"},
+                 {"az_m_s2"},
+                 {"gx_rad_s", false, false},
+                 {"gy_rad_s", false, false},
+                 {"gz_rad_s", false, false},
+                 {"mx_uT", false, false},
+                 {"my_uT", false, false},
+                 {"mz_uT", false, false}},
                 "t_s"),
         fast_(fast) {}
   std::optional<Sample> next(telltale::ShutdownSignal&) override {
@@ -111,9 +120,9 @@ class WitMotionWearable : public WearableSource {
   std::optional<Sample> next(telltale::ShutdownSignal& shutdown) override {
     const auto w = feed_.next([&] { return shutdown.stop_requested(); });
     if (!w) return std::nullopt;
-    return Sample{w->imu, w->has_mag ? w->mag_uT
-                                     : Eigen::Vector3d::Constant(
-                                           std::numeric_limits<double>::quiet_NaN())};
+    return Sample{w->imu,
+                  w->has_mag ? w->mag_uT
+                             : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN())};
   }
   bool real_time() const override { return false; }  // the device paces itself
 
@@ -123,7 +132,8 @@ class WitMotionWearable : public WearableSource {
 
 std::unique_ptr<WearableSource> make_source(const Options& o) {
   if (o.source == "sim") return std::make_unique<SimWearable>("phone-switch", o.seed);
-  if (o.source.rfind("sim:", 0) == 0) return std::make_unique<SimWearable>(o.source.substr(4), o.seed);
+  if (o.source.rfind("sim:", 0) == 0)
+    return std::make_unique<SimWearable>(o.source.substr(4), o.seed);
   if (o.source.rfind("replay:", 0) == 0)
     return std::make_unique<ReplayWearable>(o.source.substr(7), o.replay_fast);
   if (o.source.rfind("witmotion:", 0) == 0)
@@ -219,8 +229,8 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
     if (std::isnan(first_t)) first_t = s->imu.t_s;
     const double t = s->imu.t_s - first_t;
     if (source->real_time()) {
-      const auto due = start + std::chrono::duration_cast<Clock::duration>(
-                                   std::chrono::duration<double>(t));
+      const auto due =
+          start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(t));
       if (shutdown.wait_for(due - Clock::now())) break;
     }
     const fusion::PdrOutput& p = pdr->update(s->imu, s->mag_uT);
@@ -278,12 +288,7 @@ int main(int argc, char** argv) {
   app.add_option("--rate-hz", o.rate_hz, "publish rate")->capture_default_str();
   app.add_option("--seed", o.seed, "simulator seed")->capture_default_str();
   app.add_flag("--replay-fast", o.replay_fast, "replay as fast as possible");
-  app.add_option("--dds-profiles", o.dds.profiles_file, "Fast DDS profiles XML");
-  app.add_option("--security-dir", o.dds.security_dir,
-                 "DDS Security: this node's folder from deploy/security/make_fleet_pki.sh "
-                 "(default: unsecured)");
-  app.add_option("--dds-participant", o.dds.participant_profile, "participant profile")
-      ->capture_default_str();
+  telltale::dds::add_dds_options(app, o.dds);
   CLI11_PARSE(app, argc, argv);
   if (domain >= 0) o.dds.domain = domain;
   try {

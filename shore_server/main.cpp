@@ -2,20 +2,21 @@
 // stream and the dashboard.
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
-#include <condition_variable>
 #include <mutex>
 #include <thread>
 #include <vector>
 
 #include "alarm_service.hpp"
 #include "auth.hpp"
+#include "dds_cli.hpp"
 #include "fleet.hpp"
 #include "http_api.hpp"
 #include "json_views.hpp"
-#include "query.hpp"
 #include "live_hub.hpp"
+#include "query.hpp"
 #include "shore_dds.hpp"
 #include "shutdown.hpp"
 #include "store.hpp"
@@ -188,7 +189,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--coach-token", o.coach_token,
                  "coach token (default: $TELLTALE_COACH_TOKEN, else a generated one, printed)");
-  app.add_option("--analyst-token", o.analyst_tokens, "an analyst token (read and export); repeatable");
+  app.add_option("--analyst-token", o.analyst_tokens,
+                 "an analyst token (read and export); repeatable");
   app.add_option("--athlete-token", o.athlete_tokens,
                  "BOAT_ID:TOKEN, an athlete's token for their own boat; repeatable");
   app.add_option("--session-gap-s", o.session_gap_s,
@@ -210,16 +212,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--commit-ms", o.commit_ms, "store commit interval (the durability window)")
       ->capture_default_str();
-  app.add_option("--dds-profiles", o.dds.profiles_file,
-                 "Fast DDS profiles XML (default: $TELLTALE_DDS_PROFILES or deploy/dds/)");
-  app.add_option("--security-dir", o.dds.security_dir,
-                 "DDS Security: the shore's folder from deploy/security/make_fleet_pki.sh "
-                 "(default: unsecured)");
-  app.add_option("--dds-peer", o.dds.peers,
-                 "unicast discovery peer (IPv4), repeatable: networks without multicast "
-                 "(default: $TELLTALE_DDS_PEERS, comma-separated)");
-  app.add_option("--dds-participant", o.dds.participant_profile, "participant profile")
-      ->capture_default_str();
+  telltale::dds::add_dds_options(app, o.dds);
   o.http.web_dir = TELLTALE_DEFAULT_WEB_DIR;
   CLI11_PARSE(app, argc, argv);
   if (domain >= 0) o.dds.domain = domain;
