@@ -5,7 +5,9 @@
 #include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -152,16 +154,23 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
               dds.secured() ? "on" : "off");
   std::fflush(stdout);
 
-  // Stale sweep: a boat silent for stale_ms is marked stale even if DDS never says so. Every
-  // second each boat gets its receipt (what is stored), from which it backfills what is missing.
+  // Stale sweep: a boat silent for stale_ms is marked stale even if DDS never says so. Each boat
+  // gets its receipt (what is stored), from which it backfills what is missing: as soon as it
+  // moves (a stopping boat waits for it), and every second anyway (receipts are best effort).
   int tick = 0;
+  std::map<std::string, std::uint64_t> receipt_sent;  // boat -> acked_seq last published
   while (!shutdown.wait_for(std::chrono::milliseconds(200))) {
     for (const auto& v : fleet.sweep(std::chrono::steady_clock::now()))
       hub.publish_sample(v.last.boat_id, boat_json(v));
     for (const auto& a : fleet.sweep_athletes(std::chrono::steady_clock::now()))
       hub.publish_event("wearable", athlete_object(a).dump(), a.last.athlete_id);
-    if (++tick % 5 == 0)
-      for (const auto& a : store.acks()) dds.publish_ack(a.boat_id, a.boot_id, a.acked_seq);
+    const bool repeat = ++tick % 5 == 0;
+    for (const auto& a : store.acks()) {
+      auto [it, added] = receipt_sent.try_emplace(a.boat_id, a.acked_seq);
+      if (!repeat && !added && it->second == a.acked_seq) continue;
+      it->second = a.acked_seq;
+      dds.publish_ack(a.boat_id, a.boot_id, a.acked_seq);
+    }
   }
   hub.close();
   api.stop();
