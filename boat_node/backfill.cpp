@@ -6,6 +6,12 @@ namespace telltale::boat {
 
 namespace {
 constexpr std::int64_t kReceiptSilence_ns = 3'000'000'000;  ///< three missed receipts
+
+std::int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
 }  // namespace
 
 Backfiller::Backfiller(BackfillConfig config, SessionLogReader reader,
@@ -20,15 +26,14 @@ Backfiller::~Backfiller() {
   thread_.join();
 }
 
-void Backfiller::on_ack(std::uint64_t boot_id, std::uint64_t acked_seq) {
+void Backfiller::on_ack(std::uint64_t boot_id, std::uint64_t acked_seq, bool new_shore) {
   if (boot_id != config_.boot_id) return;  // a receipt for an earlier run of this boat
   // Receipts come every second; after a silence (a cut link, a shore restart) the shore is back
   // and the range it missed goes at once instead of at the next resend_after.
-  const std::int64_t now_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                  std::chrono::steady_clock::now().time_since_epoch())
-                                  .count();
+  const std::int64_t now_ns = steady_ns();
   const std::int64_t prev_ns = last_ack_ns_.exchange(now_ns);
-  if (prev_ns != 0 && now_ns - prev_ns > kReceiptSilence_ns) force_resend_.store(true);
+  if (new_shore || (prev_ns != 0 && now_ns - prev_ns > kReceiptSilence_ns))
+    force_resend_.store(true);
   shore_seen_.store(true);
   std::uint64_t prev = acked_.load();
   while (acked_seq > prev && !acked_.compare_exchange_weak(prev, acked_seq)) {
@@ -67,6 +72,10 @@ void Backfiller::run() {
       cv_.wait_for(lock, std::chrono::milliseconds(200), [this] { return stop_.load(); });
     }
     if (stop_.load() || !shore_seen_.load()) continue;
+    // No receipt for a while: the shore does not hear this boat (link cut, shore down). Resending
+    // into the void would only fill the link the moment it returns; the first receipt after the
+    // silence sends the missing range at once.
+    if (steady_ns() - last_ack_ns_.load() > kReceiptSilence_ns) continue;
     if (force_resend_.exchange(false)) sent_through_ = 0;
     const std::uint64_t published = published_.load();
     const std::uint64_t acked = acked_.load();
@@ -98,14 +107,19 @@ void Backfiller::run() {
   }
 }
 
-bool Backfiller::drain(std::chrono::milliseconds timeout) {
+bool Backfiller::drain(std::chrono::milliseconds quiet, std::chrono::milliseconds patience) {
   draining_.store(true);
   force_resend_.store(true);  // the run thread may resend at once
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  const auto started = std::chrono::steady_clock::now();
+  const auto complete = [this] { return shore_seen_.load() && acked_.load() >= published_.load(); };
   std::unique_lock lock(mutex_);
-  return cv_.wait_until(lock, deadline, [this] {
-    return shore_seen_.load() && acked_.load() >= published_.load();
-  });
+  for (;;) {
+    if (complete()) return true;
+    const auto now = std::chrono::steady_clock::now();
+    const auto heard_ago = std::chrono::nanoseconds(steady_ns() - last_ack_ns_.load());
+    if (now - started >= patience || (now - started >= quiet && heard_ago >= quiet)) return false;
+    cv_.wait_for(lock, std::chrono::milliseconds(100));
+  }
 }
 
 }  // namespace telltale::boat

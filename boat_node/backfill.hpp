@@ -6,9 +6,10 @@
 /// When the node is more than `lag` samples ahead of that receipt (the newest samples may still
 /// be in flight), a thread of its own reads the missing range from the log and writes it on the
 /// reliable backfill topic at a bounded rate; the same range is sent again only if the receipt
-/// has not moved for `resend_after`, or at once when receipts resume after a silence (the shore
-/// is back). At shutdown `drain()` sends up to the last sample and waits for the receipt. The
-/// sensor loop only stores an atomic counter.
+/// has not moved for `resend_after`, or at once when receipts resume after a silence or come from
+/// a shore instance not heard before (a restart: what was in flight to the old one is gone). At
+/// shutdown `drain()` sends up to the last sample and waits for the receipt. The sensor loop only
+/// stores an atomic counter.
 
 #include <atomic>
 #include <chrono>
@@ -23,8 +24,8 @@ namespace telltale::boat {
 
 struct BackfillConfig {
   std::uint64_t boot_id = 0;
-  std::uint64_t lag = 50;                 ///< samples left to the live path (2 s at 25 Hz)
-  std::size_t max_per_second = 2500;      ///< resend rate limit
+  std::uint64_t lag = 50;             ///< samples left to the live path (2 s at 25 Hz)
+  std::size_t max_per_second = 2500;  ///< resend rate limit
   std::chrono::milliseconds resend_after{5000};
 };
 
@@ -36,10 +37,14 @@ class Backfiller {
   ~Backfiller();
 
   void on_published(std::uint64_t seq) { published_.store(seq); }
-  void on_ack(std::uint64_t boot_id, std::uint64_t acked_seq);
-  /// Sends everything up to the last published sample and waits for the shore's receipt, at
-  /// most `timeout`. True if the shore has it all.
-  bool drain(std::chrono::milliseconds timeout);
+  /// A receipt. `new_shore` (a shore instance not heard before) resends the missing range at
+  /// once, as does a receipt after a silence.
+  void on_ack(std::uint64_t boot_id, std::uint64_t acked_seq, bool new_shore = false);
+  /// Sends everything up to the last published sample and waits for the shore's receipt. Gives
+  /// up after `quiet` if the shore has not been heard for `quiet` (a cut link, a shore gone: the
+  /// log keeps the samples); while the shore is heard, or was heard within `quiet` (it may be
+  /// restarting), waits up to `patience`. True if the shore has it all.
+  bool drain(std::chrono::milliseconds quiet, std::chrono::milliseconds patience);
 
   [[nodiscard]] std::uint64_t acked() const { return acked_.load(); }
   [[nodiscard]] std::uint64_t resent() const { return resent_.load(); }

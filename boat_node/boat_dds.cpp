@@ -3,6 +3,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <map>
 #include <mutex>
+#include <set>
 
 #include "dds_security.hpp"
 #include "telltalePubSubTypes.h"
@@ -22,8 +23,10 @@ class BoatDds::Listener : public fdds::DataReaderListener {
     if (topic == dds::kTopicShoreAck) {
       msg::ShoreAck m;
       while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK)
-        if (info.valid_data && m.boat_id().to_string() == boat_id_ && cb_.on_ack)
-          cb_.on_ack(m.boot_id(), m.acked_seq());
+        if (info.valid_data && m.boat_id().to_string() == boat_id_ && cb_.on_ack) {
+          const bool new_shore = ack_writers_.insert(info.sample_identity.writer_guid()).second;
+          cb_.on_ack(m.boot_id(), m.acked_seq(), new_shore);
+        }
     } else if (topic == dds::kTopicAlarmRules) {
       msg::AlarmRule m;
       bool changed = false;
@@ -56,15 +59,15 @@ class BoatDds::Listener : public fdds::DataReaderListener {
     } else if (topic == dds::kTopicAlarmEvents) {
       msg::AlarmEvent m;
       while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK)
-        if (info.valid_data && m.boat_id().to_string() == boat_id_ && cb_.on_event)
-          cb_.on_event(m);
+        if (info.valid_data && m.boat_id().to_string() == boat_id_ && cb_.on_event) cb_.on_event(m);
     }
   }
 
  private:
   std::string boat_id_;
   const BoatDdsCallbacks& cb_;
-  std::map<std::string, fusion::AlarmRule> rules_;  ///< listener thread only
+  std::map<std::string, fusion::AlarmRule> rules_;          ///< listener thread only
+  std::set<eprosima::fastrtps::rtps::GUID_t> ack_writers_;  ///< shore writers heard; listener only
 };
 
 BoatDds::BoatDds(const dds::DdsOptions& options, const std::string& boat_id,
@@ -87,9 +90,10 @@ void BoatDds::join() {
       participant_->topic(dds::kTopicBoatBackfill,
                           fdds::TypeSupport(new msg::BoatAttitudePubSubType())),
       "backfill_writer");
-  status_writer_ = participant_->writer(
-      participant_->topic(dds::kTopicNodeStatus, fdds::TypeSupport(new msg::NodeStatusPubSubType())),
-      "status_writer");
+  status_writer_ =
+      participant_->writer(participant_->topic(dds::kTopicNodeStatus,
+                                               fdds::TypeSupport(new msg::NodeStatusPubSubType())),
+                           "status_writer");
   participant_->reader(
       participant_->topic(dds::kTopicShoreAck, fdds::TypeSupport(new msg::ShoreAckPubSubType())),
       "ack_reader", listener_.get());

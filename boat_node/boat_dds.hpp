@@ -19,7 +19,9 @@ namespace telltale::boat {
 
 struct BoatDdsCallbacks {
   /// The shore's receipt for this boat (any run; the caller checks boot_id).
-  std::function<void(std::uint64_t boot_id, std::uint64_t acked_seq)> on_ack;
+  /// `new_shore`: the first receipt from a shore writer not heard before (a restarted shore:
+  /// whatever was in flight to the old one is gone).
+  std::function<void(std::uint64_t boot_id, std::uint64_t acked_seq, bool new_shore)> on_ack;
   /// The complete current rule set, whenever it changes.
   std::function<void(std::vector<fusion::AlarmRule>)> on_rules;
   /// An alarm event about this boat changed phase on the shore.

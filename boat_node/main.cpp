@@ -186,8 +186,8 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
 
   std::unique_ptr<telltale::boat::Backfiller> backfiller;
   telltale::boat::BoatDdsCallbacks callbacks;
-  callbacks.on_ack = [&](std::uint64_t boot, std::uint64_t acked) {
-    if (backfiller) backfiller->on_ack(boot, acked);
+  callbacks.on_ack = [&](std::uint64_t boot, std::uint64_t acked, bool new_shore) {
+    if (backfiller) backfiller->on_ack(boot, acked, new_shore);
   };
   callbacks.on_rules = [&](std::vector<telltale::fusion::AlarmRule> rules) {
     shore_rules = true;
@@ -383,8 +383,9 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   }
   log.flush();
   if (o.console && tty) std::printf("\n");
-  // Hand the shore what it is missing before going (bounded wait).
-  const bool complete = backfiller->drain(std::chrono::seconds(3));
+  // Hand the shore what it is missing before going: 3 s if the shore is not heard, up to 10 s
+  // while it is (the service manager's stop timeout is longer).
+  const bool complete = backfiller->drain(std::chrono::seconds(3), std::chrono::seconds(10));
   std::printf(
       "boat_node stopped: boat=%s published=%llu resent=%llu shore_has_all=%s bad_samples=%u "
       "acked=%llu backfill_failures=%llu\n",

@@ -177,17 +177,22 @@ TEST_F(CrashTest, TwentyKillsDuringIngest) {
       if (!e["acknowledged_at"].is_null()) still_acked.insert(e["id"].get<std::uint64_t>());
     for (const auto e : acked) EXPECT_TRUE(still_acked.count(e)) << "ack of event " << e << " lost";
   }
-  // Backfill refills what the kills lost; then every boat stops (draining) and is compared.
+  // Backfill refills what the kills lost: every boat live on the last shore instance and every
+  // sample but the newest 60 (left to the live path) stored. Then every boat stops (draining)
+  // and is compared.
+  const std::uint64_t last_up_utc = utc_now_ns();
+  EXPECT_TRUE(eventually([&] { return all_boats_fresh(last_up_utc); }, 30s));
   for (int i = 0; i < kBoats; ++i) {
     EXPECT_TRUE(eventually(
         [&] {
           const auto b = boats_by_id();
           if (!b.count(id(i))) return false;
-          const long seq = b.at(id(i))["seq"].get<long>();
-          return count_seqs(id(i), seq) >= seq - 60;
+          const long settled = b.at(id(i))["seq"].get<long>() - 60;
+          return count_seqs(id(i), settled) >= settled;
         },
         60s))
-        << id(i) << " not refilled";
+        << id(i) << " not refilled; missing "
+        << missing_seqs(db_path(), id(i), boats_by_id()[id(i)]["seq"].get<long>());
   }
   for (int i = 0; i < kBoats; ++i) {
     Process& boat = *boats_[static_cast<std::size_t>(i)];
@@ -200,7 +205,8 @@ TEST_F(CrashTest, TwentyKillsDuringIngest) {
     EXPECT_NE(line->find("shore_has_all=yes"), std::string::npos) << *line;
     std::this_thread::sleep_for(2 * std::chrono::milliseconds(kCommitMs));
     const long stored = count_seqs(id(i), published);
-    EXPECT_EQ(stored, published) << id(i);
+    EXPECT_EQ(stored, published) << id(i) << " missing "
+                                 << missing_seqs(db_path(), id(i), published);
     std::printf("[crash] %s published=%ld stored=%ld\n", id(i).c_str(), published, stored);
   }
   shore_->stop(SIGTERM);

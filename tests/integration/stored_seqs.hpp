@@ -5,6 +5,7 @@
 
 #include <sqlite3.h>
 
+#include <cstdint>
 #include <string>
 
 namespace telltale::testing {
@@ -26,6 +27,38 @@ inline long stored_seqs(const std::string& db_path, const std::string& boat, lon
   }
   sqlite3_close(db);
   return n;
+}
+
+/// The seqs in 1..max_seq the database does not hold for the boat, as ranges ("812-815 990"), for
+/// failure messages: which samples were lost tells a kill's gap from a drain cut short.
+inline std::string missing_seqs(const std::string& db_path, const std::string& boat, long max_seq) {
+  sqlite3* db = nullptr;
+  std::string out;
+  if (sqlite3_open_v2(db_path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK) {
+    sqlite3_stmt* st = nullptr;
+    sqlite3_prepare_v2(db,
+                       "SELECT DISTINCT seq FROM attitude WHERE boat_id = ? AND seq BETWEEN 1 AND "
+                       "? ORDER BY seq",
+                       -1, &st, nullptr);
+    sqlite3_bind_text(st, 1, boat.c_str(), -1, SQLITE_TRANSIENT);
+    sqlite3_bind_int64(st, 2, max_seq);
+    long expected = 1;
+    const auto gap = [&](long first, long last) {
+      if (first > last) return;
+      if (!out.empty()) out += ' ';
+      out += first == last ? std::to_string(first)
+                           : std::to_string(first) + "-" + std::to_string(last);
+    };
+    while (sqlite3_step(st) == SQLITE_ROW) {
+      const long seq = static_cast<long>(sqlite3_column_int64(st, 0));
+      gap(expected, seq - 1);
+      expected = seq + 1;
+    }
+    gap(expected, max_seq);
+    sqlite3_finalize(st);
+  }
+  sqlite3_close(db);
+  return out;
 }
 
 }  // namespace telltale::testing
