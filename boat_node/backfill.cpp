@@ -1,6 +1,7 @@
 #include "backfill.hpp"
 
 #include <algorithm>
+#include <cstdio>
 
 namespace telltale::boat {
 
@@ -17,7 +18,12 @@ std::int64_t steady_ns() {
 Backfiller::Backfiller(BackfillConfig config, SessionLogReader reader,
                        std::function<bool(const LogRecord&)> send)
     : config_(config), reader_(std::move(reader)), send_(std::move(send)) {
+  progress_ns_.store(steady_ns());
   thread_ = std::thread([this] { run(); });
+}
+
+double Backfiller::seconds_since_progress() const {
+  return static_cast<double>(steady_ns() - progress_ns_.load()) * 1e-9;
 }
 
 Backfiller::~Backfiller() {
@@ -27,7 +33,6 @@ Backfiller::~Backfiller() {
 }
 
 void Backfiller::on_ack(std::uint64_t boot_id, std::uint64_t acked_seq, bool new_shore) {
-  if (boot_id != config_.boot_id) return;  // a receipt for an earlier run of this boat
   // Receipts come every second; after a silence (a cut link, a shore restart) the shore is back
   // and the range it missed goes at once instead of at the next resend_after.
   const std::int64_t now_ns = steady_ns();
@@ -35,8 +40,11 @@ void Backfiller::on_ack(std::uint64_t boot_id, std::uint64_t acked_seq, bool new
   if (new_shore || (prev_ns != 0 && now_ns - prev_ns > kReceiptSilence_ns))
     force_resend_.store(true);
   shore_seen_.store(true);
-  std::uint64_t prev = acked_.load();
-  while (acked_seq > prev && !acked_.compare_exchange_weak(prev, acked_seq)) {
+  if (boot_id == config_.boot_id) {
+    std::uint64_t prev = acked_.load();
+    while (acked_seq > prev && !acked_.compare_exchange_weak(prev, acked_seq)) {
+    }
+    if (acked_seq > prev) progress_ns_.store(now_ns);
   }
   cv_.notify_all();
 }
@@ -119,6 +127,72 @@ bool Backfiller::drain(std::chrono::milliseconds quiet, std::chrono::millisecond
     const auto heard_ago = std::chrono::nanoseconds(steady_ns() - last_ack_ns_.load());
     if (now - started >= patience || (now - started >= quiet && heard_ago >= quiet)) return false;
     cv_.wait_for(lock, std::chrono::milliseconds(100));
+  }
+}
+
+EarlierRuns::EarlierRuns(std::filesystem::path dir, std::string boat_id, std::uint64_t current_boot,
+                         std::chrono::hours max_age, Send send,
+                         std::function<void(const std::string&)> report,
+                         std::chrono::seconds give_up)
+    : dir_(std::move(dir)),
+      boat_id_(std::move(boat_id)),
+      runs_(undelivered_runs(dir_, boat_id_, current_boot, max_age)),
+      send_(std::move(send)),
+      report_(std::move(report)),
+      give_up_(give_up) {
+  pending_.store(runs_.size());
+  if (!runs_.empty()) thread_ = std::thread([this] { run(); });
+}
+
+EarlierRuns::~EarlierRuns() {
+  stop_.store(true);
+  cv_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+void EarlierRuns::on_ack(std::uint64_t boot_id, std::uint64_t acked_seq, bool new_shore) {
+  std::lock_guard lock(mutex_);
+  if (active_) active_->on_ack(boot_id, acked_seq, new_shore);
+}
+
+void EarlierRuns::run() {
+  for (const std::uint64_t boot : runs_) {
+    SessionLogReader reader(dir_, boat_id_, boot);
+    const std::uint64_t last = reader.last_seq();
+    {
+      std::lock_guard lock(mutex_);
+      active_ = std::make_unique<Backfiller>(
+          BackfillConfig{boot, 0, 2500, std::chrono::milliseconds(5000)}, std::move(reader),
+          [this, boot](const LogRecord& r) { return send_(boot, r); });
+      active_->on_published(last);
+    }
+    std::string outcome;
+    for (;;) {
+      std::unique_lock lock(mutex_);
+      if (cv_.wait_for(lock, std::chrono::milliseconds(200), [this] { return stop_.load(); }))
+        break;
+      const std::uint64_t acked = active_->acked();
+      if (acked >= last) {
+        outcome = "delivered";
+        break;
+      }
+      if (active_->shore_seen() &&
+          active_->seconds_since_progress() > std::chrono::duration<double>(give_up_).count()) {
+        outcome = "given up at seq " + std::to_string(acked) + " (the log has a hole)";
+        break;
+      }
+    }
+    {
+      std::lock_guard lock(mutex_);
+      active_.reset();
+    }
+    if (outcome.empty()) return;  // stopping: the run stays pending for the next start
+    mark_delivered(dir_, boat_id_, boot);
+    pending_.fetch_sub(1);
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(boot));
+    report_("earlier run " + std::string(hex) + " (" + std::to_string(last) +
+            " samples): " + outcome);
   }
 }
 

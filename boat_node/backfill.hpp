@@ -14,9 +14,13 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <filesystem>
 #include <functional>
+#include <memory>
 #include <mutex>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "session_log.hpp"
 
@@ -37,7 +41,8 @@ class Backfiller {
   ~Backfiller();
 
   void on_published(std::uint64_t seq) { published_.store(seq); }
-  /// A receipt. `new_shore` (a shore instance not heard before) resends the missing range at
+  /// A receipt for this boat, any run: each one shows the shore is there; one for this run moves
+  /// acked(). `new_shore` (a shore instance not heard before) resends the missing range at
   /// once, as does a receipt after a silence.
   void on_ack(std::uint64_t boot_id, std::uint64_t acked_seq, bool new_shore = false);
   /// Sends everything up to the last published sample and waits for the shore's receipt. Gives
@@ -47,6 +52,9 @@ class Backfiller {
   bool drain(std::chrono::milliseconds quiet, std::chrono::milliseconds patience);
 
   [[nodiscard]] std::uint64_t acked() const { return acked_.load(); }
+  [[nodiscard]] std::uint64_t published() const { return published_.load(); }
+  /// Seconds since a receipt for this run last moved acked() (or since construction).
+  [[nodiscard]] double seconds_since_progress() const;
   [[nodiscard]] std::uint64_t resent() const { return resent_.load(); }
   /// Backfill writes that failed (the writer's history full: the shore not acknowledging).
   [[nodiscard]] std::uint64_t send_failures() const { return send_failures_.load(); }
@@ -65,6 +73,7 @@ class Backfiller {
   std::atomic<std::uint64_t> resent_{0};
   std::atomic<std::uint64_t> send_failures_{0};
   std::atomic<std::int64_t> last_ack_ns_{0};  ///< steady clock of the latest receipt
+  std::atomic<std::int64_t> progress_ns_{0};  ///< steady clock of the latest move of acked_
   std::atomic<bool> shore_seen_{false};
   std::atomic<bool> draining_{false};
   std::atomic<bool> force_resend_{false};
@@ -72,6 +81,43 @@ class Backfiller {
   std::uint64_t sent_through_ = 0;
   std::mutex mutex_;
   std::condition_variable cv_;
+  std::thread thread_;
+};
+
+/// Delivers earlier runs of this boat whose log the shore never confirmed in full (the boat was
+/// stopped out of reach, or the shore was down): one run at a time, oldest first, each through a
+/// Backfiller of its own with no live lag. A run is done, and marked so in the log directory,
+/// when the shore's receipt for it reaches the last seq on disk, or when the shore is heard but
+/// its receipt has not moved for `give_up` (samples the disk policy deleted leave a hole the
+/// receipt cannot pass).
+class EarlierRuns {
+ public:
+  using Send = std::function<bool(std::uint64_t boot_id, const LogRecord&)>;
+  /// `report` gets one line per finished run (from the delivery thread).
+  /// Offers the runs of `undelivered_runs(dir, boat_id, current_boot, max_age)`.
+  EarlierRuns(std::filesystem::path dir, std::string boat_id, std::uint64_t current_boot,
+              std::chrono::hours max_age, Send send, std::function<void(const std::string&)> report,
+              std::chrono::seconds give_up = std::chrono::seconds(60));
+  ~EarlierRuns();
+
+  void on_ack(std::uint64_t boot_id, std::uint64_t acked_seq, bool new_shore);
+  /// Runs not delivered yet (including the one in progress).
+  [[nodiscard]] std::size_t pending() const { return pending_.load(); }
+
+ private:
+  void run();
+
+  std::filesystem::path dir_;
+  std::string boat_id_;
+  std::vector<std::uint64_t> runs_;
+  Send send_;
+  std::function<void(const std::string&)> report_;
+  std::chrono::seconds give_up_;
+  std::atomic<std::size_t> pending_{0};
+  std::atomic<bool> stop_{false};
+  std::mutex mutex_;  ///< guards active_ (the DDS listener forwards receipts to it)
+  std::condition_variable cv_;
+  std::unique_ptr<Backfiller> active_;
   std::thread thread_;
 };
 

@@ -53,6 +53,7 @@ struct Options {
   std::uint64_t seed = 0;
   telltale::boat::ReplayOptions replay;
   std::string log_dir = "boat_log";
+  int deliver_earlier_days = 7;
   double log_max_mb = 1024;
   std::string axis_remap = "x=x,y=y,z=z";
   std::string mount_file;
@@ -185,9 +186,11 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   std::atomic<bool> silenced{false};
 
   std::unique_ptr<telltale::boat::Backfiller> backfiller;
+  std::unique_ptr<telltale::boat::EarlierRuns> earlier;
   telltale::boat::BoatDdsCallbacks callbacks;
   callbacks.on_ack = [&](std::uint64_t boot, std::uint64_t acked, bool new_shore) {
     if (backfiller) backfiller->on_ack(boot, acked, new_shore);
+    if (earlier) earlier->on_ack(boot, acked, new_shore);
   };
   callbacks.on_rules = [&](std::vector<telltale::fusion::AlarmRule> rules) {
     shore_rules = true;
@@ -199,9 +202,10 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   telltale::boat::BoatDds dds(o.dds, o.boat_id, callbacks);
 
   // One message per thread: the sensor loop publishes `out`, the backfill thread its own copy.
-  const auto fill = [&](const telltale::boat::LogRecord& r, telltale::msg::BoatAttitude& m) {
+  const auto fill = [&](const telltale::boat::LogRecord& r, std::uint64_t run,
+                        telltale::msg::BoatAttitude& m) {
     m.boat_id(o.boat_id);
-    m.boot_id(boot_id);
+    m.boot_id(run);
     m.seq(r.seq);
     m.t_utc_ns(r.t_utc_ns);
     m.heel_deg(r.heel_deg);
@@ -224,10 +228,22 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       telltale::boat::BackfillConfig{boot_id, static_cast<std::uint64_t>(2 * o.rate_hz), 2500,
                                      std::chrono::milliseconds(5000)},
       telltale::boat::SessionLogReader(o.log_dir, o.boat_id, boot_id),
-      [&fill, &dds,
+      [&fill, &dds, boot_id,
        backfill_msg = telltale::msg::BoatAttitude()](const telltale::boat::LogRecord& r) mutable {
-        fill(r, backfill_msg);
+        fill(r, boot_id, backfill_msg);
         return dds.backfill(backfill_msg);
+      });
+  // Earlier runs the shore never had in full (stopped out of reach): delivered from the log too.
+  earlier = std::make_unique<telltale::boat::EarlierRuns>(
+      o.log_dir, o.boat_id, boot_id, std::chrono::hours(24 * o.deliver_earlier_days),
+      [&fill, &dds, msg = telltale::msg::BoatAttitude()](
+          std::uint64_t run, const telltale::boat::LogRecord& r) mutable {
+        fill(r, run, msg);
+        return dds.backfill(msg);
+      },
+      [](const std::string& line) {
+        std::printf("boat_node %s\n", line.c_str());
+        std::fflush(stdout);
       });
 
   telltale::msg::NodeStatus status;
@@ -245,9 +261,11 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   const telltale::fusion::LedPanelParams led_params{o.led_step_deg,
                                                     static_cast<std::uint8_t>(o.leds_per_bar)};
 
-  std::printf("boat_node ready: boat=%s domain=%d source=%s rate=%gHz boot=%016llx log=%s\n",
-              o.boat_id.c_str(), dds.domain(), source->describe().c_str(), o.rate_hz,
-              static_cast<unsigned long long>(boot_id), o.log_dir.c_str());
+  std::printf(
+      "boat_node ready: boat=%s domain=%d source=%s rate=%gHz boot=%016llx log=%s "
+      "earlier_runs=%zu\n",
+      o.boat_id.c_str(), dds.domain(), source->describe().c_str(), o.rate_hz,
+      static_cast<unsigned long long>(boot_id), o.log_dir.c_str(), earlier->pending());
   std::fflush(stdout);
 
   const auto start = Clock::now();
@@ -337,7 +355,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       r.led_count = led_params.leds_per_bar;
       r.level = static_cast<std::uint8_t>(level);
       if (!log.append(r)) ++log_failures;
-      fill(r, out);
+      fill(r, boot_id, out);
       if (!dds.publish(out)) ++write_failures;
       backfiller->on_published(r.seq);
       if (!silenced) hook.on_level(o.boat_id, level, heel, now);
@@ -372,6 +390,8 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       if (write_failures) text += "; dds write failures " + std::to_string(write_failures);
       if (log_failures) text += "; session log write failures " + std::to_string(log_failures);
       if (!backfiller->shore_seen()) text += "; no shore receipt yet";
+      if (const auto n = earlier->pending())
+        text += "; delivering " + std::to_string(n) + " earlier run(s) from the log";
       status.t_utc_ns(telltale::utc_now_ns());
       status.uptime_s(std::chrono::duration<double>(now - start).count());
       status.samples_published(seq);
@@ -386,13 +406,17 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   // Hand the shore what it is missing before going: 3 s if the shore is not heard, up to 10 s
   // while it is (the service manager's stop timeout is longer).
   const bool complete = backfiller->drain(std::chrono::seconds(3), std::chrono::seconds(10));
+  // Otherwise the next start delivers this run from the log.
+  if (complete) telltale::boat::mark_delivered(o.log_dir, o.boat_id, boot_id);
+  const std::size_t earlier_pending = earlier->pending();
+  earlier.reset();
   std::printf(
       "boat_node stopped: boat=%s published=%llu resent=%llu shore_has_all=%s bad_samples=%u "
-      "acked=%llu backfill_failures=%llu\n",
+      "acked=%llu backfill_failures=%llu earlier_runs_pending=%zu\n",
       o.boat_id.c_str(), static_cast<unsigned long long>(seq),
       static_cast<unsigned long long>(backfiller->resent()), complete ? "yes" : "no", bad_samples,
       static_cast<unsigned long long>(backfiller->acked()),
-      static_cast<unsigned long long>(backfiller->send_failures()));
+      static_cast<unsigned long long>(backfiller->send_failures()), earlier_pending);
 }
 
 }  // namespace
@@ -427,6 +451,11 @@ int main(int argc, char** argv) {
   app.add_flag("--replay-fast", o.replay.fast, "replay as fast as possible (default: real time)");
   app.add_flag("--replay-loop", o.replay.loop, "replay the file again at its end");
   app.add_option("--log-dir", o.log_dir, "session log directory")->capture_default_str();
+  app.add_option("--deliver-earlier-days", o.deliver_earlier_days,
+                 "runs of the last N days the shore never confirmed (stopped out of reach) are "
+                 "delivered from the log at start; 0: none")
+      ->check(CLI::Range(0, 365))
+      ->capture_default_str();
   app.add_option("--log-max-mb", o.log_max_mb, "session log disk budget; oldest files go first")
       ->capture_default_str();
   app.add_option("--axis-remap", o.axis_remap, "boat axes from sensor axes, e.g. x=-y,y=x,z=z")

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <map>
 #include <stdexcept>
 
 namespace telltale::boat {
@@ -37,8 +38,28 @@ std::string file_prefix(const std::string& boat_id, std::uint64_t boot_id) {
   return boat_id + "-" + hex + "-";
 }
 
+/// `<boat>-<16 hex>-<12 digits>.tlog` of this boat: its boot id, or nothing (another boat whose
+/// id starts with this one's has a '-' where the hex digits are).
+std::optional<std::uint64_t> boot_of(const std::string& name, const std::string& boat_id) {
+  constexpr std::size_t kTail = 1 + 16 + 1 + 12 + 5;
+  if (name.size() != boat_id.size() + kTail || name.rfind(boat_id + "-", 0) != 0 ||
+      !name.ends_with(".tlog") || name[boat_id.size() + 17] != '-')
+    return std::nullopt;
+  const std::string hex = name.substr(boat_id.size() + 1, 16);
+  if (hex.find_first_not_of("0123456789abcdef") != std::string::npos) return std::nullopt;
+  return std::stoull(hex, nullptr, 16);
+}
+
+std::filesystem::path delivered_marker(const std::filesystem::path& dir, const std::string& boat_id,
+                                       std::uint64_t boot_id) {
+  std::string prefix = file_prefix(boat_id, boot_id);
+  prefix.back() = '.';
+  return dir / (prefix + "delivered");
+}
+
 /// First sequence number encoded in a log file name, or nothing.
-std::optional<std::uint64_t> first_seq_of(const std::filesystem::path& p, const std::string& prefix) {
+std::optional<std::uint64_t> first_seq_of(const std::filesystem::path& p,
+                                          const std::string& prefix) {
   const std::string name = p.filename().string();
   if (name.rfind(prefix, 0) != 0 || p.extension() != ".tlog") return std::nullopt;
   try {
@@ -96,8 +117,9 @@ std::optional<LogRecord> decode_record(const unsigned char* in) {
 SessionLog::SessionLog(SessionLogConfig config) : config_(std::move(config)) {
   std::error_code ec;
   std::filesystem::create_directories(config_.dir, ec);
-  if (ec) throw std::runtime_error("cannot create log directory " + config_.dir.string() + ": " +
-                                   ec.message());
+  if (ec)
+    throw std::runtime_error("cannot create log directory " + config_.dir.string() + ": " +
+                             ec.message());
 }
 
 SessionLog::~SessionLog() {
@@ -188,6 +210,66 @@ std::vector<LogRecord> SessionLogReader::read(std::uint64_t first_seq, std::uint
     std::fclose(f);
   }
   return out;
+}
+
+std::uint64_t SessionLogReader::last_seq() const {
+  std::uint64_t last = 0;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(dir_, ec)) {
+    const auto first = first_seq_of(e.path(), prefix_);
+    if (!first) continue;
+    const auto records = e.file_size(ec) / kLogRecordBytes;
+    if (!ec && records > 0) last = std::max(last, *first + records - 1);
+  }
+  return last;
+}
+
+std::vector<std::uint64_t> undelivered_runs(const std::filesystem::path& dir,
+                                            const std::string& boat_id, std::uint64_t current_boot,
+                                            std::chrono::hours max_age) {
+  struct Run {
+    std::filesystem::file_time_type newest =
+        std::filesystem::file_time_type::min();  // not {}: file_clock's epoch is in 2174
+    bool delivered = false;
+    bool has_log = false;
+  };
+  std::map<std::uint64_t, Run> runs;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (const auto boot = boot_of(name, boat_id)) {
+      Run& r = runs[*boot];
+      r.has_log = true;
+      r.newest = std::max(r.newest, e.last_write_time(ec));
+    }
+  }
+  for (auto& [boot, r] : runs)
+    r.delivered = std::filesystem::exists(delivered_marker(dir, boat_id, boot), ec);
+  // Markers whose run is gone (disk policy) would pile up.
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (!name.ends_with(".delivered") || name.size() != boat_id.size() + 27 ||
+        name.rfind(boat_id + "-", 0) != 0)
+      continue;
+    const std::string hex = name.substr(boat_id.size() + 1, 16);
+    if (hex.find_first_not_of("0123456789abcdef") != std::string::npos) continue;
+    if (!runs.count(std::stoull(hex, nullptr, 16))) std::filesystem::remove(e.path(), ec);
+  }
+  const auto oldest = std::filesystem::file_time_type::clock::now() - max_age;
+  std::vector<std::pair<std::filesystem::file_time_type, std::uint64_t>> order;
+  for (const auto& [boot, r] : runs)
+    if (boot != current_boot && r.has_log && !r.delivered && r.newest >= oldest)
+      order.emplace_back(r.newest, boot);
+  std::sort(order.begin(), order.end());
+  std::vector<std::uint64_t> out;
+  for (const auto& [t, boot] : order) out.push_back(boot);
+  return out;
+}
+
+void mark_delivered(const std::filesystem::path& dir, const std::string& boat_id,
+                    std::uint64_t boot_id) {
+  if (std::FILE* f = std::fopen(delivered_marker(dir, boat_id, boot_id).c_str(), "w"))
+    std::fclose(f);
 }
 
 }  // namespace telltale::boat

@@ -12,6 +12,7 @@
 /// Not thread-safe: the sensor loop appends; the backfill thread reads through its own
 /// `SessionLogReader` (files are only appended to, so a reader sees complete records).
 
+#include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -78,11 +79,24 @@ class SessionLogReader {
   /// Records with first_seq <= seq <= last_seq that are on disk, in order (missing if deleted by
   /// the disk policy or corrupt: CRC checked).
   [[nodiscard]] std::vector<LogRecord> read(std::uint64_t first_seq, std::uint64_t last_seq);
+  /// The highest seq on disk for this run (0 if none), from the newest file's name and size.
+  [[nodiscard]] std::uint64_t last_seq() const;
 
  private:
   std::filesystem::path dir_;
   std::string prefix_;
 };
+
+/// Earlier runs of this boat in `dir` whose log the shore has not confirmed in full (no
+/// `<boat>-<boot>.delivered` marker) and that were written to within `max_age`, oldest first;
+/// `current_boot` excluded. Markers of runs whose files the disk policy has deleted are removed.
+[[nodiscard]] std::vector<std::uint64_t> undelivered_runs(const std::filesystem::path& dir,
+                                                          const std::string& boat_id,
+                                                          std::uint64_t current_boot,
+                                                          std::chrono::hours max_age);
+/// Records that the shore holds the run (or all of it the log still has): not offered again.
+void mark_delivered(const std::filesystem::path& dir, const std::string& boat_id,
+                    std::uint64_t boot_id);
 
 /// Encodes/decodes one record (exposed for tests).
 inline constexpr std::size_t kLogRecordBytes = 96;

@@ -158,7 +158,7 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
   // gets its receipt (what is stored), from which it backfills what is missing: as soon as it
   // moves (a stopping boat waits for it), and every second anyway (receipts are best effort).
   int tick = 0;
-  std::map<std::string, std::uint64_t> receipt_sent;  // boat -> acked_seq last published
+  std::map<std::pair<std::string, std::uint64_t>, std::uint64_t> receipt_sent;  // (boat, run)
   while (!shutdown.wait_for(std::chrono::milliseconds(200))) {
     for (const auto& v : fleet.sweep(std::chrono::steady_clock::now()))
       hub.publish_sample(v.last.boat_id, boat_json(v));
@@ -166,7 +166,7 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
       hub.publish_event("wearable", athlete_object(a).dump(), a.last.athlete_id);
     const bool repeat = ++tick % 5 == 0;
     for (const auto& a : store.acks()) {
-      auto [it, added] = receipt_sent.try_emplace(a.boat_id, a.acked_seq);
+      auto [it, added] = receipt_sent.try_emplace({a.boat_id, a.boot_id}, a.acked_seq);
       if (!repeat && !added && it->second == a.acked_seq) continue;
       it->second = a.acked_seq;
       dds.publish_ack(a.boat_id, a.boot_id, a.acked_seq);

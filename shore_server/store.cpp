@@ -92,8 +92,9 @@ class Stmt {
   }
   Stmt& bind_u(int i, std::uint64_t v) {
     // Nanoseconds since 1970 fit int64 until 2262.
-    sqlite3_bind_int64(st_, i, static_cast<sqlite3_int64>(std::min<std::uint64_t>(
-                                   v, static_cast<std::uint64_t>(INT64_MAX))));
+    sqlite3_bind_int64(st_, i,
+                       static_cast<sqlite3_int64>(
+                           std::min<std::uint64_t>(v, static_cast<std::uint64_t>(INT64_MAX))));
     return *this;
   }
   Stmt& bind(int i, double v) {
@@ -120,7 +121,9 @@ class Stmt {
     sqlite3_clear_bindings(st_);
   }
   std::int64_t i64(int c) const { return sqlite3_column_int64(st_, c); }
-  std::uint64_t u64(int c) const { return static_cast<std::uint64_t>(sqlite3_column_int64(st_, c)); }
+  std::uint64_t u64(int c) const {
+    return static_cast<std::uint64_t>(sqlite3_column_int64(st_, c));
+  }
   double dbl(int c) const {
     return sqlite3_column_type(st_, c) == SQLITE_NULL ? std::numeric_limits<double>::quiet_NaN()
                                                       : sqlite3_column_double(st_, c);
@@ -264,8 +267,9 @@ void Store::commit_wearable(const std::vector<WearableSample>& batch) {
   std::lock_guard db_lock(db_mutex_);
   try {
     exec(db_, "BEGIN");
-    Stmt ins(db_, "INSERT OR IGNORE INTO wearable (athlete_id, t_utc_ns, seq, steps, cadence_spm, "
-                  "gait, pose, x_m, y_m, heading_deg, distance_m) VALUES (?,?,?,?,?,?,?,?,?,?,?)");
+    Stmt ins(db_,
+             "INSERT OR IGNORE INTO wearable (athlete_id, t_utc_ns, seq, steps, cadence_spm, "
+             "gait, pose, x_m, y_m, heading_deg, distance_m) VALUES (?,?,?,?,?,?,?,?,?,?,?)");
     for (const auto& w : batch) {
       ins.reset();
       ins.bind(1, w.athlete_id).bind_u(2, w.t_utc_ns).bind_u(3, w.seq);
@@ -286,10 +290,14 @@ std::vector<WearableSample> Store::wearable_track(const std::string& athlete_id,
                                                   std::uint64_t from_ns, std::uint64_t to_ns,
                                                   std::size_t limit) {
   std::lock_guard lock(reader_mutex_);
-  Stmt q(reader_, "SELECT t_utc_ns, seq, steps, cadence_spm, gait, pose, x_m, y_m, heading_deg, "
-                  "distance_m FROM wearable WHERE athlete_id = ? AND t_utc_ns >= ? AND "
-                  "t_utc_ns <= ? ORDER BY t_utc_ns LIMIT ?");
-  q.bind(1, athlete_id).bind_u(2, from_ns).bind_u(3, to_ns).bind(4, static_cast<std::int64_t>(limit));
+  Stmt q(reader_,
+         "SELECT t_utc_ns, seq, steps, cadence_spm, gait, pose, x_m, y_m, heading_deg, "
+         "distance_m FROM wearable WHERE athlete_id = ? AND t_utc_ns >= ? AND "
+         "t_utc_ns <= ? ORDER BY t_utc_ns LIMIT ?");
+  q.bind(1, athlete_id)
+      .bind_u(2, from_ns)
+      .bind_u(3, to_ns)
+      .bind(4, static_cast<std::int64_t>(limit));
   std::vector<WearableSample> out;
   while (q.step()) {
     WearableSample w;
@@ -416,8 +424,9 @@ void Store::extend_session(const std::string& boat_id, std::uint64_t t_ns) {
       std::chrono::duration_cast<std::chrono::nanoseconds>(config_.session_gap).count());
   auto it = open_sessions_.find(boat_id);
   if (it == open_sessions_.end()) {
-    Stmt q(db_, "SELECT id, boat_id, start_ns, end_ns, samples FROM sessions WHERE boat_id = ? "
-                "ORDER BY end_ns DESC LIMIT 1");
+    Stmt q(db_,
+           "SELECT id, boat_id, start_ns, end_ns, samples FROM sessions WHERE boat_id = ? "
+           "ORDER BY end_ns DESC LIMIT 1");
     q.bind(1, boat_id);
     if (q.step()) it = open_sessions_.emplace(boat_id, session_from(q)).first;
   }
@@ -434,9 +443,10 @@ void Store::extend_session(const std::string& boat_id, std::uint64_t t_ns) {
       // Backfill older than the latest session: extend the session it belongs to, if any. It may
       // close the gap to its neighbour: merge_sessions() joins them before the commit.
       backfilled_.insert(boat_id);
-      Stmt q(db_, "UPDATE sessions SET start_ns = MIN(start_ns, ?1), end_ns = MAX(end_ns, ?1), "
-                  "samples = samples + 1 WHERE id = (SELECT id FROM sessions WHERE boat_id = ?2 "
-                  "AND start_ns <= ?1 + ?3 AND end_ns + ?3 >= ?1 LIMIT 1)");
+      Stmt q(db_,
+             "UPDATE sessions SET start_ns = MIN(start_ns, ?1), end_ns = MAX(end_ns, ?1), "
+             "samples = samples + 1 WHERE id = (SELECT id FROM sessions WHERE boat_id = ?2 "
+             "AND start_ns <= ?1 + ?3 AND end_ns + ?3 >= ?1 LIMIT 1)");
       q.bind_u(1, t_ns).bind(2, boat_id).bind_u(3, gap);
       q.step();
       if (sqlite3_changes(db_) == 1) return;
@@ -488,13 +498,15 @@ void Store::merge_sessions(const std::string& boat_id) {
 
 void Store::track_receipt(const AttitudeSample& s) {
   if (s.seq == 0) return;
+  // A run silent this long has nothing more coming: its receipt is dropped (and rebuilt from disk
+  // if the boat sends it again), so the receipts published each second stay few.
+  constexpr auto kIdle = std::chrono::minutes(2);
+  const auto now = std::chrono::steady_clock::now();
   std::lock_guard lock(receipts_mutex_);
-  Receipt& r = receipts_[s.boat_id];
-  if (r.boot_id != s.boot_id || !r.known) {
+  auto [it, added] = receipts_.try_emplace({s.boat_id, s.boot_id});
+  Receipt& r = it->second;
+  if (added) {
     // A run not seen since this shore started: what is already stored counts (restart).
-    r = Receipt{};
-    r.known = true;
-    r.boot_id = s.boot_id;
     Stmt q(db_, "SELECT seq FROM attitude WHERE boat_id = ? AND boot_id = ? ORDER BY seq");
     q.bind(1, s.boat_id).bind(2, static_cast<std::int64_t>(s.boot_id));
     while (q.step()) {
@@ -506,25 +518,28 @@ void Store::track_receipt(const AttitudeSample& s) {
       }
     }
   }
-  if (s.seq <= r.acked) return;
-  r.ahead.insert(s.seq);
-  while (!r.ahead.empty() && *r.ahead.begin() <= r.acked + 1) {
-    r.acked = std::max(r.acked, *r.ahead.begin());
-    r.ahead.erase(r.ahead.begin());
+  r.touched = now;
+  if (s.seq > r.acked) {
+    r.ahead.insert(s.seq);
+    while (!r.ahead.empty() && *r.ahead.begin() <= r.acked + 1) {
+      r.acked = std::max(r.acked, *r.ahead.begin());
+      r.ahead.erase(r.ahead.begin());
+    }
   }
+  if (++receipt_updates_ % 1024 == 0)
+    std::erase_if(receipts_, [&](const auto& e) { return now - e.second.touched > kIdle; });
 }
 
 std::vector<Store::Ack> Store::acks() const {
   std::lock_guard lock(receipts_mutex_);
   std::vector<Ack> out;
-  for (const auto& [boat, r] : receipts_) out.push_back({boat, r.boot_id, r.acked});
+  for (const auto& [key, r] : receipts_) out.push_back({key.first, key.second, r.acked});
   return out;
 }
 
 void Store::apply_retention() {
-  const double now_s = std::chrono::duration<double>(
-                           std::chrono::system_clock::now().time_since_epoch())
-                           .count();
+  const double now_s =
+      std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
   const double cutoff_s = now_s - config_.retention_days * 86400.0;
   if (cutoff_s <= 0) return;
   const auto cutoff = static_cast<std::uint64_t>(cutoff_s * 1e9);
@@ -614,8 +629,9 @@ void Store::save_rules(const std::vector<AlarmRule>& rules) {
   try {
     exec(db_, "BEGIN IMMEDIATE");
     exec(db_, "DELETE FROM alarm_rules");
-    Stmt ins(db_, "INSERT INTO alarm_rules (id, position, scope, quantity, min_deg, max_deg, "
-                  "hold_s, hysteresis_deg, level, enabled) VALUES (?,?,?,?,?,?,?,?,?,?)");
+    Stmt ins(db_,
+             "INSERT INTO alarm_rules (id, position, scope, quantity, min_deg, max_deg, "
+             "hold_s, hysteresis_deg, level, enabled) VALUES (?,?,?,?,?,?,?,?,?,?)");
     std::int64_t pos = 0;
     for (const auto& r : rules) {
       ins.reset();
@@ -633,8 +649,9 @@ void Store::save_rules(const std::vector<AlarmRule>& rules) {
 
 std::vector<AlarmRule> Store::load_rules() {
   std::lock_guard lock(reader_mutex_);
-  Stmt q(reader_, "SELECT id, scope, quantity, min_deg, max_deg, hold_s, hysteresis_deg, level, "
-                  "enabled FROM alarm_rules ORDER BY position");
+  Stmt q(reader_,
+         "SELECT id, scope, quantity, min_deg, max_deg, hold_s, hysteresis_deg, level, "
+         "enabled FROM alarm_rules ORDER BY position");
   std::vector<AlarmRule> out;
   while (q.step()) {
     AlarmRule r;
@@ -654,9 +671,10 @@ std::vector<AlarmRule> Store::load_rules() {
 
 void Store::save_event(const AlarmEvent& e) {
   std::lock_guard db_lock(db_mutex_);
-  Stmt q(db_, "INSERT OR REPLACE INTO alarm_events (id, boat_id, rule_id, level, phase, raised_ns, "
-              "acknowledged_ns, silenced_ns, cleared_ns, value_deg, message) "
-              "VALUES (?,?,?,?,?,?,?,?,?,?,?)");
+  Stmt q(db_,
+         "INSERT OR REPLACE INTO alarm_events (id, boat_id, rule_id, level, phase, raised_ns, "
+         "acknowledged_ns, silenced_ns, cleared_ns, value_deg, message) "
+         "VALUES (?,?,?,?,?,?,?,?,?,?,?)");
   q.bind_u(1, e.id).bind(2, e.boat_id).bind(3, e.rule_id).bind(4, std::string(to_string(e.level)));
   q.bind(5, std::string(to_string(e.phase))).bind_u(6, e.raised_ns).bind_u(7, e.acknowledged_ns);
   q.bind_u(8, e.silenced_ns).bind_u(9, e.cleared_ns).bind(10, e.value_deg).bind(11, e.message);
@@ -680,7 +698,8 @@ std::vector<AlarmEvent> Store::events(const EventFilter& f) {
 
 std::optional<AlarmEvent> Store::event(std::uint64_t id) {
   std::lock_guard lock(reader_mutex_);
-  const std::string sql = std::string("SELECT ") + kEventColumns + " FROM alarm_events WHERE id = ?";
+  const std::string sql =
+      std::string("SELECT ") + kEventColumns + " FROM alarm_events WHERE id = ?";
   Stmt q(reader_, sql.c_str());
   q.bind_u(1, id);
   if (!q.step()) return std::nullopt;

@@ -30,8 +30,8 @@
 #include <thread>
 #include <vector>
 
-#include "telltale/fusion/alarm_engine.hpp"
 #include "fleet.hpp"
+#include "telltale/fusion/alarm_engine.hpp"
 
 namespace telltale::shore {
 
@@ -109,8 +109,8 @@ class Store {
                       std::size_t page = 2000);
   /// One page of samples after `after_ns` (exclusive) up to `to_ns`: for streamed exports.
   [[nodiscard]] std::vector<AttitudeRow> attitude_page(const std::string& boat_id,
-                                                       std::uint64_t after_ns,
-                                                       std::uint64_t to_ns, std::size_t limit);
+                                                       std::uint64_t after_ns, std::uint64_t to_ns,
+                                                       std::size_t limit);
   [[nodiscard]] std::int64_t count(const std::string& boat_id);
 
   // --- alarms (synchronous) ----------------------------------------------------------------
@@ -121,7 +121,8 @@ class Store {
   [[nodiscard]] std::optional<AlarmEvent> event(std::uint64_t id);
   [[nodiscard]] std::uint64_t max_event_id();
 
-  /// Per boat: its latest run and the highest seq of that run with every sample up to it stored.
+  /// Per boat and run (the current one, and earlier ones the boat is delivering from its log):
+  /// the highest seq of that run with every sample up to it stored.
   struct Ack {
     std::string boat_id;
     std::uint64_t boot_id;
@@ -146,24 +147,25 @@ class Store {
   std::set<std::string> backfilled_;  ///< boats with backfill older than their open session
 
   struct Receipt {
-    bool known = false;
-    std::uint64_t boot_id = 0;
     std::uint64_t acked = 0;
-    std::set<std::uint64_t> ahead;  ///< stored seqs beyond a gap
+    std::set<std::uint64_t> ahead;                  ///< stored seqs beyond a gap
+    std::chrono::steady_clock::time_point touched;  ///< when a sample of this run last came
   };
   mutable std::mutex receipts_mutex_;
-  std::map<std::string, Receipt> receipts_;
+  /// (boat, run) -> receipt: the boat's current run and earlier runs it is still delivering.
+  std::map<std::pair<std::string, std::uint64_t>, Receipt> receipts_;
+  std::uint64_t receipt_updates_ = 0;  ///< under receipts_mutex_
 
   StoreConfig config_;
-  sqlite3* db_ = nullptr;       ///< writer connection (samples, sessions, alarms)
-  sqlite3* reader_ = nullptr;   ///< read-only connection for queries
+  sqlite3* db_ = nullptr;      ///< writer connection (samples, sessions, alarms)
+  sqlite3* reader_ = nullptr;  ///< read-only connection for queries
   sqlite3_stmt* insert_ = nullptr;
-  std::mutex db_mutex_;         ///< serialises use of db_
-  std::mutex reader_mutex_;     ///< serialises use of reader_
+  std::mutex db_mutex_;                               ///< serialises use of db_
+  std::mutex reader_mutex_;                           ///< serialises use of reader_
   std::map<std::string, SessionInfo> open_sessions_;  ///< latest session per boat (writer only)
   std::set<std::string> dirty_sessions_;              ///< open sessions changed in this batch
 
-  mutable std::mutex mutex_;    ///< guards the queue and the counters
+  mutable std::mutex mutex_;  ///< guards the queue and the counters
   std::condition_variable cv_;
   std::condition_variable flushed_cv_;
   std::vector<AttitudeSample> queue_;

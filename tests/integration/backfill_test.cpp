@@ -5,6 +5,7 @@
 #include <sqlite3.h>
 
 #include "shore_fixture.hpp"
+#include "stored_seqs.hpp"
 
 namespace telltale::testing {
 namespace {
@@ -75,8 +76,7 @@ TEST_F(BackfillTest, ShoreKilledAndRestartedLosesNothing) {
 // Given a boat whose every outgoing packet is dropped for 15 s (Fast DDS's test transport), when
 // the link returns, then the shore marked it stale meanwhile and the session is complete after.
 TEST_F(BackfillTest, CutLinkIsBackfilled) {
-  Process& boat =
-      start_boat("bf2", {"--log-dir", dir_ + "/boatlog", "--fault-drop-link", "3:15"});
+  Process& boat = start_boat("bf2", {"--log-dir", dir_ + "/boatlog", "--fault-drop-link", "3:15"});
   ASSERT_TRUE(eventually([&] { return boats_by_id().count("bf2") == 1; }, 10s));
   // During the cut the boat goes stale on the shore.
   ASSERT_TRUE(eventually(
@@ -96,6 +96,51 @@ TEST_F(BackfillTest, CutLinkIsBackfilled) {
   const long published = stop_boat(boat);
   ASSERT_GT(published, 25 * 20);
   expect_complete("bf2", published);
+}
+
+/// A field `name=value` of the process's output so far (the first occurrence), or "".
+std::string field(const Process& p, const std::string& name) {
+  std::smatch m;
+  const std::string& out = p.output();
+  return std::regex_search(out, m, std::regex(name + R"(=([0-9a-f]+))")) ? m[1].str() : "";
+}
+
+// Given a boat stopped while the shore was down (its drain gives up: the run is only in its log),
+// when the boat starts again with the shore up, then it delivers the earlier run from the log
+// beside the new one, marks it delivered, and a third start has nothing left to deliver.
+TEST_F(BackfillTest, EarlierRunDeliveredAtTheNextStart) {
+  ASSERT_EQ(shore_->stop(SIGTERM), 0);
+  const std::vector<std::string> log = {"--log-dir", dir_ + "/boatlog"};
+  long first_published = 0;
+  std::uint64_t first_boot = 0;
+  {
+    Process& boat = start_boat("bf3", log);
+    first_boot = std::stoull(field(boat, "boot"), nullptr, 16);
+    std::this_thread::sleep_for(3s);
+    ASSERT_EQ(boat.stop(SIGINT, 15s), 0) << boat.output();
+    const auto line = boat.wait_for_line("boat_node stopped: ", 1s);
+    ASSERT_TRUE(line) << boat.output();
+    EXPECT_NE(line->find("shore_has_all=no"), std::string::npos) << *line;
+    first_published = std::stol(field(boat, "published"));
+    ASSERT_GT(first_published, 25 * 2);
+  }
+  boats_.clear();
+  start_shore();
+  Process& boat = start_boat("bf3", log);
+  EXPECT_EQ(field(boat, "earlier_runs"), "1");
+  const auto delivered = boat.wait_for_line("boat_node earlier run ", 30s);
+  ASSERT_TRUE(delivered) << boat.output();
+  EXPECT_NE(delivered->find("delivered"), std::string::npos) << *delivered;
+  std::this_thread::sleep_for(600ms);  // the shore's commit interval
+  EXPECT_EQ(stored_seqs(db_path(), "bf3", first_published, first_boot), first_published);
+  const long second_published = stop_boat(boat);
+  EXPECT_EQ(field(boat, "earlier_runs_pending"), "0");
+  std::this_thread::sleep_for(600ms);
+  const std::uint64_t second_boot = std::stoull(field(boat, "boot"), nullptr, 16);
+  EXPECT_EQ(stored_seqs(db_path(), "bf3", second_published, second_boot), second_published);
+  boats_.clear();
+  Process& third = start_boat("bf3", log);
+  EXPECT_EQ(field(third, "earlier_runs"), "0") << third.output();
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <httplib.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -38,9 +39,15 @@ class ShoreFixture : public ::testing::Test {
   virtual std::vector<std::string> shore_flags() const { return {}; }
 
   void start_shore() {
-    std::vector<std::string> argv = {bin_dir() + "/shore_server", "--domain",
-                                     std::to_string(domain_), "--http-port", "0", "--db",
-                                     db_path(), "--coach-token", kCoachToken};
+    std::vector<std::string> argv = {bin_dir() + "/shore_server",
+                                     "--domain",
+                                     std::to_string(domain_),
+                                     "--http-port",
+                                     "0",
+                                     "--db",
+                                     db_path(),
+                                     "--coach-token",
+                                     kCoachToken};
     for (const auto& f : shore_flags()) argv.push_back(f);
     shore_ = std::make_unique<Process>(argv);
     const auto ready = shore_->wait_for_line("shore_server ready: ", std::chrono::seconds(20));
@@ -51,8 +58,12 @@ class ShoreFixture : public ::testing::Test {
   }
 
   Process& start_boat(const std::string& id, std::vector<std::string> extra = {}) {
-    std::vector<std::string> argv = {bin_dir() + "/boat_node", "--domain",
-                                     std::to_string(domain_), "--boat-id", id};
+    std::vector<std::string> argv = {bin_dir() + "/boat_node", "--domain", std::to_string(domain_),
+                                     "--boat-id", id};
+    // The session log in the test's own folder: never the working directory, where runs of
+    // earlier test processes would be delivered as this boat's history.
+    if (std::find(extra.begin(), extra.end(), "--log-dir") == extra.end())
+      extra.insert(extra.end(), {"--log-dir", dir_ + "/log_" + id});
     for (auto& e : extra) argv.push_back(std::move(e));
     boats_.push_back(std::make_unique<Process>(argv));
     EXPECT_TRUE(boats_.back()->wait_for_line("boat_node ready: ", std::chrono::seconds(20)))

@@ -6,22 +6,27 @@
 #include <sqlite3.h>
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 namespace telltale::testing {
 
-/// How many distinct seqs in 1..max_seq the database at `db_path` holds for the boat; -1 if the
-/// file cannot be read.
-inline long stored_seqs(const std::string& db_path, const std::string& boat, long max_seq) {
+/// How many distinct seqs in 1..max_seq the database at `db_path` holds for the boat (of run
+/// `boot_id` only, if given); -1 if the file cannot be read.
+inline long stored_seqs(const std::string& db_path, const std::string& boat, long max_seq,
+                        std::optional<std::uint64_t> boot_id = std::nullopt) {
   sqlite3* db = nullptr;
   long n = -1;
   if (sqlite3_open_v2(db_path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK) {
     sqlite3_stmt* st = nullptr;
-    sqlite3_prepare_v2(
-        db, "SELECT COUNT(DISTINCT seq) FROM attitude WHERE boat_id = ? AND seq BETWEEN 1 AND ?",
-        -1, &st, nullptr);
+    sqlite3_prepare_v2(db,
+                       "SELECT COUNT(DISTINCT seq) FROM attitude WHERE boat_id = ?1 AND seq "
+                       "BETWEEN 1 AND ?2 AND (?3 IS NULL OR boot_id = ?3)",
+                       -1, &st, nullptr);
     sqlite3_bind_text(st, 1, boat.c_str(), -1, SQLITE_TRANSIENT);
     sqlite3_bind_int64(st, 2, max_seq);
+    // Boot ids are stored as their two's-complement int64.
+    if (boot_id) sqlite3_bind_int64(st, 3, static_cast<sqlite3_int64>(*boot_id));
     if (sqlite3_step(st) == SQLITE_ROW) n = sqlite3_column_int64(st, 0);
     sqlite3_finalize(st);
   }

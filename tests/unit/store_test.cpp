@@ -52,15 +52,16 @@ TEST_F(StoreTest, MigratesAnOlderSchemaKeepingItsData) {
   {
     sqlite3* db = nullptr;
     ASSERT_EQ(sqlite3_open(config().path.c_str(), &db), SQLITE_OK);
-    ASSERT_EQ(sqlite3_exec(db,
-                           "CREATE TABLE attitude (boat_id TEXT NOT NULL, t_utc_ns INTEGER NOT NULL,"
-                           " seq INTEGER NOT NULL, heel_deg REAL NOT NULL, pitch_deg REAL NOT NULL,"
-                           " heading_deg REAL, heel_rate_deg_s REAL, pitch_rate_deg_s REAL,"
-                           " yaw_rate_deg_s REAL, accel_weight REAL, quality REAL,"
-                           " PRIMARY KEY (boat_id, t_utc_ns)) WITHOUT ROWID;"
-                           "INSERT INTO attitude VALUES ('old', 1, 1, 5, 0, NULL, 0, 0, 0, 0, 1);",
-                           nullptr, nullptr, nullptr),
-              SQLITE_OK);
+    ASSERT_EQ(
+        sqlite3_exec(db,
+                     "CREATE TABLE attitude (boat_id TEXT NOT NULL, t_utc_ns INTEGER NOT NULL,"
+                     " seq INTEGER NOT NULL, heel_deg REAL NOT NULL, pitch_deg REAL NOT NULL,"
+                     " heading_deg REAL, heel_rate_deg_s REAL, pitch_rate_deg_s REAL,"
+                     " yaw_rate_deg_s REAL, accel_weight REAL, quality REAL,"
+                     " PRIMARY KEY (boat_id, t_utc_ns)) WITHOUT ROWID;"
+                     "INSERT INTO attitude VALUES ('old', 1, 1, 5, 0, NULL, 0, 0, 0, 0, 1);",
+                     nullptr, nullptr, nullptr),
+        SQLITE_OK);
     sqlite3_close(db);
   }
   Store store(config());
@@ -92,7 +93,8 @@ TEST_F(StoreTest, DeduplicatesSplitsSessionsAndAcknowledgesContiguousRuns) {
   EXPECT_EQ(acks[0].boot_id, 7u);
   EXPECT_EQ(acks[0].acked_seq, 3u);  // seq 4 is missing
   // Backfill: seq 4 arrives, and 5..6 again.
-  for (std::uint64_t i : {4ULL, 5ULL, 6ULL}) store.enqueue(sample("b", 7, i, kT0 + i * kSecond / 25));
+  for (std::uint64_t i : {4ULL, 5ULL, 6ULL})
+    store.enqueue(sample("b", 7, i, kT0 + i * kSecond / 25));
   store.flush();
   EXPECT_EQ(store.count("b"), 10);
   EXPECT_EQ(store.acks()[0].acked_seq, 10u);
@@ -104,11 +106,16 @@ TEST_F(StoreTest, DeduplicatesSplitsSessionsAndAcknowledgesContiguousRuns) {
   std::int64_t total = 0;
   for (const auto& s : sessions) total += s.samples;
   EXPECT_EQ(total, 11);
-  // A new run of the boat restarts the receipt at its own seq.
+  // A new run of the boat has a receipt of its own; the earlier run's stays (its log may still
+  // be delivering).
   store.enqueue(sample("b", 8, 1, kT0 + 121 * kSecond));
   store.flush();
-  EXPECT_EQ(store.acks()[0].boot_id, 8u);
-  EXPECT_EQ(store.acks()[0].acked_seq, 1u);
+  acks = store.acks();
+  ASSERT_EQ(acks.size(), 2u);
+  EXPECT_EQ(acks[0].boot_id, 7u);
+  EXPECT_EQ(acks[0].acked_seq, 11u);
+  EXPECT_EQ(acks[1].boot_id, 8u);
+  EXPECT_EQ(acks[1].acked_seq, 1u);
 }
 
 // After a restart the receipt of a run is rebuilt from what is on disk.
