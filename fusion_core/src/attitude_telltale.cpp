@@ -12,8 +12,10 @@ namespace {
 /// 5 rad/s |v| = 0.2 rad and the error is < 1e-6 rad per step.
 Eigen::Quaterniond quat_from_rotvec(const Eigen::Vector3d& v) {
   const double a2 = 0.25 * v.squaredNorm();  // (|v|/2)^2
-  const double c = 1.0 - a2 * (0.5 - a2 / 24.0);
-  const double s = 0.5 * (1.0 - a2 * (1.0 / 6.0 - a2 / 120.0));
+  // Constant reciprocals: the compiler may not turn x / 24 into a multiplication (not exact), and
+  // a division is 13-20 cycles on the update's critical path.
+  const double c = 1.0 - a2 * (0.5 - a2 * (1.0 / 24.0));
+  const double s = 0.5 * (1.0 - a2 * (1.0 / 6.0 - a2 * (1.0 / 120.0)));
   return Eigen::Quaterniond(c, s * v.x(), s * v.y(), s * v.z());
 }
 
