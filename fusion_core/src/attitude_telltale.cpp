@@ -115,12 +115,14 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
     state_.q_gyro = state_.q_gyro * quat_from_rotvec(gyro * dt);
     renormalise(state_.q_gyro);
   }
-  const Eigen::Matrix3d r_gyro = state_.q_gyro.toRotationMatrix();  // body -> I
+  // R^T (I -> body), built directly from the conjugate (bit-identical to transposing R): two of
+  // the three products below are by R^T, and Eigen's column-major product is the packed one.
+  const Eigen::Matrix3d rt_gyro = state_.q_gyro.conjugate().toRotationMatrix();
   const Eigen::Vector3d up_i = state_.up_i;                         // before this correction
   // The vertical seen in the body: the turn test, the bias and the output all follow from it and
   // from the target seen in the body (rotations preserve dot and cross products), which saves
   // three of the five matrix products the frame-I forms need.
-  const Eigen::Vector3d up_b = r_gyro.transpose() * up_i;
+  const Eigen::Vector3d up_b = rt_gyro * up_i;
 
   // --- Rest detection: gyro and accelerometer steady for rest_min_s -> learn the bias.
   const double a_rest = step(k.rest_lp);
@@ -151,7 +153,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   }
 
   // --- Accelerometer in frame I; the non-inertial test and the weight (the paper's idea).
-  const Eigen::Vector3d acc_i = r_gyro * s.acc_body_m_s2;
+  const Eigen::Vector3d acc_i = rt_gyro.transpose() * s.acc_body_m_s2;
   // |a_I - lowpass(a_I)| sees a horizontal acceleration as well as a vertical one, unlike the
   // paper's | |a| - g | (a 1 m/s^2 push sideways changes |a| by 0.05 m/s^2 only).
   // Measured against a 1 s low-pass, not the slow one: a residual bias e rotates gravity in I at
@@ -219,7 +221,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
       state_.up_i = moved * scale;
       // The same step seen in the body: R^T is linear, so R^T up_i follows from up_b and R^T
       // target without a product by R^T of the new up_i.
-      const Eigen::Vector3d target_b = r_gyro.transpose() * target;
+      const Eigen::Vector3d target_b = rt_gyro * target;
       up_body = (up_b + w * (target_b - up_b)) * scale;
       // Bias in motion: this step's correction is the small rotation w (target x up) of frame I,
       // which is minus the residual bias times dt, seen in the body frame; integrate it slowly
