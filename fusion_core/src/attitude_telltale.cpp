@@ -41,6 +41,8 @@ TelltaleAttitudeFilter::TelltaleAttitudeFilter(Params params) : params_(params) 
             1.0 / (p.nonin_high_m_s2 - p.nonin_low_m_s2),
             1.0 / (p.turn_high_m_s2 - p.turn_low_m_s2),
             1.0 / p.turn_rate_rad_s,
+            p.saturation_fraction * p.gyro_range_rad_s,
+            p.saturation_fraction * p.acc_range_m_s2,
             1.0 / p.g_m_s2,
             1.0 / (p.g_m_s2 * p.g_m_s2)};
 }
@@ -94,14 +96,16 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   }
   const Params& p = params_;
   const Rates& k = rates_;
-  const bool gyro_sat =
-      s.gyro_body_rad_s.cwiseAbs().maxCoeff() >= p.saturation_fraction * p.gyro_range_rad_s;
-  const bool acc_sat =
-      s.acc_body_m_s2.cwiseAbs().maxCoeff() >= p.saturation_fraction * p.acc_range_m_s2;
-  diag_.gyro_saturated += gyro_sat ? 1u : 0u;
-  diag_.acc_saturated += acc_sat ? 1u : 0u;
+  const bool gyro_sat = s.gyro_body_rad_s.cwiseAbs().maxCoeff() >= k.gyro_sat_rad_s;
+  const bool acc_sat = s.acc_body_m_s2.cwiseAbs().maxCoeff() >= k.acc_sat_m_s2;
   const bool gap = dt > p.max_gap_s;
-  diag_.gaps += gap ? 1u : 0u;
+  // One test for the three rare events; their bookkeeping stays off the common path.
+  const bool unusual = gyro_sat | acc_sat | gap;
+  if (unusual) [[unlikely]] {
+    diag_.gyro_saturated += gyro_sat ? 1u : 0u;
+    diag_.acc_saturated += acc_sat ? 1u : 0u;
+    diag_.gaps += gap ? 1u : 0u;
+  }
   // First-order low-pass steps dt / tau (forward Euler; dt << tau, clamped for long steps).
   const auto step = [dt](double inv_tau) { return std::min(1.0, dt * inv_tau); };
   const Eigen::Vector3d gyro = s.gyro_body_rad_s - state_.bias_rad_s;
@@ -227,7 +231,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
       // which is minus the residual bias times dt, seen in the body frame; integrate it slowly
       // (bias_motion_tau_s) so it never fights the low-pass.
       if (!at_rest && !gap) {
-        state_.bias_rad_s -= (w * target_b.cross(up_b)) * k.bias_motion;
+        state_.bias_rad_s -= target_b.cross(up_b) * (w * k.bias_motion);
         state_.bias_rad_s =
             state_.bias_rad_s.cwiseMax(-p.max_bias_rad_s).cwiseMin(p.max_bias_rad_s);
       }
@@ -237,7 +241,8 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // --- Quality: a rough tilt variance, growing with gyro-only time, saturation and gaps,
   // shrinking while the accelerometer is trusted.
   constexpr double kDriftVar = 1e-6;         // (0.06 deg/s)^2 * s: residual bias after learning
-  state_.tilt_var_rad2 += kDriftVar * dt + (gyro_sat ? 1e-4 : 0.0) + (gap ? 1e-2 : 0.0);
+  state_.tilt_var_rad2 += kDriftVar * dt;
+  if (unusual) [[unlikely]] state_.tilt_var_rad2 += (gyro_sat ? 1e-4 : 0.0) + (gap ? 1e-2 : 0.0);
   state_.tilt_var_rad2 *= 1.0 - w * step(k.acc);
 
   // --- What output() needs: the corrected vertical seen in the body, and the body rate.

@@ -119,10 +119,11 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
  private:
   void initialise(const ImuSample& s);
   /// 1 / time constant (and 1 / threshold span) of every Params entry used per sample, so the
-  /// update multiplies instead of dividing.
+  /// update multiplies instead of dividing; and the saturation thresholds.
   struct Rates {
     double rest_lp, rest_bias, nonin_lp, nonin_release, turn_lp, turn_release, acc, acc_rest,
-        bias_motion, nonin_range, turn_range, turn_rate, inv_g, inv_g2;
+        bias_motion, nonin_range, turn_range, turn_rate, gyro_sat_rad_s, acc_sat_m_s2, inv_g,
+        inv_g2;
   };
   Params params_;
   Rates rates_{};
