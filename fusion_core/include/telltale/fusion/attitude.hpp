@@ -66,8 +66,8 @@ enum class SampleGate { kReject, kFirst, kNext };
                                             unsigned& rejected_non_finite, unsigned& rejected_time) {
   dt_s = 0.0;
   // 0 * x is 0 for a finite x and NaN for NaN or Inf: one sum tests all seven values at once.
-  const double zero = 0.0 * sample.t_s + (0.0 * sample.gyro_body_rad_s).sum() +
-                      (0.0 * sample.acc_body_m_s2).sum();
+  const double zero =
+      0.0 * sample.t_s + (0.0 * sample.gyro_body_rad_s + 0.0 * sample.acc_body_m_s2).sum();
   if (zero != 0.0) {
     ++rejected_non_finite;
     return SampleGate::kReject;
