@@ -122,7 +122,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // R^T (I -> body), built directly from the conjugate (bit-identical to transposing R): two of
   // the three products below are by R^T, and Eigen's column-major product is the packed one.
   const Eigen::Matrix3d rt_gyro = state_.q_gyro.conjugate().toRotationMatrix();
-  const Eigen::Vector3d up_i = state_.up_i;                         // before this correction
+  const Eigen::Vector3d up_i = state_.up_i;  // before this correction
   // The vertical seen in the body: the turn test, the bias and the output all follow from it and
   // from the target seen in the body (rotations preserve dot and cross products), which saves
   // three of the five matrix products the frame-I forms need.
@@ -240,9 +240,11 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
 
   // --- Quality: a rough tilt variance, growing with gyro-only time, saturation and gaps,
   // shrinking while the accelerometer is trusted.
-  constexpr double kDriftVar = 1e-6;         // (0.06 deg/s)^2 * s: residual bias after learning
+  constexpr double kDriftVar = 1e-6;  // (0.06 deg/s)^2 * s: residual bias after learning
   state_.tilt_var_rad2 += kDriftVar * dt;
-  if (unusual) [[unlikely]] state_.tilt_var_rad2 += (gyro_sat ? 1e-4 : 0.0) + (gap ? 1e-2 : 0.0);
+  if (unusual) [[unlikely]] {
+    state_.tilt_var_rad2 += (gyro_sat ? 1e-4 : 0.0) + (gap ? 1e-2 : 0.0);
+  }
   state_.tilt_var_rad2 *= 1.0 - w * step(k.acc);
 
   // --- What output() needs: the corrected vertical seen in the body, and the body rate.

@@ -63,7 +63,8 @@ enum class SampleGate { kReject, kFirst, kNext };
 /// sets started. Inline: it runs before every update and a call costs as much as its body.
 [[nodiscard]] inline SampleGate gate_sample(const ImuSample& sample, bool& started,
                                             double& last_t_s, double& dt_s,
-                                            unsigned& rejected_non_finite, unsigned& rejected_time) {
+                                            unsigned& rejected_non_finite,
+                                            unsigned& rejected_time) {
   dt_s = 0.0;
   // 0 * x is 0 for a finite x and NaN for NaN or Inf: one sum tests all seven values at once.
   const double zero =
