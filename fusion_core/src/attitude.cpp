@@ -9,27 +9,6 @@
 
 namespace telltale::fusion {
 
-SampleGate gate_sample(const ImuSample& s, bool& started, double& last_t_s, double& dt_s,
-                       unsigned& rejected_non_finite, unsigned& rejected_time) {
-  dt_s = 0.0;
-  if (!std::isfinite(s.t_s) || !s.gyro_body_rad_s.allFinite() || !s.acc_body_m_s2.allFinite()) {
-    ++rejected_non_finite;
-    return SampleGate::kReject;
-  }
-  if (!started) {
-    started = true;
-    last_t_s = s.t_s;
-    return SampleGate::kFirst;
-  }
-  dt_s = s.t_s - last_t_s;
-  if (!(dt_s > 0.0)) {
-    ++rejected_time;
-    return SampleGate::kReject;
-  }
-  last_t_s = s.t_s;
-  return SampleGate::kNext;
-}
-
 void tilt_from_accel(const Eigen::Vector3d& f, double& heel_rad, double& pitch_rad) {
   // At rest f = g (sin(pitch), cos(pitch) sin(heel), cos(pitch) cos(heel)).
   heel_rad = std::atan2(f.y(), f.z());

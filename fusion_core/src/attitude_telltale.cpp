@@ -12,8 +12,10 @@ namespace {
 /// 5 rad/s |v| = 0.2 rad and the error is < 1e-6 rad per step.
 Eigen::Quaterniond quat_from_rotvec(const Eigen::Vector3d& v) {
   const double a2 = 0.25 * v.squaredNorm();  // (|v|/2)^2
-  const double c = 1.0 - a2 * (0.5 - a2 / 24.0);
-  const double s = 0.5 * (1.0 - a2 * (1.0 / 6.0 - a2 / 120.0));
+  // Constant reciprocals: the compiler may not turn x / 24 into a multiplication (not exact), and
+  // a division is 13-20 cycles on the update's critical path.
+  const double c = 1.0 - a2 * (0.5 - a2 * (1.0 / 24.0));
+  const double s = 0.5 * (1.0 - a2 * (1.0 / 6.0 - a2 * (1.0 / 120.0)));
   return Eigen::Quaterniond(c, s * v.x(), s * v.y(), s * v.z());
 }
 
@@ -39,6 +41,8 @@ TelltaleAttitudeFilter::TelltaleAttitudeFilter(Params params) : params_(params) 
             1.0 / (p.nonin_high_m_s2 - p.nonin_low_m_s2),
             1.0 / (p.turn_high_m_s2 - p.turn_low_m_s2),
             1.0 / p.turn_rate_rad_s,
+            p.saturation_fraction * p.gyro_range_rad_s,
+            p.saturation_fraction * p.acc_range_m_s2,
             1.0 / p.g_m_s2,
             1.0 / (p.g_m_s2 * p.g_m_s2)};
 }
@@ -60,10 +64,24 @@ void TelltaleAttitudeFilter::initialise(const ImuSample& s) {
   state_.last_t_s = s.t_s;
   state_.tilt_var_rad2 = 0.01;  // (6 deg)^2: unknown until the first seconds have been seen
   state_.initialised = true;
-  state_.out = AttitudeOutput{};
-  state_.out.heel_rad = heel;
-  state_.out.pitch_rad = pitch;
-  state_.out.valid = true;
+  state_.up_body = state_.q_gyro.toRotationMatrix().row(2).transpose();  // R^T (0, 0, 1)
+}
+
+// Computed here, not in update(): the boat node reads one output per 4 samples (25 Hz of 100 Hz)
+// and the two atan2, a square root and three divisions are a fifth of the update's time.
+AttitudeOutput TelltaleAttitudeFilter::output() const {
+  AttitudeOutput o;
+  if (!state_.initialised) return o;
+  o.valid = true;
+  if (!state_.updated) {  // the first sample's tilt, rates, weight and quality 0
+    tilt_from_accel(state_.up_body, o.heel_rad, o.pitch_rad);
+    return o;
+  }
+  output_from_up(state_.rate_rad_s, state_.up_body, o);
+  constexpr double kInvVar0 = 1.0 / 7.6e-5;  // 1 / (0.5 deg)^2
+  o.acc_weight = state_.weight;
+  o.quality = 1.0 / (1.0 + state_.tilt_var_rad2 * kInvVar0);
+  return o;
 }
 
 void TelltaleAttitudeFilter::update(const ImuSample& s) {
@@ -78,14 +96,16 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   }
   const Params& p = params_;
   const Rates& k = rates_;
-  const bool gyro_sat =
-      s.gyro_body_rad_s.cwiseAbs().maxCoeff() >= p.saturation_fraction * p.gyro_range_rad_s;
-  const bool acc_sat =
-      s.acc_body_m_s2.cwiseAbs().maxCoeff() >= p.saturation_fraction * p.acc_range_m_s2;
-  diag_.gyro_saturated += gyro_sat ? 1u : 0u;
-  diag_.acc_saturated += acc_sat ? 1u : 0u;
+  const bool gyro_sat = s.gyro_body_rad_s.cwiseAbs().maxCoeff() >= k.gyro_sat_rad_s;
+  const bool acc_sat = s.acc_body_m_s2.cwiseAbs().maxCoeff() >= k.acc_sat_m_s2;
   const bool gap = dt > p.max_gap_s;
-  diag_.gaps += gap ? 1u : 0u;
+  // One test for the three rare events; their bookkeeping stays off the common path.
+  const bool unusual = gyro_sat | acc_sat | gap;
+  if (unusual) [[unlikely]] {
+    diag_.gyro_saturated += gyro_sat ? 1u : 0u;
+    diag_.acc_saturated += acc_sat ? 1u : 0u;
+    diag_.gaps += gap ? 1u : 0u;
+  }
   // First-order low-pass steps dt / tau (forward Euler; dt << tau, clamped for long steps).
   const auto step = [dt](double inv_tau) { return std::min(1.0, dt * inv_tau); };
   const Eigen::Vector3d gyro = s.gyro_body_rad_s - state_.bias_rad_s;
@@ -99,8 +119,14 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
     state_.q_gyro = state_.q_gyro * quat_from_rotvec(gyro * dt);
     renormalise(state_.q_gyro);
   }
-  const Eigen::Matrix3d r_gyro = state_.q_gyro.toRotationMatrix();  // body -> I
-  const Eigen::Vector3d up_i = state_.up_i;                         // before this correction
+  // R^T (I -> body), built directly from the conjugate (bit-identical to transposing R): two of
+  // the three products below are by R^T, and Eigen's column-major product is the packed one.
+  const Eigen::Matrix3d rt_gyro = state_.q_gyro.conjugate().toRotationMatrix();
+  const Eigen::Vector3d up_i = state_.up_i;  // before this correction
+  // The vertical seen in the body: the turn test, the bias and the output all follow from it and
+  // from the target seen in the body (rotations preserve dot and cross products), which saves
+  // three of the five matrix products the frame-I forms need.
+  const Eigen::Vector3d up_b = rt_gyro * up_i;
 
   // --- Rest detection: gyro and accelerometer steady for rest_min_s -> learn the bias.
   const double a_rest = step(k.rest_lp);
@@ -131,7 +157,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   }
 
   // --- Accelerometer in frame I; the non-inertial test and the weight (the paper's idea).
-  const Eigen::Vector3d acc_i = r_gyro * s.acc_body_m_s2;
+  const Eigen::Vector3d acc_i = rt_gyro.transpose() * s.acc_body_m_s2;
   // |a_I - lowpass(a_I)| sees a horizontal acceleration as well as a vertical one, unlike the
   // paper's | |a| - g | (a 1 m/s^2 push sideways changes |a| by 0.05 m/s^2 only).
   // Measured against a 1 s low-pass, not the slow one: a residual bias e rotates gravity in I at
@@ -146,16 +172,16 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // = 1.25 m/s^2 for seconds) that the low-pass would absorb as a tilt. Signature: a horizontal
   // acceleration across the heading, toward the side the vehicle turns to. A rotation in place
   // (a turntable's axis, a hand turning the sensor) has no such correlation.
-  // All of it in frame I, with up_i for the vertical: the bow x (unit), its horizontal part
-  // x_h = x - (x.up) up, |x_h|^2 = 1 - (x.up)^2, and a_lat = (up x x_h).a / |x_h| =
-  // (up x x).a / |x_h|.
-  const double yaw_rate = (r_gyro.transpose() * up_i).dot(gyro);  // rate about the vertical
-  const Eigen::Vector3d bow_i = r_gyro.col(0);
-  const double bow_up = bow_i.dot(up_i);
+  // With the vertical up: the bow x (unit), its horizontal part x_h = x - (x.up) up,
+  // |x_h|^2 = 1 - (x.up)^2, and a_lat = (up x x_h).a / |x_h| = (up x x).a / |x_h|. Evaluated in
+  // the body, where x = (1, 0, 0): x.up = up_b.x and (up x x).a = a.y up_b.z - a.z up_b.y.
+  const double yaw_rate = up_b.dot(gyro);  // rate about the vertical
+  const double bow_up = up_b.x();
   const double xh2 = 1.0 - bow_up * bow_up;
   double turn = 0.0;
   if (xh2 > 0.09) {
-    const double a_lat = up_i.cross(bow_i).dot(acc_i) / std::sqrt(xh2);
+    const Eigen::Vector3d& a = s.acc_body_m_s2;
+    const double a_lat = (a.y() * up_b.z() - a.z() * up_b.y()) / std::sqrt(xh2);
     turn = a_lat * std::clamp(yaw_rate * k.turn_rate, -1.0, 1.0);
   }
   state_.turn_m_s2 += step(k.turn_lp) * (turn - state_.turn_m_s2);
@@ -182,6 +208,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // for heel and pitch, and the turn test is invariant to a rotation about it, so the correction
   // is this one unit vector rather than a rotation.
   const double l2 = state_.acc_lp2_i.squaredNorm();
+  Eigen::Vector3d up_body = up_b;  // the corrected vertical in the body (the output's input)
   if (l2 > 0.25 * p.g_m_s2 * p.g_m_s2) {
     // Only the target's direction matters (a norm off by e moves the result by ~w e theta), so
     // near g one Newton step from 1/g stands in for the square root and the division.
@@ -194,12 +221,17 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
     if (m2 > 1e-6) {  // not a half-turn away (an upside-down start at w ~ 0.5)
       // Steps are small in steady state (|moved| = 1 - O(w theta^2)): there a Newton step to unit
       // length is exact to (1 - m2)^2 < 1e-6; a large step takes the square root.
-      state_.up_i = moved * (std::abs(m2 - 1.0) < 1e-3 ? 1.5 - 0.5 * m2 : 1.0 / std::sqrt(m2));
+      const double scale = std::abs(m2 - 1.0) < 1e-3 ? 1.5 - 0.5 * m2 : 1.0 / std::sqrt(m2);
+      state_.up_i = moved * scale;
+      // The same step seen in the body: R^T is linear, so R^T up_i follows from up_b and R^T
+      // target without a product by R^T of the new up_i.
+      const Eigen::Vector3d target_b = rt_gyro * target;
+      up_body = (up_b + w * (target_b - up_b)) * scale;
       // Bias in motion: this step's correction is the small rotation w (target x up) of frame I,
       // which is minus the residual bias times dt, seen in the body frame; integrate it slowly
       // (bias_motion_tau_s) so it never fights the low-pass.
       if (!at_rest && !gap) {
-        state_.bias_rad_s -= (r_gyro.transpose() * (w * target.cross(up_i))) * k.bias_motion;
+        state_.bias_rad_s -= target_b.cross(up_b) * (w * k.bias_motion);
         state_.bias_rad_s =
             state_.bias_rad_s.cwiseMax(-p.max_bias_rad_s).cwiseMin(p.max_bias_rad_s);
       }
@@ -208,18 +240,17 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
 
   // --- Quality: a rough tilt variance, growing with gyro-only time, saturation and gaps,
   // shrinking while the accelerometer is trusted.
-  constexpr double kDriftVar = 1e-6;         // (0.06 deg/s)^2 * s: residual bias after learning
-  constexpr double kInvVar0 = 1.0 / 7.6e-5;  // 1 / (0.5 deg)^2
-  state_.tilt_var_rad2 += kDriftVar * dt + (gyro_sat ? 1e-4 : 0.0) + (gap ? 1e-2 : 0.0);
+  constexpr double kDriftVar = 1e-6;  // (0.06 deg/s)^2 * s: residual bias after learning
+  state_.tilt_var_rad2 += kDriftVar * dt;
+  if (unusual) [[unlikely]] {
+    state_.tilt_var_rad2 += (gyro_sat ? 1e-4 : 0.0) + (gap ? 1e-2 : 0.0);
+  }
   state_.tilt_var_rad2 *= 1.0 - w * step(k.acc);
 
-  // --- Output: the corrected vertical, seen in the body frame.
-  const Eigen::Vector3d up_body = r_gyro.transpose() * state_.up_i;
-  AttitudeOutput& o = state_.out;
-  output_from_up(gyro, up_body, o);
-  o.acc_weight = w;
-  o.quality = 1.0 / (1.0 + state_.tilt_var_rad2 * kInvVar0);
-  o.valid = true;
+  // --- What output() needs: the corrected vertical seen in the body, and the body rate.
+  state_.up_body = up_body;
+  state_.rate_rad_s = gyro;
+  state_.updated = true;
 }
 
 }  // namespace telltale::fusion

@@ -91,8 +91,12 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
     double weight = 0.0;
     double tilt_var_rad2 = 0.0;  ///< rough tilt variance behind `quality`
     double last_t_s = 0.0;
-    AttitudeOutput out{};
+    /// The output's inputs (output() is computed from them on demand): the corrected vertical
+    /// seen in the body (unit) and the bias-corrected body rate of the last update.
+    Eigen::Vector3d up_body = Eigen::Vector3d::UnitZ();
+    Eigen::Vector3d rate_rad_s = Eigen::Vector3d::Zero();
     bool initialised = false;
+    bool updated = false;  ///< an update followed the first sample
   };
   struct Diagnostics {
     unsigned rejected_non_finite = 0;
@@ -105,7 +109,8 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
 
   explicit TelltaleAttitudeFilter(Params params = {});
   void update(const ImuSample& sample) override;
-  [[nodiscard]] AttitudeOutput output() const override { return state_.out; }
+  /// Computed on demand from the state (a read costs ~170 instructions; update() does not pay it).
+  [[nodiscard]] AttitudeOutput output() const override;
   [[nodiscard]] const State& state() const { return state_; }
   void set_state(const State& s) { state_ = s; }
   [[nodiscard]] const Diagnostics& diagnostics() const { return diag_; }
@@ -114,10 +119,11 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
  private:
   void initialise(const ImuSample& s);
   /// 1 / time constant (and 1 / threshold span) of every Params entry used per sample, so the
-  /// update multiplies instead of dividing.
+  /// update multiplies instead of dividing; and the saturation thresholds.
   struct Rates {
     double rest_lp, rest_bias, nonin_lp, nonin_release, turn_lp, turn_release, acc, acc_rest,
-        bias_motion, nonin_range, turn_range, turn_rate, inv_g, inv_g2;
+        bias_motion, nonin_range, turn_range, turn_rate, gyro_sat_rad_s, acc_sat_m_s2, inv_g,
+        inv_g2;
   };
   Params params_;
   Rates rates_{};
