@@ -2,9 +2,12 @@
 
 #include <httplib.h>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <ctime>
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "json_views.hpp"
 #include "openapi_json.hpp"
@@ -40,12 +43,14 @@ struct HttpApi::Impl {
   HttpConfig config;
   ShoreContext ctx;
   httplib::Server server;
+  std::atomic<bool> stop_requested{false};
+  std::atomic<bool> served{false};  ///< serve() has returned
 
   Impl(HttpConfig c, ShoreContext context) : config(std::move(c)), ctx(context) {}
 
   std::optional<Principal> principal(const httplib::Request& req) const {
-    return ctx.tokens.find(token_from_headers(req.get_header_value("Authorization"),
-                                              req.get_header_value("Cookie")));
+    return ctx.tokens.find(
+        token_from_headers(req.get_header_value("Authorization"), req.get_header_value("Cookie")));
   }
 
   void configure() {
@@ -76,7 +81,9 @@ struct HttpApi::Impl {
       } else if (res.status == 413) {
         json_error(res, 413, "request body too large");
       } else {
-        json_error(res, res.status, res.status == 400 ? "malformed request (a POST or PUT needs a Content-Length)" : "request failed");
+        json_error(res, res.status,
+                   res.status == 400 ? "malformed request (a POST or PUT needs a Content-Length)"
+                                     : "request failed");
       }
     });
     // The one exception handler: HttpError carries its 4xx; anything else is a 500.
@@ -151,7 +158,7 @@ struct HttpApi::Impl {
       res.set_chunked_content_provider(
           "text/event-stream",
           [this, client, pending = std::move(snapshot)](std::size_t,
-                                                         httplib::DataSink& sink) mutable {
+                                                        httplib::DataSink& sink) mutable {
             bool closed = false;
             std::string out = std::move(pending);
             pending.clear();
@@ -191,8 +198,18 @@ int HttpApi::bind() {
   return port;
 }
 
-void HttpApi::serve() { impl_->server.listen_after_bind(); }
+void HttpApi::serve() {
+  if (!impl_->stop_requested.load()) impl_->server.listen_after_bind();
+  impl_->served.store(true);
+}
 
-void HttpApi::stop() { impl_->server.stop(); }
+void HttpApi::stop() {
+  impl_->stop_requested.store(true);
+  // A SIGTERM right after start-up can come before the listen loop runs; stop it once it does.
+  while (!impl_->served.load()) {
+    if (impl_->server.is_running()) impl_->server.stop();
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+}
 
 }  // namespace telltale::shore

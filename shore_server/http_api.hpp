@@ -21,10 +21,10 @@ namespace telltale::shore {
 
 struct HttpConfig {
   std::string bind_address = "127.0.0.1";
-  int port = 8080;                   ///< 0: pick a free port
-  std::string web_dir;               ///< static dashboard files
+  int port = 8080;      ///< 0: pick a free port
+  std::string web_dir;  ///< static dashboard files
   std::size_t max_stream_clients = 64;
-  std::size_t rest_threads = 8;      ///< workers beyond the ones the streams may hold
+  std::size_t rest_threads = 8;  ///< workers beyond the ones the streams may hold
   std::size_t max_body_bytes = 1 << 20;
 };
 
@@ -48,6 +48,9 @@ class HttpApi {
   int bind();
   /// Serves until stop(); call on a thread of its own.
   void serve();
+  /// Makes serve() return, also when it has not started listening yet (cpp-httplib ignores a
+  /// stop before its listen loop runs: the server would then serve forever). Returns once
+  /// serve() has returned; serve() must have been called, or be called, on another thread.
   void stop();
 
  private:
