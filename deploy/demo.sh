@@ -37,7 +37,7 @@ fi
 "$bin/shore_server" --http-port "$port" --db "$db" --coach-token "$token" $(sec shore) \
   >"$log/shore" 2>&1 &
 pids+=($!)
-for _ in $(seq 100); do grep -q "ready" "$log/shore" && break; sleep 0.1; done
+for _ in $(seq 100); do grep -qs "ready" "$log/shore" && break; sleep 0.1; done
 grep -q "ready" "$log/shore" || { cat "$log/shore"; exit 1; }
 for boat in ILCA-1 ILCA-2 ILCA-3 ILCA-4; do
   # shellcheck disable=SC2046
