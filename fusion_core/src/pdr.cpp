@@ -320,7 +320,18 @@ void HeadingFilter::update(double t_s, const Eigen::Vector3d& gyro, const Eigen:
     up_init_ = true;
   } else {
     if (gyro_ok) state_.up += state_.up.cross(gyro) * dt;
-    state_.up += dt / (params_.up_tau_s + dt) * (acc.normalized() - state_.up);
+    // Walking round a corner (0.6 m radius at 1.4 m/s: 3 m/s^2, 17 deg of tilt) the
+    // accelerometer also reads the centripetal acceleration v w (toward the centre, left for a
+    // left turn); left in, it tilts the up direction, and the magnetic heading by about
+    // tan(dip) times as much, for seconds after every corner.
+    Eigen::Vector3d f = acc;
+    const double w_up = gyro_ok ? gyro.dot(state_.up) : 0.0;
+    Eigen::Vector3d fwd = Eigen::Vector3d::UnitX() - state_.up.x() * state_.up;
+    if (fwd.norm() > 0.3 && speed_m_s_ > 0.0) {
+      fwd.normalize();
+      f -= speed_m_s_ * w_up * state_.up.cross(fwd);
+    }
+    state_.up += dt / (params_.up_tau_s + dt) * (f.normalized() - state_.up);
     state_.up.normalize();
   }
   // Prediction: heading rate = -(yaw rate about up) (heading is clockwise).
@@ -406,6 +417,7 @@ Pdr::Wave Pdr::step_wave(double t0, double t1) const {
 
 void Pdr::on_step(double t_s) {
   const bool foot = params_.mount == StepMount::kFoot;
+  const std::array<Eigen::Vector3d, 2> tilts_before = tilts_;
   const double per_event = foot ? 2.0 : 1.0;  // a foot sensor sees one event per two steps
   // Steps the detector missed (our addition): its thresholds follow the last steps' peaks and
   // valleys, so after an arm swing the smaller steps of the next pose go unseen until its
@@ -462,23 +474,35 @@ void Pdr::on_step(double t_s) {
           settling_ = false;
           correlated_steps_ = 0;
           switch_steps_ = 0;
-          pre_switch_tilts_ = tilts_;
+          // The phone may have begun to move a step or two before the waveforms said so: those
+          // steps join the switch (re-laid at its end) and the gravity before them is the old
+          // pose's.
+          const std::size_t back = std::min<std::size_t>(
+              last_count_, static_cast<std::size_t>(std::clamp(params_.switch_lookback_steps, 0,
+                                                               static_cast<int>(kLookback))));
+          pre_switch_tilts_ = back > 0 ? last_tilts_before_[kLookback - back] : tilts_;
+          for (std::size_t i = kLookback - back; i < kLookback; ++i)
+            switch_[static_cast<std::size_t>(switch_steps_++)] = last_steps_[i];
+          last_count_ = 0;
           reset_walking_direction();
           ++diag_.switches;
           // If the 3 steps before the switch were straight, their mean heading stands in for
-          // the heading during the switch.
-          // The comparison spans two steps, so the switch may have begun during the latest
-          // step: the 3 steps before that one are the ones known to be clean.
+          // the heading during the switch. The comparison spans two steps, so the switch may
+          // have begun during the latest step: the 3 steps before the re-laid ones (at least
+          // the latest) are the ones known to be clean.
           have_replacement_ = false;
-          if (recent_count_ >= 4) {
+          const std::size_t skip = std::max<std::size_t>(1, back);
+          const std::size_t n_recent = recent_heading_rad_.size();
+          if (static_cast<std::size_t>(recent_count_) >= 3 + skip) {
+            const std::size_t i0 = n_recent - skip - 3;
             double s = 0, c = 0;
-            for (std::size_t i = 0; i < 3; ++i) {
+            for (std::size_t i = i0; i < i0 + 3; ++i) {
               s += std::sin(recent_heading_rad_[i]);
               c += std::cos(recent_heading_rad_[i]);
             }
             const double mean = std::atan2(s, c);
             bool straight = true;
-            for (std::size_t i = 0; i < 3; ++i)
+            for (std::size_t i = i0; i < i0 + 3; ++i)
               straight =
                   straight && std::abs(std::remainder(recent_heading_rad_[i] - mean, kTwoPi)) <
                                   params_.straight_deg * M_PI / 180.0;
@@ -592,6 +616,7 @@ void Pdr::on_step(double t_s) {
   const double len = (per_event + missed) * lengths_.length_m(applied_pose_, params_.height_m, hz) *
                      params_.step_scale[static_cast<std::size_t>(applied_pose_)];
   out_.last_step_length_m = len;
+  heading_.set_speed(len / (per_event + missed) * hz);
   out_.distance_m += len;
   if (!foot && (!pose_known_ || !heading_.initialised())) {
     // At the start the pose (hence the walking frame and the heading) is not known yet: the
@@ -614,6 +639,21 @@ void Pdr::on_step(double t_s) {
   if (!switching_ && switch_steps_ > 0) {
     relay_switch_steps(heading);
     switch_steps_ = 0;
+  }
+  if (!switching_ && !foot) {
+    for (std::size_t i = 0; i + 1 < kLookback; ++i) {
+      last_steps_[i] = last_steps_[i + 1];
+      last_tilts_before_[i] = last_tilts_before_[i + 1];
+    }
+    SwitchStep& r = last_steps_.back();
+    r.length_m = len;
+    r.laid_rad = heading;
+    r.old_frame_rad = step_heading;
+    r.slot = last_slot_;
+    r.tilt = tilts_[last_slot_];
+    r.axis_sum = {step_axis_x, step_axis_z};
+    last_tilts_before_.back() = tilts_before;
+    last_count_ = std::min(last_count_ + 1, kLookback);
   }
   out_.heading_deg = heading * 180.0 / M_PI;
 }

@@ -11,12 +11,14 @@
 /// consecutive step waveforms, with the mean heading of the 3 straight steps before the switch used
 /// during it -> step length L = a h + b f + c per pose (eq. (13)) -> position (eq. (11)).
 ///
-/// Our additions (each measured on closed loops, see /work/notes/s2-pdr.md): online gyro-aided
-/// hard-iron calibration of the magnetometer (hard_iron.hpp); a switch's steps re-laid with the
-/// heading each really had once the new pose is known; steps the detector left in a gap of
-/// several intervals counted; the phone's yaw from the walking direction removed using the
-/// step's acceleration pattern (shrunk toward 0 while the pose is young); a personal step-length
-/// factor from one calibration walk of known length (PdrParams::step_scale; s2-pdr2.md).
+/// Our additions (each measured on closed loops, `fusion_cli steps-eval --tables pdr`): online
+/// gyro-aided hard-iron calibration of the magnetometer (hard_iron.hpp); a switch's steps, and
+/// the one or two before it was detected, re-laid with the heading each really had once the new
+/// pose is known; steps the detector left in a gap of several intervals counted; the phone's yaw
+/// from the walking direction removed using the step's acceleration pattern (shrunk toward 0
+/// while the pose is young); the centripetal acceleration of turns taken out before the up
+/// direction follows the accelerometer; a personal step-length factor from one calibration walk
+/// of known length (PdrParams::step_scale).
 ///
 /// Frames: the phone's sensor axes are whatever the phone has; the walking frame is x forward, y
 /// left, z up with `v_walking = M_pose v_sensor` (M = I for hand-held and arm swing). Position is
@@ -180,6 +182,9 @@ class HeadingFilter {
               const Eigen::Vector3d& mag_uT);
   /// Forgets the heading (next magnetic reading initialises it); keeps the up direction.
   void reset_heading() { state_.initialised = false; }
+  /// Walking speed along the frame's x axis, m/s: its centripetal acceleration in turns is taken
+  /// out of the accelerometer before the up direction is pulled toward it.
+  void set_speed(double v_m_s) { speed_m_s_ = v_m_s; }
   /// The walking frame changed by `r` (v_new = r v_old): re-expresses the up direction and
   /// forgets the heading.
   void change_frame(const Eigen::Matrix3d& r) {
@@ -205,6 +210,7 @@ class HeadingFilter {
   State state_;
   Diagnostics diag_;
   bool up_init_ = false;
+  double speed_m_s_ = 0.0;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -216,6 +222,7 @@ struct PdrParams {
   double switch_tilt_deg = 15.0;       ///< ...if gravity also moved this much in the sensor frame
                                        ///< (twice this much is a switch whatever the correlation)
   int switch_exit_steps = 2;           ///< correlated steps needed to leave a switch
+  int switch_lookback_steps = 2;       ///< steps before its detection re-laid with a switch
   int pose_window_steps = 10;          ///< steps after a switch to confirm the new pose
   int pose_fallback_steps = 10;        ///< identical answers that change the pose without a switch
   double pose_gravity_deg = 45.0;      ///< a pose whose M does not bring gravity this close to
@@ -319,6 +326,12 @@ class Pdr {
     std::array<Eigen::Vector2d, 2> axis_sum{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
   };
   static constexpr std::size_t kMaxSwitchSteps = 32;
+  /// The last steps laid outside a switch, newest last: a switch is seen one or two steps after
+  /// the phone began to move, so those are re-laid with the switch (switch_lookback_steps).
+  static constexpr std::size_t kLookback = 2;
+  std::array<SwitchStep, kLookback> last_steps_{};
+  std::array<std::array<Eigen::Vector3d, 2>, kLookback> last_tilts_before_{};
+  std::size_t last_count_ = 0;
   void relay_switch_steps(double heading_after);
   void reset_walking_direction();
   // Correlation of the horizontal acceleration with d(vertical)/dt in the pose's walking frame.
@@ -340,7 +353,7 @@ class Pdr {
   double interval_ema_s_ = 0.0;
   // Heading over the current step (circular mean) and of the last three steps.
   double sum_sin_ = 0.0, sum_cos_ = 0.0;
-  std::array<double, 4> recent_heading_rad_{};  ///< oldest first
+  std::array<double, 5> recent_heading_rad_{};  ///< oldest first
   int recent_count_ = 0;
   bool switching_ = false;
   int correlated_steps_ = 0;
