@@ -627,15 +627,15 @@ void Pdr::on_step(double t_s) {
   out_.x_m += (len + pending_m_) * std::sin(heading);
   out_.y_m += (len + pending_m_) * std::cos(heading);
   pending_m_ = 0.0;
-  if (switching_ && switch_steps_ < static_cast<int>(switch_.size())) {
-    SwitchStep& r = switch_[static_cast<std::size_t>(switch_steps_++)];
-    r.length_m = len;
-    r.laid_rad = heading;
-    r.old_frame_rad = step_heading;
-    r.slot = last_slot_;
-    r.tilt = tilts_[last_slot_];
-    r.axis_sum = {step_axis_x, step_axis_z};
-  }
+  SwitchStep laid;  // what a later re-laying of this step needs
+  laid.length_m = len;
+  laid.laid_rad = heading;
+  laid.old_frame_rad = step_heading;
+  laid.slot = last_slot_;
+  laid.tilt = tilts_[last_slot_];
+  laid.axis_sum = {step_axis_x, step_axis_z};
+  if (switching_ && switch_steps_ < static_cast<int>(switch_.size()))
+    switch_[static_cast<std::size_t>(switch_steps_++)] = laid;
   if (!switching_ && switch_steps_ > 0) {
     relay_switch_steps(heading);
     switch_steps_ = 0;
@@ -645,13 +645,7 @@ void Pdr::on_step(double t_s) {
       last_steps_[i] = last_steps_[i + 1];
       last_tilts_before_[i] = last_tilts_before_[i + 1];
     }
-    SwitchStep& r = last_steps_.back();
-    r.length_m = len;
-    r.laid_rad = heading;
-    r.old_frame_rad = step_heading;
-    r.slot = last_slot_;
-    r.tilt = tilts_[last_slot_];
-    r.axis_sum = {step_axis_x, step_axis_z};
+    last_steps_.back() = laid;
     last_tilts_before_.back() = tilts_before;
     last_count_ = std::min(last_count_ + 1, kLookback);
   }
