@@ -119,11 +119,13 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
  private:
   void initialise(const ImuSample& s);
   /// 1 / time constant (and 1 / threshold span) of every Params entry used per sample, so the
-  /// update multiplies instead of dividing; and the saturation thresholds.
+  /// update multiplies instead of dividing; the saturation thresholds; 1 + low / span of the two
+  /// weight ramps (w = one - measure / span); the Newton step 1 / |l| ~ newton_a - newton_b |l|^2
+  /// from 1 / g.
   struct Rates {
     double rest_lp, rest_bias, nonin_lp, nonin_release, turn_lp, turn_release, acc, acc_rest,
         bias_motion, nonin_range, turn_range, turn_rate, gyro_sat_rad_s, acc_sat_m_s2, inv_g,
-        inv_g2;
+        inv_g2, nonin_one, turn_one, newton_a, newton_b;
   };
   Params params_;
   Rates rates_{};
