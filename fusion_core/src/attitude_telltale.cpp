@@ -175,8 +175,9 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // Measured against a 1 s low-pass, not the slow one: a residual bias e rotates gravity in I at
   // rate e, which shows up as g * e * tau here; with tau = 1 s a 1 deg/s error reads 0.17 m/s^2
   // and cannot lock the gate shut.
-  // After the step, a_I - lowpass = (1 - a) (a_I - lowpass before): the norm is taken from the
-  // difference before the step, so the step itself is not on the way to the weight.
+  // After the step, a_I - lowpass = (1 - a) (a_I - lowpass before), and 1 - a >= 0 (a is clamped
+  // to 1): the norm is taken from the difference before the step, so the step itself is not on
+  // the way to the weight.
   const double a_fast = step(k.nonin_lp);
   const Eigen::Vector3d fast_diff = acc_i - state_.acc_fast_i;
   state_.acc_fast_i += a_fast * fast_diff;

@@ -109,7 +109,7 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
 
   explicit TelltaleAttitudeFilter(Params params = {});
   void update(const ImuSample& sample) override;
-  /// Computed on demand from the state (a read costs ~170 instructions; update() does not pay it).
+  /// Computed on demand from the state (a read costs ~155 instructions; update() does not pay it).
   [[nodiscard]] AttitudeOutput output() const override;
   [[nodiscard]] const State& state() const { return state_; }
   void set_state(const State& s) { state_ = s; }
