@@ -8,20 +8,29 @@
 namespace telltale::fusion {
 namespace {
 
-/// Quaternion of the rotation vector v (rad), accurate to O(|v|^5) without sin/cos: at 25 Hz and
-/// 5 rad/s |v| = 0.2 rad and the error is < 1e-6 rad per step.
-Eigen::Quaterniond quat_from_rotvec(const Eigen::Vector3d& v) {
-  const double a2 = 0.25 * v.squaredNorm();  // (|v|/2)^2
-  // Constant reciprocals: the compiler may not turn x / 24 into a multiplication (not exact), and
-  // a division is 13-20 cycles on the update's critical path.
-  const double c = 1.0 - a2 * (0.5 - a2 * (1.0 / 24.0));
-  const double s = 0.5 * (1.0 - a2 * (1.0 / 6.0 - a2 * (1.0 / 120.0)));
-  return Eigen::Quaterniond(c, s * v.x(), s * v.y(), s * v.z());
+/// q * (quaternion of the rotation vector v (rad)), brought back to unit norm. The rotation's
+/// quaternion dq = (c, s v), c = cos(|v|/2), s = sin(|v|/2) / |v|, is accurate to O(|v|^5)
+/// without sin/cos: at 25 Hz and 5 rad/s |v| = 0.2 rad and the error is < 1e-6 rad per step.
+/// Arranged for a short dependency chain (v depends on the bias the last update refined, and
+/// everything in this update depends on q): q dq = c q + s (q (0, v)), where q (0, v) needs only
+/// v and is formed while c and s are; c and s are evaluated in Estrin's form, with
+/// (|v|/2)^2 = n / 4 folded into the constants (powers of two: exact).
+Eigen::Quaterniond rotate_by(const Eigen::Quaterniond& q, const Eigen::Vector3d& v) {
+  const double n = v.squaredNorm();
+  const double n2 = n * n;
+  // c = 1 - a2 / 2 + a2^2 / 24, s = 1 / 2 - a2 / 12 + a2^2 / 240 with a2 = n / 4. Constant
+  // reciprocals: the compiler may not turn x / 24 into a multiplication (not exact), and a
+  // division is 13-20 cycles on the update's critical path.
+  const double c = (1.0 - 0.125 * n) + n2 * (1.0 / 384.0);
+  const double s = (0.5 - n * (1.0 / 48.0)) + n2 * (1.0 / 3840.0);
+  const Eigen::Quaterniond p = q * Eigen::Quaterniond(0.0, v.x(), v.y(), v.z());
+  Eigen::Quaterniond r;
+  r.coeffs() = c * q.coeffs() + s * p.coeffs();
+  // Back to unit norm without a square root (Newton step on |r|; the error e of |r|^2 = 1 + e
+  // becomes O(e^2)). The quaternions here drift by ~1e-16 per step.
+  r.coeffs() *= 1.5 - 0.5 * r.coeffs().squaredNorm();
+  return r;
 }
-
-/// Pulls a near-unit quaternion back to unit norm without a square root (Newton step on |q|;
-/// the error e of |q|^2 = 1 + e becomes O(e^2)). The quaternions here drift by ~1e-16 per step.
-void renormalise(Eigen::Quaterniond& q) { q.coeffs() *= 1.5 - 0.5 * q.coeffs().squaredNorm(); }
 
 double clamp01(double x) { return std::min(1.0, std::max(0.0, x)); }
 
@@ -44,7 +53,11 @@ TelltaleAttitudeFilter::TelltaleAttitudeFilter(Params params) : params_(params) 
             p.saturation_fraction * p.gyro_range_rad_s,
             p.saturation_fraction * p.acc_range_m_s2,
             1.0 / p.g_m_s2,
-            1.0 / (p.g_m_s2 * p.g_m_s2)};
+            1.0 / (p.g_m_s2 * p.g_m_s2),
+            1.0 + p.nonin_low_m_s2 / (p.nonin_high_m_s2 - p.nonin_low_m_s2),
+            1.0 + p.turn_low_m_s2 / (p.turn_high_m_s2 - p.turn_low_m_s2),
+            1.5 / p.g_m_s2,
+            0.5 / (p.g_m_s2 * p.g_m_s2 * p.g_m_s2)};
 }
 
 void TelltaleAttitudeFilter::initialise(const ImuSample& s) {
@@ -116,8 +129,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // 0.15 deg of mean inclination RMSE). Over a gap nothing is known about the rotation: the gyro
   // is not integrated and the tilt is left to the accelerometer.
   if (!gap) {
-    state_.q_gyro = state_.q_gyro * quat_from_rotvec(gyro * dt);
-    renormalise(state_.q_gyro);
+    state_.q_gyro = rotate_by(state_.q_gyro, gyro * dt);
   }
   // R^T (I -> body), built directly from the conjugate (bit-identical to transposing R): two of
   // the three products below are by R^T, and Eigen's column-major product is the packed one.
@@ -163,11 +175,18 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // Measured against a 1 s low-pass, not the slow one: a residual bias e rotates gravity in I at
   // rate e, which shows up as g * e * tau here; with tau = 1 s a 1 deg/s error reads 0.17 m/s^2
   // and cannot lock the gate shut.
-  state_.acc_fast_i += step(k.nonin_lp) * (acc_i - state_.acc_fast_i);
+  // After the step, a_I - lowpass = (1 - a) (a_I - lowpass before), and 1 - a >= 0 (a is clamped
+  // to 1): the norm is taken from the difference before the step, so the step itself is not on
+  // the way to the weight.
+  const double a_fast = step(k.nonin_lp);
+  const Eigen::Vector3d fast_diff = acc_i - state_.acc_fast_i;
+  state_.acc_fast_i += a_fast * fast_diff;
   const double nonin =
-      std::max((acc_i - state_.acc_fast_i).norm(), std::abs(s.acc_body_m_s2.norm() - p.g_m_s2));
+      std::max((1.0 - a_fast) * fast_diff.norm(), std::abs(s.acc_body_m_s2.norm() - p.g_m_s2));
   state_.nonin_hold_m_s2 = std::max(nonin, state_.nonin_hold_m_s2 * (1.0 - step(k.nonin_release)));
-  double w = 1.0 - (state_.nonin_hold_m_s2 - p.nonin_low_m_s2) * k.nonin_range;
+  // 1 - (hold - low) / (high - low), with 1 + low / (high - low) precomputed: one product and one
+  // difference after the hold.
+  double w = k.nonin_one - state_.nonin_hold_m_s2 * k.nonin_range;
   // A vehicle turning while it moves has a centripetal acceleration (a tack: 2.5 m/s * 0.5 rad/s
   // = 1.25 m/s^2 for seconds) that the low-pass would absorb as a tilt. Signature: a horizontal
   // acceleration across the heading, toward the side the vehicle turns to. A rotation in place
@@ -181,13 +200,18 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   double turn = 0.0;
   if (xh2 > 0.09) {
     const Eigen::Vector3d& a = s.acc_body_m_s2;
-    const double a_lat = (a.y() * up_b.z() - a.z() * up_b.y()) / std::sqrt(xh2);
+    // x / sqrt(xh2) as (x / xh2) sqrt(xh2): the division and the square root run side by side
+    // instead of one after the other (this is on the way to the weight).
+    const double a_lat = (a.y() * up_b.z() - a.z() * up_b.y()) / xh2 * std::sqrt(xh2);
     turn = a_lat * std::clamp(yaw_rate * k.turn_rate, -1.0, 1.0);
   }
-  state_.turn_m_s2 += step(k.turn_lp) * (turn - state_.turn_m_s2);
+  // The low-pass step as (1 - a) m + a turn: the first product is ready before turn is.
+  const double a_turn = step(k.turn_lp);
+  state_.turn_m_s2 = (1.0 - a_turn) * state_.turn_m_s2 + a_turn * turn;
   state_.turn_hold_m_s2 =
       std::max(state_.turn_m_s2, state_.turn_hold_m_s2 * (1.0 - step(k.turn_release)));
-  const double w_turn = 1.0 - clamp01((state_.turn_hold_m_s2 - p.turn_low_m_s2) * k.turn_range);
+  // 1 - clamp01(x) = clamp01(1 - x), and 1 - (hold - low) / (high - low) as for w above.
+  const double w_turn = clamp01(k.turn_one - state_.turn_hold_m_s2 * k.turn_range);
   w = std::max(p.w_min, clamp01(w * w_turn));
   // At rest the motion is inertial by definition: the tilt error accumulated before the bias was
   // known (10 deg/s for a second) must not look like a linear acceleration and lock the gate.
@@ -199,8 +223,12 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // the mean that makes oscillations cancel (a shake with sharp stops and gentle starts would
   // leave a residue). Only a turn, a one-sided acceleration by nature, is kept out.
   const double a_lp = at_rest ? step(k.acc_rest) : std::max(p.lp_turn_min, w_turn) * step(k.acc);
-  state_.acc_lp1_i += a_lp * (acc_i - state_.acc_lp1_i);
-  state_.acc_lp2_i += a_lp * (state_.acc_lp1_i - state_.acc_lp2_i);
+  // a_lp waits for the turn test; the differences it scales do not. lp2 + a (lp1' - lp2) with
+  // lp1' - lp2 = (lp1 - lp2) + a (a_I - lp1).
+  const Eigen::Vector3d lp_d1 = acc_i - state_.acc_lp1_i;
+  const Eigen::Vector3d lp_d2 = state_.acc_lp1_i - state_.acc_lp2_i;
+  state_.acc_lp1_i += a_lp * lp_d1;
+  state_.acc_lp2_i += a_lp * (lp_d2 + a_lp * lp_d1);
 
   // --- Correction: move the vertical of frame I toward the low-passed specific force (full
   // step at w = 1: the low-pass already is the time constant; a fraction w of the way otherwise,
@@ -212,10 +240,11 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   if (l2 > 0.25 * p.g_m_s2 * p.g_m_s2) {
     // Only the target's direction matters (a norm off by e moves the result by ~w e theta), so
     // near g one Newton step from 1/g stands in for the square root and the division.
+    // (1.5 - 0.5 l2 / g^2) / g as newton_a - newton_b l2: one product and one difference.
     const double l2_rel = l2 * k.inv_g2;
-    const Eigen::Vector3d target =
-        state_.acc_lp2_i *
-        (std::abs(l2_rel - 1.0) < 0.1 ? k.inv_g * (1.5 - 0.5 * l2_rel) : 1.0 / std::sqrt(l2));
+    const double scale_lp =
+        std::abs(l2_rel - 1.0) < 0.1 ? k.newton_a - k.newton_b * l2 : 1.0 / std::sqrt(l2);
+    const Eigen::Vector3d target = state_.acc_lp2_i * scale_lp;
     const Eigen::Vector3d moved = up_i + w * (target - up_i);
     const double m2 = moved.squaredNorm();
     if (m2 > 1e-6) {  // not a half-turn away (an upside-down start at w ~ 0.5)
@@ -224,14 +253,18 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
       const double scale = std::abs(m2 - 1.0) < 1e-3 ? 1.5 - 0.5 * m2 : 1.0 / std::sqrt(m2);
       state_.up_i = moved * scale;
       // The same step seen in the body: R^T is linear, so R^T up_i follows from up_b and R^T
-      // target without a product by R^T of the new up_i.
-      const Eigen::Vector3d target_b = rt_gyro * target;
+      // target without a product by R^T of the new up_i. R^T target = scale_lp R^T lp2: the
+      // product by R^T does not wait for scale_lp.
+      const Eigen::Vector3d lp_b = rt_gyro * state_.acc_lp2_i;
+      const Eigen::Vector3d target_b = lp_b * scale_lp;
       up_body = (up_b + w * (target_b - up_b)) * scale;
       // Bias in motion: this step's correction is the small rotation w (target x up) of frame I,
       // which is minus the residual bias times dt, seen in the body frame; integrate it slowly
-      // (bias_motion_tau_s) so it never fights the low-pass.
+      // (bias_motion_tau_s) so it never fights the low-pass. The bias feeds the next update's
+      // integration, so this is the end of the loop-carried chain: the cross product is taken
+      // with lp_b, and scale_lp joins w in the one scalar factor.
       if (!at_rest && !gap) {
-        state_.bias_rad_s -= target_b.cross(up_b) * (w * k.bias_motion);
+        state_.bias_rad_s -= lp_b.cross(up_b) * (scale_lp * w * k.bias_motion);
         state_.bias_rad_s =
             state_.bias_rad_s.cwiseMax(-p.max_bias_rad_s).cwiseMin(p.max_bias_rad_s);
       }

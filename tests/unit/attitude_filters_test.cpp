@@ -48,6 +48,28 @@ TEST(FastAtan2, MatchesTheLibraryOnEveryOctant) {
   EXPECT_NEAR(fast_atan2(-1.0, -1.0), -3.0 * M_PI / 4, 1e-9);
 }
 
+// The pair folds the octant steps into one sign flip and one offset: every octant, both lanes.
+TEST(FastAtan2, PairMatchesTheLibraryOnEveryOctantInBothLanes) {
+  double worst = 0.0;
+  for (int i = 0; i < 20000; ++i) {
+    const double a = -M_PI + 2.0 * M_PI * (i + 0.5) / 20000.0;
+    const double b = 1.0 - a;  // the other lane in another octant
+    for (double r : {1e-6, 0.3, 1.0, 9.81, 1e5}) {
+      double r0 = 0.0;
+      double r1 = 0.0;
+      fast_atan2_pair(r * std::sin(a), r * std::cos(a), std::sin(b), std::cos(b), r0, r1);
+      worst = std::max(worst, std::abs(r0 - std::atan2(r * std::sin(a), r * std::cos(a))));
+      worst = std::max(worst, std::abs(r1 - std::atan2(std::sin(b), std::cos(b))));
+    }
+  }
+  EXPECT_LT(worst, 1e-9);
+  double r0 = 1.0;
+  double r1 = 1.0;
+  fast_atan2_pair(0.0, 1.0, 1.0, 0.0, r0, r1);
+  EXPECT_DOUBLE_EQ(r0, 0.0);
+  EXPECT_NEAR(r1, M_PI / 2, 1e-15);
+}
+
 // A positive roll rate heels to starboard; a positive rate about +y (port) puts the bow down.
 TEST(EulerRates, SignsOfSpecSection1) {
   double hr = 0.0;

@@ -122,8 +122,9 @@ void tilt_from_accel(const Eigen::Vector3d& acc_body_m_s2, double& heel_rad, dou
 }
 
 /// fast_atan2(y0, x0) and fast_atan2(y1, x1) at once: with SSE2 the two lanes of one register take
-/// the same operations in the same order (the same results, signed zeros aside) for about half
-/// the instructions of two calls. The production output needs heel and pitch on every read.
+/// the same approximation (the same results to rounding, ~1e-16 rad) for about half the
+/// instructions of two calls. The production output needs heel and pitch on every read, and it
+/// waits for this: the octant bookkeeping is arranged off the path from the division to the result.
 inline void fast_atan2_pair(double y0, double x0, double y1, double x1, double& r0, double& r1) {
 #if defined(__SSE2__)
   const auto select = [](__m128d mask, __m128d a, __m128d b) {  // mask ? a : b, lane by lane
@@ -136,8 +137,8 @@ inline void fast_atan2_pair(double y0, double x0, double y1, double x1, double& 
   const __m128d ay = _mm_andnot_pd(sign, y);
   const __m128d ax = _mm_andnot_pd(sign, x);
   const __m128d swap = _mm_cmpgt_pd(ay, ax);
-  const __m128d lo = select(swap, ax, ay);
-  const __m128d hi = select(swap, ay, ax);
+  const __m128d lo = _mm_min_pd(ay, ax);  // = select(swap, ax, ay) for numbers: one operation
+  const __m128d hi = _mm_max_pd(ay, ax);
   constexpr double kTanPi12 = 0.26794919243112270;
   constexpr double kSqrt3 = 1.7320508075688772;
   const __m128d fold = _mm_cmpgt_pd(lo, _mm_mul_pd(c(kTanPi12), hi));
@@ -151,11 +152,18 @@ inline void fast_atan2_pair(double y0, double x0, double y1, double x1, double& 
   const __m128d p2 =
       _mm_mul_pd(z8, _mm_add_pd(_mm_sub_pd(c(1.0 / 9.0), _mm_mul_pd(z2, c(1.0 / 11.0))),
                                 _mm_mul_pd(z4, c(1.0 / 13.0))));
-  __m128d r = _mm_mul_pd(z, _mm_add_pd(_mm_add_pd(p0, p1), p2));
-  r = _mm_add_pd(r, _mm_and_pd(fold, c(M_PI / 6.0)));
-  r = select(swap, _mm_sub_pd(c(M_PI / 2.0), r), r);
-  r = select(_mm_cmplt_pd(x, _mm_setzero_pd()), _mm_sub_pd(c(M_PI), r), r);
-  r = select(_mm_cmplt_pd(y, _mm_setzero_pd()), _mm_xor_pd(sign, r), r);
+  const __m128d a = _mm_mul_pd(z, _mm_add_pd(_mm_add_pd(p0, p1), p2));
+  // The octant steps r += pi/6 (fold), r = pi/2 - r (swap), r = pi - r (x < 0), r = -r (y < 0)
+  // are each r -> +-r + offset, so together they are one sign flip of a plus one offset, both
+  // known from the masks long before a is: the result is one xor and one addition after a.
+  const __m128d xneg = _mm_cmplt_pd(x, _mm_setzero_pd());
+  const __m128d yneg = _mm_and_pd(sign, y);  // the sign bit of y
+  const __m128d flip = _mm_xor_pd(_mm_and_pd(sign, _mm_xor_pd(swap, xneg)), yneg);
+  __m128d off = _mm_and_pd(fold, c(M_PI / 6.0));
+  off = _mm_add_pd(_mm_xor_pd(off, _mm_and_pd(sign, swap)), _mm_and_pd(swap, c(M_PI / 2.0)));
+  off = _mm_add_pd(_mm_xor_pd(off, _mm_and_pd(sign, xneg)), _mm_and_pd(xneg, c(M_PI)));
+  off = _mm_xor_pd(off, yneg);
+  const __m128d r = _mm_add_pd(_mm_xor_pd(a, flip), off);
   r0 = _mm_cvtsd_f64(r);
   r1 = _mm_cvtsd_f64(_mm_unpackhi_pd(r, r));
 #else

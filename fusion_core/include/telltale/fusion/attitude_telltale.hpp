@@ -109,7 +109,7 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
 
   explicit TelltaleAttitudeFilter(Params params = {});
   void update(const ImuSample& sample) override;
-  /// Computed on demand from the state (a read costs ~170 instructions; update() does not pay it).
+  /// Computed on demand from the state (a read costs ~155 instructions; update() does not pay it).
   [[nodiscard]] AttitudeOutput output() const override;
   [[nodiscard]] const State& state() const { return state_; }
   void set_state(const State& s) { state_ = s; }
@@ -119,11 +119,13 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
  private:
   void initialise(const ImuSample& s);
   /// 1 / time constant (and 1 / threshold span) of every Params entry used per sample, so the
-  /// update multiplies instead of dividing; and the saturation thresholds.
+  /// update multiplies instead of dividing; the saturation thresholds; 1 + low / span of the two
+  /// weight ramps (w = one - measure / span); the Newton step 1 / |l| ~ newton_a - newton_b |l|^2
+  /// from 1 / g.
   struct Rates {
     double rest_lp, rest_bias, nonin_lp, nonin_release, turn_lp, turn_release, acc, acc_rest,
         bias_motion, nonin_range, turn_range, turn_rate, gyro_sat_rad_s, acc_sat_m_s2, inv_g,
-        inv_g2;
+        inv_g2, nonin_one, turn_one, newton_a, newton_b;
   };
   Params params_;
   Rates rates_{};
