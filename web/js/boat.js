@@ -121,8 +121,13 @@ export function mountBoat(container, { live, role, params, navigate }) {
 
   // Alarms of this boat.
   if (has('/alarms/events')) {
+    // Renders overlap (an SSE alarm message and an ack's refresh): only the latest one started may
+    // draw, or a slow answer from before an ack puts the stale 'raised' state back for good.
+    let renders = 0;
     const renderAlarms = async () => {
+      const mine = ++renders;
       const events = await api(`/alarms/events${q({ boat: id, active: 'true' })}`);
+      if (mine !== renders) return;
       alarmsBox.replaceChildren(el('h2', { text: 'Active alarms' }),
         events.length ? el('ul', { class: 'events' }, events.map((ev) => eventItem(ev, role, renderAlarms)))
           : el('p', { class: 'empty', text: 'None.' }));
