@@ -477,9 +477,7 @@ void Pdr::on_step(double t_s) {
           // The phone may have begun to move a step or two before the waveforms said so: those
           // steps join the switch (re-laid at its end) and the gravity before them is the old
           // pose's.
-          const std::size_t back = std::min<std::size_t>(
-              last_count_, static_cast<std::size_t>(std::clamp(params_.switch_lookback_steps, 0,
-                                                               static_cast<int>(kLookback))));
+          const std::size_t back = last_count_;
           pre_switch_tilts_ = back > 0 ? last_tilts_before_[kLookback - back] : tilts_;
           for (std::size_t i = kLookback - back; i < kLookback; ++i)
             switch_[static_cast<std::size_t>(switch_steps_++)] = last_steps_[i];
@@ -613,10 +611,11 @@ void Pdr::on_step(double t_s) {
   }
   // Eq. (13) and eq. (11). The first step has no frequency yet: the person's usual walk.
   const double hz = out_.step_hz > 0.0 ? out_.step_hz : 1.8;
-  const double len = (per_event + missed) * lengths_.length_m(applied_pose_, params_.height_m, hz) *
-                     params_.step_scale[static_cast<std::size_t>(applied_pose_)];
+  const double step_m = lengths_.length_m(applied_pose_, params_.height_m, hz) *
+                        params_.step_scale[static_cast<std::size_t>(applied_pose_)];
+  const double len = (per_event + missed) * step_m;
   out_.last_step_length_m = len;
-  heading_.set_speed(len / (per_event + missed) * hz);
+  heading_.set_speed(step_m * hz);
   out_.distance_m += len;
   if (!foot && (!pose_known_ || !heading_.initialised())) {
     // At the start the pose (hence the walking frame and the heading) is not known yet: the

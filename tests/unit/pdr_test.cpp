@@ -65,6 +65,35 @@ TEST(HeadingFilter, FollowsAConstantRightTurn) {
   EXPECT_EQ(f.diagnostics().rejected_mag, 0u);
 }
 
+// A corner at walking speed (0.6 m radius, 1.4 m/s: 3.3 m/s^2 toward the centre) read by a
+// level sensor with a perfect magnetometer: the largest heading error in the 3 s after the corner,
+// with and without the walking speed known (the centripetal part taken out of the up direction).
+double worst_error_after_corner_deg(bool speed_known) {
+  HeadingFilter f;
+  if (speed_known) f.set_speed(1.4);
+  const double v = 1.4, radius = 0.6, w = v / radius, turn_s = 0.5 * M_PI / w;
+  double psi = 100.0 * kDeg, worst = 0.0;
+  for (int k = 0; k <= 400; ++k) {
+    const double t = k * 0.02;
+    const bool turning = t >= 2.0 && t < 2.0 + turn_s;  // a left turn: the heading falls
+    if (turning) psi -= w * 0.02;
+    const Eigen::Vector3d mag(20 * std::cos(psi), 20 * std::sin(psi), -44);
+    f.update(t, {0, 0, turning ? w : 0.0}, {0, turning ? v * w : 0.0, kG}, mag);
+    if (t > 2.0 + turn_s)
+      worst = std::max(worst, std::abs(std::remainder(f.heading_rad() - psi, 2 * M_PI)) / kDeg);
+  }
+  return worst;
+}
+
+TEST(HeadingFilter, CornerAtWalkingSpeedDoesNotTiltTheHeading) {
+  const double with = worst_error_after_corner_deg(true);
+  const double without = worst_error_after_corner_deg(false);
+  RecordProperty("worst_after_corner_deg", std::to_string(with));
+  RecordProperty("without_speed_deg", std::to_string(without));
+  EXPECT_LT(with, 1.0);
+  EXPECT_GT(without, 3.0 * with);  // what the correction is for
+}
+
 TEST(HeadingFilter, GyroOnlyWithoutMagnetometerAndRejectsNaN) {
   HeadingFilter f;
   const Eigen::Vector3d no_mag = Eigen::Vector3d::Constant(std::nan(""));

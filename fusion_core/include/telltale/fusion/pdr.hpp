@@ -222,7 +222,6 @@ struct PdrParams {
   double switch_tilt_deg = 15.0;       ///< ...if gravity also moved this much in the sensor frame
                                        ///< (twice this much is a switch whatever the correlation)
   int switch_exit_steps = 2;           ///< correlated steps needed to leave a switch
-  int switch_lookback_steps = 2;       ///< steps before its detection re-laid with a switch
   int pose_window_steps = 10;          ///< steps after a switch to confirm the new pose
   int pose_fallback_steps = 10;        ///< identical answers that change the pose without a switch
   double pose_gravity_deg = 45.0;      ///< a pose whose M does not bring gravity this close to
@@ -327,7 +326,7 @@ class Pdr {
   };
   static constexpr std::size_t kMaxSwitchSteps = 32;
   /// The last steps laid outside a switch, newest last: a switch is seen one or two steps after
-  /// the phone began to move, so those are re-laid with the switch (switch_lookback_steps).
+  /// the phone began to move, so those are re-laid with the switch.
   static constexpr std::size_t kLookback = 2;
   std::array<SwitchStep, kLookback> last_steps_{};
   std::array<std::array<Eigen::Vector3d, 2>, kLookback> last_tilts_before_{};
