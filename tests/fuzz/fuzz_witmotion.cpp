@@ -56,7 +56,9 @@ bool same_sample(const WitSample& a, const WitSample& b) {
 
 void check_sample(const WitSample& s, const WitMotionParams& p) {
   const double acc_max = p.acc_range_g * kG;
-  const double gyro_max = p.gyro_range_deg_s * M_PI / 180.0;
+  // The decoder's scale is range * (pi / 180) / 32768 and full scale 32768 counts: the bound must
+  // be formed the same way ((range * pi) / 180 can be one ulp below it; a fuzzed range found it).
+  const double gyro_max = p.gyro_range_deg_s * (M_PI / 180.0);
   FUZZ_CHECK(s.imu.acc_body_m_s2.allFinite());
   FUZZ_CHECK(s.imu.acc_body_m_s2.cwiseAbs().maxCoeff() <= acc_max);
   if (s.has_gyro) {
