@@ -51,6 +51,24 @@ TEST(GaitSim, AtRestTheSensorsSeeGravityAndTheEarthField) {
   }
 }
 
+// The phone's orientation is continuous when the walk starts and stops: its gyro never reads
+// more than the trunk and hand can turn it (a jump of the trunk sway at the first step once read
+// 11-22 rad/s for one sample, 13 deg of rotation that never happened).
+TEST(GaitSim, PhoneRateStaysPhysicalWhenTheWalkStartsAndStops) {
+  for (const char* name : {"phone-hand-held-walk", "phone-call-walk", "phone-pocket-walk"}) {
+    for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+      const auto run = simulate_gait(*make_gait_scenario(name, seed), random_person(seed), seed);
+      const double t_start = run.step_times_s.front();
+      const double t_stop = run.samples.back().imu.t_s - 2.0;  // standing 2 s after the walk
+      double worst = 0.0;
+      for (const auto& s : run.samples)
+        if (std::abs(s.imu.t_s - t_start) < 0.5 || std::abs(s.imu.t_s - t_stop) < 0.5)
+          worst = std::max(worst, s.imu.gyro_body_rad_s.norm());
+      EXPECT_LT(worst, 2.0) << name << " seed " << seed;
+    }
+  }
+}
+
 // Walking: the truth counts, distance and foot/body relation add up, and the mean vertical
 // specific force over the walk is g (no net vertical acceleration).
 TEST(GaitSim, TruthBookkeepingAddsUp) {

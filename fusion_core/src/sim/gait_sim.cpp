@@ -255,6 +255,7 @@ class Simulator {
     double step_hz = 0, step_len = 0;
     Gait gait = Gait::kWalk;
     bool moving = false;
+    double blend = 0.0;  ///< 0 standing .. 1 walking: trunk and arm motion build up and die out
   };
 
   [[nodiscard]] Body body(double t) const {
@@ -305,6 +306,14 @@ class Simulator {
     const double yaw_amp = (row.running ? 5.0 : 3.0) * kDeg;
     b.trunk = {2.0 * kDeg * std::cos(kTwoPi * b.stride_phase), 1.5 * kDeg * std::cos(kTwoPi * ph),
                yaw_amp * std::sin(kTwoPi * b.stride_phase)};
+    // The trunk's sway and the hand's tremor build up over the first step and die out over the
+    // last, so the phone's orientation stays continuous when the walk starts and stops (a jump
+    // is no rotation a body can make, and a gyro sampled at it read 11-22 rad/s for one sample).
+    // The arm swing needs no ramp: it is at the middle of its swing when a stride starts.
+    const double ramp_in = (t - steps_.front().t0) / steps_.front().period_s;
+    const double ramp_out = (t_end_ - t) / steps_.back().period_s;
+    b.blend = minjerk(std::clamp(std::min(ramp_in, ramp_out), 0.0, 1.0));
+    b.trunk *= b.blend;
     return b;
   }
 
@@ -334,7 +343,7 @@ class Simulator {
     const Eigen::Matrix3d mis =
         rot_z(p_.mount_yaw_deg[ip] * kDeg) * rot_y(p_.mount_tilt_deg[ip] * kDeg);
     const Eigen::Vector3d& tr = b.trunk;
-    const double still = b.moving ? 1.0 : 0.2;  // a person standing holds the phone steadier
+    const double still = 0.2 + 0.8 * b.blend;  // a person standing holds the phone steadier
     Eigen::Matrix3d osc = Eigen::Matrix3d::Identity();
     Eigen::Vector3d gain(1, 1, 1);
     acc_w = Eigen::Vector3d::Zero();
