@@ -417,6 +417,12 @@ Pdr::Wave Pdr::step_wave(double t0, double t1) const {
 
 void Pdr::on_step(double t_s) {
   const bool foot = params_.mount == StepMount::kFoot;
+  // How this step's heading depends on the hard-iron offset (mean over the step).
+  const bool have_mag_grad = mag_grad_n_ > 0;
+  const Eigen::Vector3d mag_grad =
+      have_mag_grad ? Eigen::Vector3d(mag_grad_sum_ / mag_grad_n_) : Eigen::Vector3d::Zero();
+  mag_grad_sum_.setZero();
+  mag_grad_n_ = 0;
   const std::array<Eigen::Vector3d, 2> tilts_before = tilts_;
   const double per_event = foot ? 2.0 : 1.0;  // a foot sensor sees one event per two steps
   // Steps the detector missed (our addition): its thresholds follow the last steps' peaks and
@@ -590,11 +596,29 @@ void Pdr::on_step(double t_s) {
   if (sum_sin_ != 0.0 || sum_cos_ != 0.0) heading = wrap_2pi(std::atan2(sum_sin_, sum_cos_));
   sum_sin_ = sum_cos_ = 0.0;
   ++yaw_steps_;
+  // The walking-direction sums of the last step count once this step shows that both were
+  // straight (a corner's centripetal acceleration would bias them).
+  const bool straight =
+      have_last_raw_ && std::abs(std::remainder(heading - last_raw_heading_rad_, kTwoPi)) <
+                            params_.straight_deg * M_PI / 180.0;
+  if (straight && last_straight_) {
+    yaw_fwd_ += last_fwd_;
+    yaw_left_ += last_left_;
+  }
+  last_fwd_ = step_fwd_;
+  last_left_ = step_left_;
+  step_fwd_ = step_left_ = 0.0;
+  last_straight_ = straight;
+  last_raw_heading_rad_ = heading;
+  have_last_raw_ = true;
+  double yaw_corr = 0.0;
   if (!foot && params_.walking_direction && yaw_steps_ >= params_.walking_direction_steps &&
       yaw_fwd_ > 0.0)
-    heading = wrap_2pi(heading - static_cast<double>(yaw_steps_) /
-                                     (yaw_steps_ + params_.walking_direction_prior_steps) *
-                                     std::atan2(yaw_left_, yaw_fwd_));
+    yaw_corr = static_cast<double>(yaw_steps_) /
+               (yaw_steps_ + params_.walking_direction_prior_steps) *
+               std::atan2(yaw_left_, yaw_fwd_);
+  if (params_.revise_track && !switching_) revise_pose_yaw(yaw_corr);
+  heading = wrap_2pi(heading - yaw_corr);
   const double step_heading = heading;
   const Eigen::Vector2d step_axis_x = axis_sum_[0], step_axis_z = axis_sum_[1];
   axis_sum_[0].setZero();
@@ -623,9 +647,22 @@ void Pdr::on_step(double t_s) {
     pending_m_ += len;
     return;
   }
-  out_.x_m += (len + pending_m_) * std::sin(heading);
-  out_.y_m += (len + pending_m_) * std::cos(heading);
+  const double laid_m = len + pending_m_;
+  out_.x_m += laid_m * std::sin(heading);
+  out_.y_m += laid_m * std::cos(heading);
   pending_m_ = 0.0;
+  if (!switching_) {
+    pose_disp_ += laid_m * Eigen::Vector2d(std::sin(heading), std::cos(heading));
+    ++pose_steps_;
+    if (params_.revise_track && params_.calibrate_mag && have_mag_grad) {
+      // d(east, north)/dheading times dheading/doffset: how this step moves per uT of offset.
+      const Eigen::Matrix<double, 2, 3> a =
+          laid_m * Eigen::Vector2d(std::cos(heading), -std::sin(heading)) * mag_grad.transpose();
+      mag_a_ += a;
+      mag_c_ += a * mag_cal_.offset_uT();
+    }
+  }
+  if (params_.revise_track) revise_mag_offset();
   SwitchStep laid;  // what a later re-laying of this step needs
   laid.length_m = len;
   laid.laid_rad = heading;
@@ -653,8 +690,65 @@ void Pdr::on_step(double t_s) {
 
 void Pdr::reset_walking_direction() {
   yaw_fwd_ = yaw_left_ = 0.0;
+  step_fwd_ = step_left_ = last_fwd_ = last_left_ = 0.0;
+  have_last_raw_ = last_straight_ = false;
   yaw_steps_ = 0;
   have_av_ = false;
+  // The steps of the pose that ends keep the correction they have.
+  pose_disp_.setZero();
+  pose_corr_rad_ = 0.0;
+  pose_steps_ = 0;
+}
+
+void Pdr::revise_pose_yaw(double corr) {
+  // The pose's steps were laid with heading - pose_corr_rad_; with the better estimate they turn
+  // about the point where the pose began (headings clockwise, so east/north turn the other way).
+  const double d = corr - pose_corr_rad_;
+  if (d == 0.0) return;
+  const double c = std::cos(d), sn = std::sin(d);
+  const Eigen::Vector2d turned(pose_disp_.x() * c - pose_disp_.y() * sn,
+                               pose_disp_.y() * c + pose_disp_.x() * sn);
+  out_.x_m += turned.x() - pose_disp_.x();
+  out_.y_m += turned.y() - pose_disp_.y();
+  pose_disp_ = turned;
+  pose_corr_rad_ = corr;
+  // Steps a later switch may re-lay must know the heading they now have.
+  const std::size_t n = std::min(last_count_, pose_steps_);
+  for (std::size_t i = kLookback - n; i < kLookback; ++i)
+    last_steps_[i].laid_rad = wrap_2pi(last_steps_[i].laid_rad - d);
+}
+
+void Pdr::revise_mag_offset() {
+  // First order in the heading change (a few degrees at most: a 1 uT offset in a 20 uT
+  // horizontal field is 3 deg).
+  const Eigen::Vector2d corr = mag_a_ * mag_cal_.offset_uT() - mag_c_;
+  out_.x_m += corr.x() - mag_applied_.x();
+  out_.y_m += corr.y() - mag_applied_.y();
+  mag_applied_ = corr;
+}
+
+void Pdr::learn_gyro_bias(const ImuSample& s) {
+  if (still_n_ == 0) still_t0_ = s.t_s;
+  ++still_n_;
+  still_w_ += s.gyro_body_rad_s;
+  still_w2_ += s.gyro_body_rad_s.squaredNorm();
+  const double a = s.acc_body_m_s2.norm();
+  still_a_ += a;
+  still_a2_ += a * a;
+  if (s.t_s - still_t0_ < params_.still_window_s) return;
+  const double n = still_n_;
+  const Eigen::Vector3d mean_w = still_w_ / n;
+  const double var_w = still_w2_ / n - mean_w.squaredNorm();
+  const double mean_a = still_a_ / n, var_a = still_a2_ / n - mean_a * mean_a;
+  if (still_n_ >= 10 && var_w < params_.still_gyro_std_rad_s * params_.still_gyro_std_rad_s &&
+      var_a < params_.still_acc_std_m_s2 * params_.still_acc_std_m_s2 &&
+      mean_w.norm() < params_.still_max_bias_rad_s) {
+    ++diag_.still_windows;
+    gyro_bias_ += (mean_w - gyro_bias_) / std::min(diag_.still_windows, 10u);
+  }
+  still_n_ = 0;
+  still_w_.setZero();
+  still_w2_ = still_a_ = still_a2_ = 0.0;
 }
 
 void Pdr::relay_switch_steps(double heading_after) {
@@ -718,11 +812,17 @@ void Pdr::relay_switch_steps(double heading_after) {
   }
 }
 
-const PdrOutput& Pdr::update(const ImuSample& s, const Eigen::Vector3d& mag_uT) {
+const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT) {
   out_.step = false;
-  if (!std::isfinite(s.t_s) || !s.acc_body_m_s2.allFinite() || (have_t_ && !(s.t_s > last_t_s_))) {
+  if (!std::isfinite(raw.t_s) || !raw.acc_body_m_s2.allFinite() ||
+      (have_t_ && !(raw.t_s > last_t_s_))) {
     ++diag_.rejected_non_finite;
     return out_;
+  }
+  ImuSample s = raw;
+  if (gyro_ok(s)) {
+    learn_gyro_bias(s);
+    s.gyro_body_rad_s -= gyro_bias_;
   }
   have_t_ = true;
   last_t_s_ = s.t_s;
@@ -765,8 +865,8 @@ const PdrOutput& Pdr::update(const ImuSample& s, const Eigen::Vector3d& mag_uT) 
       if (fwd.norm() > 0.3) {
         fwd.normalize();
         const Eigen::Vector3d left = up.cross(fwd);
-        yaw_fwd_ += a.dot(fwd) * dav;
-        yaw_left_ += a.dot(left) * dav;
+        step_fwd_ += a.dot(fwd) * dav;
+        step_left_ += a.dot(left) * dav;
       }
     }
     last_av_ = av;
@@ -785,6 +885,13 @@ const PdrOutput& Pdr::update(const ImuSample& s, const Eigen::Vector3d& mag_uT) 
     const Eigen::Vector3d x = Eigen::Vector3d::UnitX() - up.x() * up;
     const Eigen::Vector3d z = -Eigen::Vector3d::UnitZ() + up.z() * up;
     const Eigen::Vector2d hx(x.dot(east), x.dot(north)), hz(z.dot(east), z.dot(north));
+    // A change db of the hard-iron offset turns north toward east by east.db / H (H the
+    // horizontal field; |east| = |north| = H here), so every heading grows by east.db / H^2.
+    const double h2 = north.squaredNorm();
+    if (h2 > 1.0) {
+      mag_grad_sum_ += east / h2;
+      ++mag_grad_n_;
+    }
     if (hx.norm() > 1e-9) axis_sum_[0] += hx.normalized();
     if (hz.norm() > 1e-9) axis_sum_[1] += hz.normalized();
   }

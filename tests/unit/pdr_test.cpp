@@ -220,14 +220,91 @@ TEST(Pdr, DetectsPoseSwitchesAndEndsInTheTruePose) {
   EXPECT_NEAR(std::atan2(pdr.output().x_m, pdr.output().y_m) / kDeg, 0.0, 5.0);
 }
 
+// Given a phone still in a pocket with a gyro bias, then the PDR learns the bias from the still
+// windows; when the walk starts, the windows stop (|f| and the rate vary) and the bias is kept.
+// (A hand-held phone's tremor, 0.11 rad/s in the simulator, is too much motion to learn from.)
+TEST(Pdr, LearnsTheGyroBiasWhileStillAndKeepsItWalking) {
+  auto sc = *sim::make_gait_scenario("phone-pocket-walk", 21);
+  sc.standing_s = 6.0;
+  sc.errors.gyro_bias_rad_s = 0.02;  // per axis, 1.1 deg/s
+  const auto person = sim::random_person(21);
+  const auto run = sim::simulate_gait(sc, person, 21);
+  // The bias the simulator drew: the mean rate while standing (the hand's tremor averages out).
+  Eigen::Vector3d truth = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (const auto& s : run.samples)
+    if (s.imu.t_s < 5.5) {
+      truth += s.imu.gyro_body_rad_s;
+      ++n;
+    }
+  truth /= n;
+  PdrParams p;
+  p.height_m = person.height_m;
+  Pdr pdr(p);
+  unsigned windows_before_walk = 0, windows_at_walk_end = 0;
+  const double walk_end_s = run.step_times_s.back();
+  Eigen::Vector3d bias_before_walk = Eigen::Vector3d::Zero();
+  for (const auto& s : run.samples) {
+    (void)pdr.update(s.imu, s.mag_uT);
+    if (s.imu.t_s < 6.0) {
+      windows_before_walk = pdr.diagnostics().still_windows;
+      bias_before_walk = pdr.gyro_bias_rad_s();
+    }
+    if (s.imu.t_s < walk_end_s) windows_at_walk_end = pdr.diagnostics().still_windows;
+  }
+  EXPECT_GE(windows_before_walk, 4u);
+  EXPECT_LT((bias_before_walk - truth).norm(), 0.003);
+  EXPECT_GT(truth.norm(), 0.01);
+  // Walking adds no window (one may close in the first step), and the bias stays learnt.
+  EXPECT_LE(windows_at_walk_end, windows_before_walk + 1u);
+  EXPECT_LT((pdr.gyro_bias_rad_s() - truth).norm(), 0.003);
+}
+
+// Given loops walked with the phone at the ear (a hard-iron offset the magnetometer calibration
+// only learns at the first corner), then re-laying the steps already walked when the offset is
+// known closes the loops far better: 20 walks, measured median 0.86 % with, 1.65 % without, and
+// 18 within 2 % against 14.
+TEST(Pdr, RevisingTheTrackWithTheLearntHardIronClosesLoops) {
+  std::vector<double> with, without;
+  for (int i = 0; i < 20; ++i) {
+    const auto seed = static_cast<std::uint64_t>(2001 + i);
+    auto sc = *sim::make_gait_scenario("loop", seed);
+    for (auto& seg : sc.segments) seg.pose = PhonePose::kCall;
+    const auto person = sim::random_person(seed);
+    const auto run = sim::simulate_gait(sc, person, seed);
+    for (const bool revise : {true, false}) {
+      PdrParams p;
+      p.height_m = person.height_m;
+      p.step_scale.fill(sim::personal_step_scale(person, seed + 1000003));
+      p.revise_track = revise;
+      Pdr pdr(p);
+      for (const auto& s : run.samples) (void)pdr.update(s.imu, s.mag_uT);
+      const auto& last = run.samples.back();
+      (revise ? with : without)
+          .push_back(std::hypot(pdr.output().x_m - last.x_m, pdr.output().y_m - last.y_m) /
+                     run.distance_m);
+    }
+  }
+  std::sort(with.begin(), with.end());
+  std::sort(without.begin(), without.end());
+  const auto within = [](const std::vector<double>& v) {
+    return std::count_if(v.begin(), v.end(), [](double e) { return e <= 0.02; });
+  };
+  RecordProperty("median_percent_revised", std::to_string(100 * with[10]));
+  RecordProperty("median_percent_not_revised", std::to_string(100 * without[10]));
+  RecordProperty("within_2_percent_revised", std::to_string(within(with)));
+  RecordProperty("within_2_percent_not_revised", std::to_string(within(without)));
+  EXPECT_LT(with[10], 0.75 * without[10]);
+  EXPECT_GE(within(with), within(without) + 3);
+}
+
 // Issue 5's closed-loop target: end-point error <= 2 % of the distance in >= 90 % of walks (seed
 // 003: 85 %). With this simulator's sensor error model that is NOT reached. Measured (fusion_cli
 // steps-eval --tables pdr, seeds 2001-2040, each person first calibrated by a 100 m hand-held
-// walk): 25 of 40 walks within 2 %, median 1.83 %, 90th percentile 3.58 % (22 of 40, 1.98 %,
-// 3.90 % before the centripetal correction of the up direction). Step length is not what is
-// left: with the true heading at every step the estimated lengths alone end within 2 % in 36 of
-// 40; the rest is the heading (hard-iron residual, per-pose offsets, steps of pose switches).
-// These 20 walks measure median 1.90 %, 13 within 2 %, 18th 2.68 %; the test holds that line.
+// walk): 28 of 40 walks within 2 %, median 1.37 %, 90th percentile 2.57 % (25 of 40, 1.83 %,
+// 3.58 % before the track revision, the straight-step yaw estimate and the still gyro bias; in
+// one pose without switches 37 of 40). These 20 walks measure median 1.37 %, 15 within 2 %, 18th
+// 2.31 %; the test holds that line.
 TEST(Pdr, ClosedLoopsWithPoseSwitchesMeasuredFigures) {
   std::vector<double> err;
   for (int i = 0; i < 20; ++i)
@@ -236,9 +313,10 @@ TEST(Pdr, ClosedLoopsWithPoseSwitchesMeasuredFigures) {
   const auto within = std::count_if(err.begin(), err.end(), [](double e) { return e <= 0.02; });
   RecordProperty("within_2_percent", std::to_string(within));
   RecordProperty("median_percent", std::to_string(100 * err[10]));
-  EXPECT_LE(err[10], 0.020);
-  EXPECT_GE(within, 13);
-  EXPECT_LE(err[17], 0.030);
+  RecordProperty("18th_percent", std::to_string(100 * err[17]));
+  EXPECT_LE(err[10], 0.016);
+  EXPECT_GE(within, 14);
+  EXPECT_LE(err[17], 0.026);
 }
 
 // One 100 m hand-held walk of known length per person fixes the distance for every pose: the

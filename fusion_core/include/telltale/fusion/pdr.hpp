@@ -16,9 +16,11 @@
 /// the one or two before it was detected, re-laid with the heading each really had once the new
 /// pose is known; steps the detector left in a gap of several intervals counted; the phone's yaw
 /// from the walking direction removed using the step's acceleration pattern (shrunk toward 0
-/// while the pose is young); the centripetal acceleration of turns taken out before the up
-/// direction follows the accelerometer; a personal step-length factor from one calibration walk
-/// of known length (PdrParams::step_scale).
+/// while the pose is young, from straight steps only); the centripetal acceleration of turns
+/// taken out before the up direction follows the accelerometer; steps already walked re-laid when
+/// the hard-iron offset or the pose's yaw estimate improves (PdrParams::revise_track); the gyro
+/// bias learnt while standing still; a personal step-length factor from one calibration walk of
+/// known length (PdrParams::step_scale).
 ///
 /// Frames: the phone's sensor axes are whatever the phone has; the walking frame is x forward, y
 /// left, z up with `v_walking = M_pose v_sensor` (M = I for hand-held and arm swing). Position is
@@ -235,9 +237,24 @@ struct PdrParams {
   int walking_direction_steps = 1;     ///< steps in a pose before the correction applies
   /// The correction after n steps in a pose is n / (n + this) of the estimate: a per-pose yaw
   /// of about 2 deg rms is no larger than the estimate's own noise after a few dozen steps, so a
-  /// young estimate is shrunk toward 0 (tuned on seeds 100-139: residual yaw 2.04 deg rms
-  /// uncorrected, 1.94 applied in full after 16 steps, 1.76 with 32 here from the first step).
+  /// young estimate is shrunk toward 0. Only steps walked straight (this and the neighbouring
+  /// step within straight_deg of each other) feed the estimate: in a corner the centripetal
+  /// acceleration starts and stops within a step and correlates with the vertical's derivative
+  /// (end-of-pose error, seeds 100-139: hand-held 1.13 -> 0.47 deg rms, phone call 0.73 -> 0.14).
   double walking_direction_prior_steps = 32.0;
+  /// Re-lay steps already walked when an estimate they were laid with improves (our addition):
+  /// the hard-iron offset (each step's heading moves by its sensitivity to the offset, so the
+  /// leg walked before the first corner calibrated the magnetometer is corrected too) and the
+  /// pose's yaw from the walking direction (every step since the pose began turns with it).
+  bool revise_track = true;
+  /// Gyro bias from standing still (our addition): a window of this length in which the rate
+  /// and |f| vary less than the limits below gives the bias as its mean rate (the average of the
+  /// last 10 such windows is subtracted from every sample). A mean rate above
+  /// still_max_bias_rad_s is a slow steady turn (a vehicle), not a bias.
+  double still_window_s = 1.0;
+  double still_gyro_std_rad_s = 0.03;
+  double still_acc_std_m_s2 = 0.15;
+  double still_max_bias_rad_s = 0.1;
   /// Personal factor on the model's step length, per pose (1 = the population model). Set it from
   /// a calibration walk of known length: known distance / `output().distance_m` of that walk.
   std::array<double, kPoseCount> step_scale{1.0, 1.0, 1.0, 1.0};
@@ -272,6 +289,7 @@ class Pdr {
     unsigned pose_changes = 0;       ///< classified pose changes applied
     unsigned replaced_headings = 0;  ///< steps that used the pre-switch heading
     unsigned filled_steps = 0;       ///< steps added for gaps the detector left
+    unsigned still_windows = 0;      ///< still windows that set the gyro bias
   };
   /// `net` and `lengths` default to the built-in model; they are copied.
   explicit Pdr(Params params = {}, const PoseNetwork& net = builtin_pose_network(),
@@ -282,6 +300,8 @@ class Pdr {
   [[nodiscard]] const Diagnostics& diagnostics() const { return diag_; }
   [[nodiscard]] const StepDiagnostics& step_diagnostics() const;
   [[nodiscard]] const HardIronCalibrator& mag_calibration() const { return mag_cal_; }
+  /// Gyro bias learnt while still (sensor frame, rad/s; subtracted from every sample).
+  [[nodiscard]] const Eigen::Vector3d& gyro_bias_rad_s() const { return gyro_bias_; }
   /// Step frequencies seen at each step so far are not stored (no heap); for calibration, collect
   /// `output().step_hz` at every step in the caller.
 
@@ -333,9 +353,35 @@ class Pdr {
   std::size_t last_count_ = 0;
   void relay_switch_steps(double heading_after);
   void reset_walking_direction();
-  // Correlation of the horizontal acceleration with d(vertical)/dt in the pose's walking frame.
+  void learn_gyro_bias(const ImuSample& s);
+  /// Turns the steps laid in this pose so far with a new yaw correction `corr` (rad).
+  void revise_pose_yaw(double corr);
+  /// Moves the track by what the current hard-iron offset changes in every step laid so far.
+  void revise_mag_offset();
+  // Correlation of the horizontal acceleration with d(vertical)/dt in the pose's walking frame:
+  // the sums of straight steps, of the step in progress, and of the last step (kept until the
+  // next one shows whether it was straight).
   double yaw_fwd_ = 0.0, yaw_left_ = 0.0;
+  double step_fwd_ = 0.0, step_left_ = 0.0, last_fwd_ = 0.0, last_left_ = 0.0;
+  double last_raw_heading_rad_ = 0.0;
+  bool have_last_raw_ = false, last_straight_ = false;
   int yaw_steps_ = 0;
+  // Track revision for the pose's yaw: displacement of the steps laid in this pose (as laid),
+  // the correction they carry, and how many there are.
+  Eigen::Vector2d pose_disp_ = Eigen::Vector2d::Zero();
+  double pose_corr_rad_ = 0.0;
+  std::size_t pose_steps_ = 0;
+  // Track revision for the hard-iron offset: over all laid steps, sum of L dpos/dheading
+  // (dheading/doffset)^T (east, north per uT) and of the same times the offset each was laid
+  // with; the correction already applied. Over the current step: sum of dheading/doffset.
+  Eigen::Matrix<double, 2, 3> mag_a_ = Eigen::Matrix<double, 2, 3>::Zero();
+  Eigen::Vector2d mag_c_ = Eigen::Vector2d::Zero(), mag_applied_ = Eigen::Vector2d::Zero();
+  Eigen::Vector3d mag_grad_sum_ = Eigen::Vector3d::Zero();
+  int mag_grad_n_ = 0;
+  // Still windows for the gyro bias.
+  double still_t0_ = 0.0, still_w2_ = 0.0, still_a_ = 0.0, still_a2_ = 0.0;
+  Eigen::Vector3d still_w_ = Eigen::Vector3d::Zero(), gyro_bias_ = Eigen::Vector3d::Zero();
+  int still_n_ = 0;
   double last_av_ = 0.0, last_av_t_ = 0.0;
   bool have_av_ = false;
   std::array<SwitchStep, kMaxSwitchSteps> switch_{};
