@@ -595,15 +595,18 @@ void Pdr::on_step(double t_s) {
   double heading = heading_.heading_rad();
   if (sum_sin_ != 0.0 || sum_cos_ != 0.0) heading = wrap_2pi(std::atan2(sum_sin_, sum_cos_));
   sum_sin_ = sum_cos_ = 0.0;
-  ++yaw_steps_;
   // The walking-direction sums of the last step count once this step shows that both were
   // straight (a corner's centripetal acceleration would bias them).
   const bool straight =
       have_last_raw_ && std::abs(std::remainder(heading - last_raw_heading_rad_, kTwoPi)) <
                             params_.straight_deg * M_PI / 180.0;
-  if (straight && last_straight_) {
+  if (straight && last_straight_ && last_fwd_ > 0.0) {
     yaw_fwd_ += last_fwd_;
     yaw_left_ += last_left_;
+    const double a = std::atan2(last_left_, last_fwd_);
+    step_yaw_sum_ += a;
+    step_yaw_sq_ += a * a;
+    ++straight_steps_;
   }
   last_fwd_ = step_fwd_;
   last_left_ = step_left_;
@@ -612,11 +615,13 @@ void Pdr::on_step(double t_s) {
   last_raw_heading_rad_ = heading;
   have_last_raw_ = true;
   double yaw_corr = 0.0;
-  if (!foot && params_.walking_direction && yaw_steps_ >= params_.walking_direction_steps &&
-      yaw_fwd_ > 0.0)
-    yaw_corr = static_cast<double>(yaw_steps_) /
-               (yaw_steps_ + params_.walking_direction_prior_steps) *
-               std::atan2(yaw_left_, yaw_fwd_);
+  if (!foot && params_.walking_direction &&
+      straight_steps_ >= std::max(2, params_.walking_direction_steps) && yaw_fwd_ > 0.0) {
+    const double n = straight_steps_, mean = step_yaw_sum_ / n;
+    const double se2 = std::max(0.0, step_yaw_sq_ / n - mean * mean) / (n - 1.0);
+    const double prior2 = std::pow(params_.walking_direction_prior_deg * M_PI / 180.0, 2);
+    yaw_corr = prior2 / (prior2 + se2) * std::atan2(yaw_left_, yaw_fwd_);
+  }
   if (params_.revise_track && !switching_) revise_pose_yaw(yaw_corr);
   heading = wrap_2pi(heading - yaw_corr);
   const double step_heading = heading;
@@ -692,7 +697,8 @@ void Pdr::reset_walking_direction() {
   yaw_fwd_ = yaw_left_ = 0.0;
   step_fwd_ = step_left_ = last_fwd_ = last_left_ = 0.0;
   have_last_raw_ = last_straight_ = false;
-  yaw_steps_ = 0;
+  step_yaw_sum_ = step_yaw_sq_ = 0.0;
+  straight_steps_ = 0;
   have_av_ = false;
   // The steps of the pose that ends keep the correction they have.
   pose_disp_.setZero();

@@ -234,14 +234,15 @@ struct PdrParams {
   double fill_max_gap_s = 4.0;         ///< ...if shorter than this...
   double fill_min_energy = 0.5;        ///< ...and the phone's acceleration energy says walking
   bool walking_direction = true;       ///< correct the phone's yaw from the acceleration pattern
-  int walking_direction_steps = 1;     ///< steps in a pose before the correction applies
-  /// The correction after n steps in a pose is n / (n + this) of the estimate: a per-pose yaw
-  /// of about 2 deg rms is no larger than the estimate's own noise after a few dozen steps, so a
-  /// young estimate is shrunk toward 0. Only steps walked straight (this and the neighbouring
-  /// step within straight_deg of each other) feed the estimate: in a corner the centripetal
-  /// acceleration starts and stops within a step and correlates with the vertical's derivative
-  /// (end-of-pose error, seeds 100-139: hand-held 1.13 -> 0.47 deg rms, phone call 0.73 -> 0.14).
-  double walking_direction_prior_steps = 32.0;
+  int walking_direction_steps = 4;     ///< straight steps in a pose before the correction applies
+  /// How far a phone is yawed in a hand or pocket, rms (a few degrees). The estimate is shrunk
+  /// toward 0 by prior^2 / (prior^2 + s^2), s its standard error from the scatter of the steps'
+  /// own angles, so a noisy estimate (a pocket, a swinging arm) corrects little and a clean one
+  /// (hand-held, at the ear) almost in full. Only steps walked straight (this and the neighbouring
+  /// step within straight_deg of each other) feed it: in a corner the centripetal acceleration
+  /// starts and stops within a step and correlates with the vertical's derivative (end-of-pose
+  /// error, seeds 100-139: hand-held 1.13 -> 0.47 deg rms, phone call 0.73 -> 0.14).
+  double walking_direction_prior_deg = 2.0;
   /// Re-lay steps already walked when an estimate they were laid with improves (our addition):
   /// the hard-iron offset (each step's heading moves by its sensitivity to the offset, so the
   /// leg walked before the first corner calibrated the magnetometer is corrected too) and the
@@ -365,7 +366,9 @@ class Pdr {
   double step_fwd_ = 0.0, step_left_ = 0.0, last_fwd_ = 0.0, last_left_ = 0.0;
   double last_raw_heading_rad_ = 0.0;
   bool have_last_raw_ = false, last_straight_ = false;
-  int yaw_steps_ = 0;
+  // Per straight step: sum and sum of squares of its own yaw angle, and how many.
+  double step_yaw_sum_ = 0.0, step_yaw_sq_ = 0.0;
+  int straight_steps_ = 0;
   // Track revision for the pose's yaw: displacement of the steps laid in this pose (as laid),
   // the correction they carry, and how many there are.
   Eigen::Vector2d pose_disp_ = Eigen::Vector2d::Zero();
