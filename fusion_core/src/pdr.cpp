@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "pose_bp_data.hpp"
+#include "telltale/fusion/attitude.hpp"
 
 namespace telltale::fusion {
 namespace {
@@ -455,6 +456,7 @@ void Pdr::on_step(double t_s) {
   const double f = out_.step_hz;
   out_.gait = f < 1.6 ? 0 : f < 1.95 ? 1 : f < 2.35 ? 2 : f < 2.75 ? 3 : 4;
 
+  if (!foot && tilt_n_ > 0) learn_acc_bias(t_s);
   if (!foot) {
     // Pose switch (seed 003): cross-correlation of this step's waveform with the same foot's
     // previous one. A turn also changes the waveform, so we add a condition of our own: the
@@ -490,6 +492,7 @@ void Pdr::on_step(double t_s) {
           last_count_ = 0;
           reset_walking_direction();
           ++diag_.switches;
+          forget_vertical_field();
           // If the 3 steps before the switch were straight, their mean heading stands in for
           // the heading during the switch. The comparison spans two steps, so the switch may
           // have begun during the latest step: the 3 steps before the re-laid ones (at least
@@ -580,7 +583,10 @@ void Pdr::on_step(double t_s) {
           sum_sin_ = sum_cos_ = 0.0;
         }
         if (pose_known_ && candidate_pose_ != applied_pose_) ++diag_.pose_changes;
-        if (candidate_pose_ != applied_pose_) reset_walking_direction();
+        if (candidate_pose_ != applied_pose_) {
+          reset_walking_direction();
+          forget_vertical_field();
+        }
         applied_pose_ = candidate_pose_;
         pose_known_ = true;
       }
@@ -608,6 +614,7 @@ void Pdr::on_step(double t_s) {
     step_yaw_sq_ += a * a;
     ++straight_steps_;
   }
+  if (applied_pose_ == PhonePose::kArmSwing) swing_axis_direction();
   last_fwd_ = step_fwd_;
   last_left_ = step_left_;
   step_fwd_ = step_left_ = 0.0;
@@ -693,7 +700,87 @@ void Pdr::on_step(double t_s) {
   out_.heading_deg = heading * 180.0 / M_PI;
 }
 
+void Pdr::swing_axis_direction() {
+  // Arm swing: the acceleration pattern is the arm's, not the trunk's, and says little about the
+  // walking direction (2.8 deg rms per pose in the simulator). The arm swings in the walking
+  // direction's vertical plane, so the step's principal rotation axis, made horizontal, is the
+  // walking frame's left; forward = left x up. The pattern's step sums are replaced by that unit
+  // direction (the arm's swing rate is ~1 rad/s, its gyro noise and bias ~0.01 rad/s).
+  const Eigen::Matrix3d sw = step_swing_;
+  step_swing_.setZero();
+  step_fwd_ = step_left_ = 0.0;
+  if (!(sw.trace() > 0.0)) return;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(sw);
+  const Eigen::Vector3d& up = heading_.state().up;
+  Eigen::Vector3d axis = eig.eigenvectors().col(2);
+  // The swing must dominate: a stronger second axis (no swing, a turn, a hand moving about)
+  // leaves the step without an estimate.
+  if (!(eig.eigenvalues()[2] > params_.swing_axis_ratio * eig.eigenvalues()[1])) return;
+  axis -= axis.dot(up) * up;
+  Eigen::Vector3d fwd = Eigen::Vector3d::UnitX() - up.x() * up;
+  if (axis.norm() < 0.5 || fwd.norm() < 0.3) return;
+  fwd.normalize();
+  const Eigen::Vector3d left = up.cross(fwd);
+  if (axis.dot(left) < 0.0) axis = -axis;
+  const Eigen::Vector3d walk = axis.normalized().cross(up);
+  step_fwd_ = walk.dot(fwd);
+  step_left_ = walk.dot(left);
+}
+
+void Pdr::learn_acc_bias(double t_s) {
+  // The earth field's vertical component is the same wherever the walker faces. Up tilted by
+  // an angle d (a vector across up, rad) reads m.up + m_h.d, where m_h is the horizontal field
+  // in the sensor frame, which turns round as the walker turns: a tilt fixed in the phone shows
+  // as a vertical field that changes with the heading. An accelerometer bias b tilts up by
+  // b_h / g (its part across up), so, with the bias already removed (acc_bias_) and C the
+  // vertical field plus the hard-iron residual along up (constant while the phone sits the same
+  // way, free after a pose change):
+  //   m.up + m_h.acc_bias_ / g = C + m_h.b / g.
+  // One measurement per step (the step's means), a Kalman filter for [C, b].
+  const double n = tilt_n_;
+  const double z = tilt_z_sum_ / n;
+  const Eigen::Vector3d r = tilt_r_sum_ / n;
+  // A better hard-iron offset moves the corrected field, and C with it, by the change along up.
+  const Eigen::Vector3d offset = mag_cal_.offset_uT();
+  acc_x_[0] -= (offset - tilt_offset_uT_).dot(tilt_up_sum_ / n);
+  tilt_offset_uT_ = offset;
+  tilt_z_sum_ = 0.0;
+  tilt_r_sum_.setZero();
+  tilt_up_sum_.setZero();
+  tilt_n_ = 0;
+  if (tilt_t_s_ >= 0.0)
+    acc_p_(0, 0) += params_.acc_bias_vertical_walk_uT * params_.acc_bias_vertical_walk_uT *
+                    std::max(0.0, t_s - tilt_t_s_);
+  tilt_t_s_ = t_s;
+  Eigen::Vector4d h;
+  h << 1.0, r;
+  const double var = params_.acc_bias_step_noise_uT * params_.acc_bias_step_noise_uT;
+  const double innovation = z - h.dot(acc_x_);
+  const double s = h.dot(acc_p_ * h) + var;
+  // A magnetic disturbance (steel, a car) moves the vertical field by far more than a bias can.
+  if (innovation * innovation > 25.0 * s) return;
+  const Eigen::Vector4d k = acc_p_ * h / s;
+  acc_x_ += k * innovation;
+  acc_p_ -= k * h.transpose() * acc_p_;
+  // Past a few times the prior the estimate is no bias (a field that is not the earth's):
+  // the last plausible one stays.
+  if (acc_x_.tail<3>().norm() < 5.0 * params_.acc_bias_prior_m_s2) acc_bias_ = acc_x_.tail<3>();
+}
+
+void Pdr::forget_vertical_field() {
+  // The phone now sits another way: the hard-iron residual along up, hence C, is new.
+  acc_p_.row(0).setZero();
+  acc_p_.col(0).setZero();
+  acc_p_(0, 0) = 1e4;
+  tilt_settled_t_s_ = last_t_s_ + 3.0 * params_.heading.up_tau_s;
+  tilt_z_sum_ = 0.0;
+  tilt_r_sum_.setZero();
+  tilt_up_sum_.setZero();
+  tilt_n_ = 0;
+}
+
 void Pdr::reset_walking_direction() {
+  step_swing_.setZero();
   yaw_fwd_ = yaw_left_ = 0.0;
   step_fwd_ = step_left_ = last_fwd_ = last_left_ = 0.0;
   have_last_raw_ = last_straight_ = false;
@@ -853,7 +940,24 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
     mag_cal_.update(s.t_s, s.gyro_body_rad_s, mag);
     mag = mag_cal_.corrected(mag);
   }
-  heading_.update(s.t_s, m * s.gyro_body_rad_s, m * s.acc_body_m_s2, m * mag);
+  heading_.update(s.t_s, m * s.gyro_body_rad_s, m * (s.acc_body_m_s2 - acc_bias_), m * mag);
+  if (!foot && !switching_ && params_.learn_acc_bias && mag.allFinite() && heading_.initialised() &&
+      gyro_ok(s) && applied_pose_ != PhonePose::kArmSwing && s.t_s > tilt_settled_t_s_) {
+    // What the field's vertical component says about the up direction (learn_acc_bias). Not in
+    // turns: what is left of the centripetal acceleration tilts up with the turn, in step with
+    // the change of heading the estimate feeds on. Not in arm swing: the pendulum's acceleration
+    // tilts up in step with the swing, which also turns the horizontal field in the phone. Not
+    // while up settles after the phone moved (a few of the up filter's time constants).
+    const Eigen::Vector3d up = m.transpose() * heading_.state().up;
+    const double vertical = mag.dot(up);
+    if (std::abs(s.gyro_body_rad_s.dot(up)) < params_.acc_bias_max_turn_rad_s) {
+    const Eigen::Vector3d r = (mag - vertical * up) / kStandardGravity_m_s2;
+    tilt_z_sum_ += vertical + r.dot(acc_bias_);
+    tilt_r_sum_ += r;
+    tilt_up_sum_ += up;
+    ++tilt_n_;
+    }
+  }
   if (!foot && !switching_ && params_.walking_direction && gyro_ok(s)) {
     // Walking direction from the acceleration pattern of the step (our addition): the trunk
     // brakes after heel strike and speeds up before the next one, so the forward acceleration
@@ -863,6 +967,13 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
     // walking frame is how far the phone is yawed from the walking direction (2 deg rms per
     // pose in the simulator, and what a hand really does).
     const Eigen::Vector3d& up = heading_.state().up;
+    if (applied_pose_ == PhonePose::kArmSwing) {
+      // A swinging arm turns the phone about the shoulder's axis, across the walking direction
+      // whatever the phone's yaw in the hand: its rotations are summed for the step's principal
+      // axis (swing_axis_direction).
+      const Eigen::Vector3d w = m * s.gyro_body_rad_s;
+      step_swing_.noalias() += w * w.transpose();
+    }
     const Eigen::Vector3d a = m * s.acc_body_m_s2;
     const double av = a.dot(up);
     if (have_av_) {

@@ -243,6 +243,9 @@ struct PdrParams {
   /// starts and stops within a step and correlates with the vertical's derivative (end-of-pose
   /// error, seeds 100-139: hand-held 1.13 -> 0.47 deg rms, phone call 0.73 -> 0.14).
   double walking_direction_prior_deg = 2.0;
+  /// In arm swing the walking direction comes from the step's principal rotation axis, when its
+  /// sum of squared rates is this many times the next axis's (a swing, not a turn or a fumble).
+  double swing_axis_ratio = 4.0;
   /// Re-lay steps already walked when an estimate they were laid with improves (our addition):
   /// the hard-iron offset (each step's heading moves by its sensitivity to the offset, so the
   /// leg walked before the first corner calibrated the magnetometer is corrected too) and the
@@ -256,6 +259,17 @@ struct PdrParams {
   double still_gyro_std_rad_s = 0.03;
   double still_acc_std_m_s2 = 0.15;
   double still_max_bias_rad_s = 0.1;
+  /// Accelerometer bias from the field's vertical component (our addition): a bias b tilts the
+  /// up direction by its part across up over g, and the magnetic heading by tan(dip) times that
+  /// (0.05 m/s^2: 0.3 deg of tilt, 0.7 deg of heading at 65 deg dip), with a sign that turns
+  /// with the heading, so it does not cancel round a loop. Seen as a vertical field that
+  /// changes with the heading (Pdr::learn_acc_bias); the estimate is removed from the
+  /// accelerometer before the heading filter.
+  bool learn_acc_bias = true;
+  double acc_bias_prior_m_s2 = 0.1;      ///< prior std of each bias component
+  double acc_bias_step_noise_uT = 0.5;   ///< noise of one step's mean vertical field
+  double acc_bias_vertical_walk_uT = 0.05;  ///< drift of the vertical field, uT/sqrt(s)
+  double acc_bias_max_turn_rad_s = 0.4;     ///< samples turning faster than this are left out
   /// Personal factor on the model's step length, per pose (1 = the population model). Set it from
   /// a calibration walk of known length: known distance / `output().distance_m` of that walk.
   std::array<double, kPoseCount> step_scale{1.0, 1.0, 1.0, 1.0};
@@ -303,6 +317,9 @@ class Pdr {
   [[nodiscard]] const HardIronCalibrator& mag_calibration() const { return mag_cal_; }
   /// Gyro bias learnt while still (sensor frame, rad/s; subtracted from every sample).
   [[nodiscard]] const Eigen::Vector3d& gyro_bias_rad_s() const { return gyro_bias_; }
+  /// Accelerometer bias learnt from the vertical field (sensor frame, m/s^2; removed from the
+  /// accelerometer before the heading filter).
+  [[nodiscard]] const Eigen::Vector3d& acc_bias_m_s2() const { return acc_bias_; }
   /// Step frequencies seen at each step so far are not stored (no heap); for calibration, collect
   /// `output().step_hz` at every step in the caller.
 
@@ -354,6 +371,12 @@ class Pdr {
   std::size_t last_count_ = 0;
   void relay_switch_steps(double heading_after);
   void reset_walking_direction();
+  /// Accelerometer bias from the vertical field's constancy (one Kalman update per step).
+  void learn_acc_bias(double t_s);
+  /// The phone changed how it sits: the vertical field plus hard-iron residual is unknown again.
+  void forget_vertical_field();
+  /// Arm swing: the step's walking direction from its principal rotation axis (step_fwd_/left_).
+  void swing_axis_direction();
   void learn_gyro_bias(const ImuSample& s);
   /// Turns the steps laid in this pose so far with a new yaw correction `corr` (rad).
   void revise_pose_yaw(double corr);
@@ -363,6 +386,7 @@ class Pdr {
   // the sums of straight steps, of the step in progress, and of the last step (kept until the
   // next one shows whether it was straight).
   double yaw_fwd_ = 0.0, yaw_left_ = 0.0;
+  Eigen::Matrix3d step_swing_ = Eigen::Matrix3d::Zero();  ///< sum of w w^T over the step (arm swing)
   double step_fwd_ = 0.0, step_left_ = 0.0, last_fwd_ = 0.0, last_left_ = 0.0;
   double last_raw_heading_rad_ = 0.0;
   bool have_last_raw_ = false, last_straight_ = false;
@@ -384,6 +408,21 @@ class Pdr {
   // Still windows for the gyro bias.
   double still_t0_ = 0.0, still_w2_ = 0.0, still_a_ = 0.0, still_a2_ = 0.0;
   Eigen::Vector3d still_w_ = Eigen::Vector3d::Zero(), gyro_bias_ = Eigen::Vector3d::Zero();
+  // Accelerometer bias from the vertical field: state [C (uT), b (m/s^2, sensor frame)], its
+  // covariance, the bias removed before the heading filter, and the step's sums.
+  Eigen::Vector4d acc_x_ = Eigen::Vector4d::Zero();
+  Eigen::Matrix4d acc_p_ = initial_acc_covariance();
+  Eigen::Vector3d acc_bias_ = Eigen::Vector3d::Zero();
+  double tilt_z_sum_ = 0.0, tilt_t_s_ = -1.0, tilt_settled_t_s_ = 0.0;
+  Eigen::Vector3d tilt_r_sum_ = Eigen::Vector3d::Zero(), tilt_up_sum_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d tilt_offset_uT_ = Eigen::Vector3d::Zero();  ///< hard-iron offset C is for
+  int tilt_n_ = 0;
+  [[nodiscard]] Eigen::Matrix4d initial_acc_covariance() const {
+    Eigen::Matrix4d p = Eigen::Matrix4d::Identity() * params_.acc_bias_prior_m_s2 *
+                        params_.acc_bias_prior_m_s2;
+    p(0, 0) = 1e4;
+    return p;
+  }
   int still_n_ = 0;
   double last_av_ = 0.0, last_av_t_ = 0.0;
   bool have_av_ = false;
