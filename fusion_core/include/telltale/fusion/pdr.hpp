@@ -19,8 +19,10 @@
 /// while the pose is young, from straight steps only); the centripetal acceleration of turns
 /// taken out before the up direction follows the accelerometer; steps already walked re-laid when
 /// the hard-iron offset or the pose's yaw estimate improves (PdrParams::revise_track); the gyro
-/// bias learnt while standing still; a personal step-length factor from one calibration walk of
-/// known length (PdrParams::step_scale).
+/// bias learnt while standing still; in arm swing the walking direction from the arm's swing axis
+/// (PdrParams::swing_axis_ratio); the accelerometer bias learnt from the constancy of the field's
+/// vertical component (PdrParams::learn_acc_bias); a personal step-length factor from one
+/// calibration walk of known length (PdrParams::step_scale).
 ///
 /// Frames: the phone's sensor axes are whatever the phone has; the walking frame is x forward, y
 /// left, z up with `v_walking = M_pose v_sensor` (M = I for hand-held and arm swing). Position is
