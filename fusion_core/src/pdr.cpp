@@ -757,11 +757,13 @@ void Pdr::learn_acc_bias(double t_s) {
   const double var = params_.acc_bias_step_noise_uT * params_.acc_bias_step_noise_uT;
   const double innovation = z - h.dot(acc_x_);
   const double s = h.dot(acc_p_ * h) + var;
+  if (!std::isfinite(innovation) || !(s > 0.0)) return;
   // A magnetic disturbance (steel, a car) moves the vertical field by far more than a bias can.
   if (innovation * innovation > 25.0 * s) return;
   const Eigen::Vector4d k = acc_p_ * h / s;
   acc_x_ += k * innovation;
   acc_p_ -= k * h.transpose() * acc_p_;
+  acc_p_ = 0.5 * (acc_p_ + acc_p_.transpose()).eval();  // symmetric over hours of steps
   // Past a few times the prior the estimate is no bias (a field that is not the earth's):
   // the last plausible one stays.
   if (acc_x_.tail<3>().norm() < 5.0 * params_.acc_bias_prior_m_s2) acc_bias_ = acc_x_.tail<3>();
