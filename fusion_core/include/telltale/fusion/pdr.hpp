@@ -215,6 +215,8 @@ class HeadingFilter {
   Diagnostics diag_;
   bool up_init_ = false;
   double speed_m_s_ = 0.0;
+  Eigen::Vector3d last_gyro_ = Eigen::Vector3d::Zero();  ///< for the trapezoidal rate
+  bool last_gyro_ok_ = false;
 };
 
 // ---------------------------------------------------------------------------------------------
