@@ -964,11 +964,11 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
     const Eigen::Vector3d up = m.transpose() * heading_.state().up;
     const double vertical = mag.dot(up);
     if (std::abs(s.gyro_body_rad_s.dot(up)) < params_.acc_bias_max_turn_rad_s) {
-    const Eigen::Vector3d r = (mag - vertical * up) / kStandardGravity_m_s2;
-    tilt_z_sum_ += vertical + r.dot(acc_bias_);
-    tilt_r_sum_ += r;
-    tilt_up_sum_ += up;
-    ++tilt_n_;
+      const Eigen::Vector3d r = (mag - vertical * up) / kStandardGravity_m_s2;
+      tilt_z_sum_ += vertical + r.dot(acc_bias_);
+      tilt_r_sum_ += r;
+      tilt_up_sum_ += up;
+      ++tilt_n_;
     }
   }
   if (!foot && !switching_ && params_.walking_direction && gyro_ok(s)) {

@@ -270,8 +270,8 @@ struct PdrParams {
   /// changes with the heading (Pdr::learn_acc_bias); the estimate is removed from the
   /// accelerometer before the heading filter.
   bool learn_acc_bias = true;
-  double acc_bias_prior_m_s2 = 0.1;      ///< prior std of each bias component
-  double acc_bias_step_noise_uT = 0.5;   ///< noise of one step's mean vertical field
+  double acc_bias_prior_m_s2 = 0.1;         ///< prior std of each bias component
+  double acc_bias_step_noise_uT = 0.5;      ///< noise of one step's mean vertical field
   double acc_bias_vertical_walk_uT = 0.05;  ///< drift of the vertical field, uT/sqrt(s)
   double acc_bias_max_turn_rad_s = 0.4;     ///< samples turning faster than this are left out
   /// Personal factor on the model's step length, per pose (1 = the population model). Set it from
@@ -390,7 +390,8 @@ class Pdr {
   // the sums of straight steps, of the step in progress, and of the last step (kept until the
   // next one shows whether it was straight).
   double yaw_fwd_ = 0.0, yaw_left_ = 0.0;
-  Eigen::Matrix3d step_swing_ = Eigen::Matrix3d::Zero();  ///< sum of w w^T over the step (arm swing)
+  /// Arm swing: sum of w w^T (walking frame) over the step in progress.
+  Eigen::Matrix3d step_swing_ = Eigen::Matrix3d::Zero();
   double step_fwd_ = 0.0, step_left_ = 0.0, last_fwd_ = 0.0, last_left_ = 0.0;
   double last_raw_heading_rad_ = 0.0;
   bool have_last_raw_ = false, last_straight_ = false;
@@ -422,8 +423,8 @@ class Pdr {
   Eigen::Vector3d tilt_offset_uT_ = Eigen::Vector3d::Zero();  ///< hard-iron offset C is for
   int tilt_n_ = 0;
   [[nodiscard]] Eigen::Matrix4d initial_acc_covariance() const {
-    Eigen::Matrix4d p = Eigen::Matrix4d::Identity() * params_.acc_bias_prior_m_s2 *
-                        params_.acc_bias_prior_m_s2;
+    Eigen::Matrix4d p =
+        Eigen::Matrix4d::Identity() * params_.acc_bias_prior_m_s2 * params_.acc_bias_prior_m_s2;
     p(0, 0) = 1e4;
     return p;
   }
