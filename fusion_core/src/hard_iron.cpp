@@ -3,6 +3,8 @@
 #include <Eigen/Dense>
 #include <cmath>
 
+#include "telltale/fusion/imu_sample.hpp"
+
 namespace telltale::fusion {
 
 HardIronCalibrator::HardIronCalibrator(Params params) : params_(params) {
@@ -21,12 +23,9 @@ void HardIronCalibrator::update(double t_s, const Eigen::Vector3d& gyro, const E
     // Attitude relative to the start (sensor -> reference). Trapezoidal rate: with the rate at
     // the end of the interval only, the half-sample lag made the field turn ~0.1 uT wrong per
     // 5 deg of wobble, always with the rotation, and the fit 20-35 uT wrong (measured).
-    const Eigen::Vector3d dtheta = 0.5 * (gyro + state_.last_gyro) * (t_s - state_.last_t_s);
-    const double angle = dtheta.norm();
-    if (angle > 1e-12)
-      state_.attitude =
-          (state_.attitude * Eigen::Quaterniond(Eigen::AngleAxisd(angle, dtheta / angle)))
-              .normalized();
+    state_.attitude =
+        (state_.attitude * interval_rotation(state_.last_gyro, gyro, t_s - state_.last_t_s))
+            .normalized();
   }
   state_.started = true;
   state_.last_t_s = t_s;

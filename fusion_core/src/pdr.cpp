@@ -26,6 +26,16 @@ double sigmoid(double x) { return 1.0 / (1.0 + std::exp(-x)); }
 
 bool gyro_ok(const ImuSample& s) { return s.gyro_body_rad_s.allFinite(); }
 
+/// The walking frame's forward (its x axis made horizontal) and left, for an up direction in
+/// that frame; false when x is within ~17 deg of vertical (no forward direction).
+bool horizontal_axes(const Eigen::Vector3d& up, Eigen::Vector3d& fwd, Eigen::Vector3d& left) {
+  fwd = Eigen::Vector3d::UnitX() - up.x() * up;
+  if (!(fwd.norm() > 0.3)) return false;
+  fwd.normalize();
+  left = up.cross(fwd);
+  return true;
+}
+
 }  // namespace
 
 // --- features ---------------------------------------------------------------------------------
@@ -321,14 +331,13 @@ void HeadingFilter::update(double t_s, const Eigen::Vector3d& gyro, const Eigen:
     up_init_ = true;
   } else {
     if (gyro_ok) {
-      // A world-fixed vector turns by -theta in the sensor frame: trapezoidal rate, exact
+      // A world-fixed vector turns back by the body's rotation: trapezoidal rate, exact
       // rotation. A swinging arm turns the phone +-30 deg and back every stride, and the
       // first-order step (u += u x w dt with the end-of-interval rate) drifted the up direction
       // steadily, held only by the accelerometer's pull: straight arm-swing walks with ideal
       // sensors had a heading deviation of +-2.1 deg over the headings, +-1.2 deg now.
-      const Eigen::Vector3d theta = 0.5 * (gyro + (last_gyro_ok_ ? last_gyro_ : gyro)) * dt;
-      const double angle = theta.norm();
-      if (angle > 1e-12) state_.up = Eigen::AngleAxisd(-angle, theta / angle) * state_.up;
+      state_.up =
+          interval_rotation(last_gyro_ok_ ? last_gyro_ : gyro, gyro, dt).conjugate() * state_.up;
     }
     last_gyro_ = gyro;
     last_gyro_ok_ = gyro_ok;
@@ -338,11 +347,8 @@ void HeadingFilter::update(double t_s, const Eigen::Vector3d& gyro, const Eigen:
     // tan(dip) times as much, for seconds after every corner.
     Eigen::Vector3d f = acc;
     const double w_up = gyro_ok ? gyro.dot(state_.up) : 0.0;
-    Eigen::Vector3d fwd = Eigen::Vector3d::UnitX() - state_.up.x() * state_.up;
-    if (fwd.norm() > 0.3 && speed_m_s_ > 0.0) {
-      fwd.normalize();
-      f -= speed_m_s_ * w_up * state_.up.cross(fwd);
-    }
+    Eigen::Vector3d fwd, left;
+    if (speed_m_s_ > 0.0 && horizontal_axes(state_.up, fwd, left)) f -= speed_m_s_ * w_up * left;
     state_.up += dt / (params_.up_tau_s + dt) * (f.normalized() - state_.up);
     state_.up.normalize();
   }
@@ -728,14 +734,29 @@ void Pdr::swing_axis_direction() {
   // leaves the step without an estimate.
   if (!(eig.eigenvalues()[2] > params_.swing_axis_ratio * eig.eigenvalues()[1])) return;
   axis -= axis.dot(up) * up;
-  Eigen::Vector3d fwd = Eigen::Vector3d::UnitX() - up.x() * up;
-  if (axis.norm() < 0.5 || fwd.norm() < 0.3) return;
-  fwd.normalize();
-  const Eigen::Vector3d left = up.cross(fwd);
+  Eigen::Vector3d fwd, left;
+  if (axis.norm() < 0.5 || !horizontal_axes(up, fwd, left)) return;
   if (axis.dot(left) < 0.0) axis = -axis;
   const Eigen::Vector3d walk = axis.normalized().cross(up);
   step_fwd_ = walk.dot(fwd);
   step_left_ = walk.dot(left);
+}
+
+void Pdr::add_vertical_field(const Eigen::Vector3d& gyro, const Eigen::Vector3d& up,
+                             const Eigen::Vector3d& mag) {
+  // One sample of what the field's vertical component says about the up direction (sensor
+  // frame; learn_acc_bias). The caller leaves out arm swing (the pendulum's acceleration tilts
+  // up in step with the swing, which also turns the horizontal field in the phone) and the few
+  // up time constants after the phone moved. Turns are left out here: what is left of the
+  // centripetal acceleration tilts up with the turn, in step with the change of heading the
+  // estimate feeds on.
+  if (!(std::abs(gyro.dot(up)) < params_.acc_bias_max_turn_rad_s)) return;
+  const double vertical = mag.dot(up);
+  const Eigen::Vector3d r = (mag - vertical * up) / kStandardGravity_m_s2;
+  tilt_z_sum_ += vertical + r.dot(acc_bias_);
+  tilt_r_sum_ += r;
+  tilt_up_sum_ += up;
+  ++tilt_n_;
 }
 
 void Pdr::learn_acc_bias(double t_s) {
@@ -955,23 +976,10 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
   }
   heading_.update(s.t_s, m * s.gyro_body_rad_s, m * (s.acc_body_m_s2 - acc_bias_), m * mag);
   if (!foot && !switching_ && params_.learn_acc_bias && mag.allFinite() && heading_.initialised() &&
-      gyro_ok(s) && applied_pose_ != PhonePose::kArmSwing && s.t_s > tilt_settled_t_s_) {
-    // What the field's vertical component says about the up direction (learn_acc_bias). Not in
-    // turns: what is left of the centripetal acceleration tilts up with the turn, in step with
-    // the change of heading the estimate feeds on. Not in arm swing: the pendulum's acceleration
-    // tilts up in step with the swing, which also turns the horizontal field in the phone. Not
-    // while up settles after the phone moved (a few of the up filter's time constants).
-    const Eigen::Vector3d up = m.transpose() * heading_.state().up;
-    const double vertical = mag.dot(up);
-    if (std::abs(s.gyro_body_rad_s.dot(up)) < params_.acc_bias_max_turn_rad_s) {
-      const Eigen::Vector3d r = (mag - vertical * up) / kStandardGravity_m_s2;
-      tilt_z_sum_ += vertical + r.dot(acc_bias_);
-      tilt_r_sum_ += r;
-      tilt_up_sum_ += up;
-      ++tilt_n_;
-    }
-  }
-  if (!foot && !switching_ && params_.walking_direction && gyro_ok(s)) {
+      gyro_ok(s) && applied_pose_ != PhonePose::kArmSwing && s.t_s > tilt_settled_t_s_)
+    add_vertical_field(s.gyro_body_rad_s, m.transpose() * heading_.state().up, mag);
+  if (!foot && !switching_ && params_.walking_direction && gyro_ok(s) &&
+      applied_pose_ != PhonePose::kArmSwing) {
     // Walking direction from the acceleration pattern of the step (our addition): the trunk
     // brakes after heel strike and speeds up before the next one, so the forward acceleration
     // is in quadrature with the vertical one, correlated with its time derivative; sideways
@@ -980,28 +988,26 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
     // walking frame is how far the phone is yawed from the walking direction (2 deg rms per
     // pose in the simulator, and what a hand really does).
     const Eigen::Vector3d& up = heading_.state().up;
-    if (applied_pose_ == PhonePose::kArmSwing) {
-      // A swinging arm turns the phone about the shoulder's axis, across the walking direction
-      // whatever the phone's yaw in the hand: its rotations are summed for the step's principal
-      // axis (swing_axis_direction).
-      const Eigen::Vector3d w = m * s.gyro_body_rad_s;
-      step_swing_.noalias() += w * w.transpose();
-    }
     const Eigen::Vector3d a = m * s.acc_body_m_s2;
     const double av = a.dot(up);
-    if (have_av_) {
+    Eigen::Vector3d fwd, left;
+    if (have_av_ && horizontal_axes(up, fwd, left)) {
       const double dav = (av - last_av_) / (s.t_s - last_av_t_);
-      Eigen::Vector3d fwd = Eigen::Vector3d::UnitX() - up.x() * up;
-      if (fwd.norm() > 0.3) {
-        fwd.normalize();
-        const Eigen::Vector3d left = up.cross(fwd);
-        step_fwd_ += a.dot(fwd) * dav;
-        step_left_ += a.dot(left) * dav;
-      }
+      step_fwd_ += a.dot(fwd) * dav;
+      step_left_ += a.dot(left) * dav;
     }
     last_av_ = av;
     last_av_t_ = s.t_s;
     have_av_ = true;
+  } else if (!foot && !switching_ && params_.walking_direction && gyro_ok(s) &&
+             applied_pose_ == PhonePose::kArmSwing) {
+    // A swinging arm turns the phone about the shoulder's axis, across the walking direction
+    // whatever the phone's yaw in the hand: its rotations are summed for the step's principal
+    // axis (swing_axis_direction), in place of the acceleration pattern (the arm's, not the
+    // trunk's).
+    const Eigen::Vector3d w = m * s.gyro_body_rad_s;
+    step_swing_.noalias() += w * w.transpose();
+    have_av_ = false;
   } else {
     have_av_ = false;
   }

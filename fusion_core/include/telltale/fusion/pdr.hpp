@@ -375,6 +375,9 @@ class Pdr {
   std::size_t last_count_ = 0;
   void relay_switch_steps(double heading_after);
   void reset_walking_direction();
+  /// Adds one sample (sensor frame) to the step's vertical-field sums.
+  void add_vertical_field(const Eigen::Vector3d& gyro, const Eigen::Vector3d& up,
+                          const Eigen::Vector3d& mag);
   /// Accelerometer bias from the vertical field's constancy (one Kalman update per step).
   void learn_acc_bias(double t_s);
   /// The phone changed how it sits: the vertical field plus hard-iron residual is unknown again.
