@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -180,20 +181,30 @@ void pdr_table(int loops, int first_seed) {
   struct Row {
     sim::LoopVariant variant;
     bool calibrate;
-    const char* name;
+    std::string name;
+    std::optional<fusion::PhonePose> pose;
   };
-  const Row rows[] = {
-      {sim::LoopVariant::kAsSimulated, true, "pose switches, full sensor errors"},
-      {sim::LoopVariant::kSinglePose, true, "one pose, full sensor errors"},
-      {sim::LoopVariant::kIdealSensors, true, "pose switches, no biases/misalignment"},
-      {sim::LoopVariant::kAsSimulated, false, "pose switches, full errors, no calibration walk"}};
+  std::vector<Row> rows = {
+      {sim::LoopVariant::kAsSimulated, true, "pose switches, full sensor errors", {}},
+      {sim::LoopVariant::kSinglePose, true, "one pose, full sensor errors", {}},
+      {sim::LoopVariant::kIdealSensors, true, "pose switches, no biases/misalignment", {}},
+      {sim::LoopVariant::kAsSimulated,
+       false,
+       "pose switches, full errors, no calibration walk",
+       {}}};
+  for (int p = 0; p < fusion::kPoseCount; ++p) {
+    const auto pose = static_cast<fusion::PhonePose>(p);
+    rows.push_back({sim::LoopVariant::kSinglePose, true,
+                    "whole walk " + std::string(sim::pose_name(pose)) + ", full sensor errors",
+                    pose});
+  }
   for (const auto& row : rows) {
     std::vector<double> err, dist;
     std::size_t counted = 0, truth = 0;
     for (int i = 0; i < loops; ++i) {
       progress("loops", i + 1, loops);
       const auto r = sim::simulate_pdr_loop(static_cast<std::uint64_t>(first_seed + i), row.variant,
-                                            row.calibrate);
+                                            row.calibrate, row.pose);
       err.push_back(100.0 * r.error_fraction);
       dist.push_back(100.0 * std::fabs(r.distance_error_fraction));
       counted += r.steps_counted;
@@ -203,8 +214,8 @@ void pdr_table(int loops, int first_seed) {
     std::sort(dist.begin(), dist.end());
     const auto within = std::count_if(err.begin(), err.end(), [](double e) { return e <= 2.0; });
     const auto p90 = (err.size() * 9) / 10 - 1;
-    std::printf("| %s | %.2f | %.2f | %ld / %d (%.0f %%) | %zu / %zu | %.2f / %.2f |\n", row.name,
-                err[err.size() / 2], err[p90], static_cast<long>(within), loops,
+    std::printf("| %s | %.2f | %.2f | %ld / %d (%.0f %%) | %zu / %zu | %.2f / %.2f |\n",
+                row.name.c_str(), err[err.size() / 2], err[p90], static_cast<long>(within), loops,
                 100.0 * static_cast<double>(within) / loops, counted, truth, dist[dist.size() / 2],
                 dist[p90]);
     std::fflush(stdout);

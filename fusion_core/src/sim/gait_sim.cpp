@@ -251,12 +251,47 @@ class Simulator {
     double s = 0, v = 0;
     Eigen::Vector3d acc_w = Eigen::Vector3d::Zero();  // walking-frame acceleration
     Eigen::Vector3d trunk = Eigen::Vector3d::Zero();  // roll, pitch, yaw oscillation, rad
-    double stride_phase = 0;
+    /// Stride phase (0..1 over two steps) and its first two time derivatives, C1 in time.
+    double stride_phase = 0, stride_rate = 0, stride_rate_d = 0;
+    /// Arm-swing amplitude (rad) and its first two time derivatives, C1 in time.
+    double arm_amp = 0, arm_amp_d = 0, arm_amp_dd = 0;
     double step_hz = 0, step_len = 0;
     Gait gait = Gait::kWalk;
     bool moving = false;
     double blend = 0.0;  ///< 0 standing .. 1 walking: trunk and arm motion build up and die out
   };
+
+  /// Arm-swing amplitude of a step (rad): full swing from a 0.7 m step up.
+  [[nodiscard]] double arm_amplitude(std::size_t k) const {
+    return p_.arm_swing_deg * kDeg * std::min(1.0, steps_[k].length_m / 0.7);
+  }
+
+  /// Stride phase and arm-swing amplitude at phase ph of step k, with their time derivatives.
+  /// The phase runs k/2 .. (k+1)/2 over the step along a cubic Hermite curve whose rate at each
+  /// heel strike is the mean of the two steps' rates; the amplitude moves between knot values
+  /// (the mean of two steps' amplitudes; 0 when the walk starts and ends) along a smoothstep.
+  /// Both are C1 across steps: the arm's angular velocity never jumps.
+  void stride_motion(std::size_t k, double ph, Body& b) const {
+    const std::size_t n = steps_.size();
+    const double T = steps_[k].period_s;
+    const auto rate = [&](std::size_t i) { return 0.5 / steps_[i].period_s; };
+    const double r0 = k == 0 ? rate(0) : 0.5 * (rate(k - 1) + rate(k));
+    const double r1 = k + 1 == n ? rate(k) : 0.5 * (rate(k) + rate(k + 1));
+    const double u = ph, u2 = u * u, u3 = u2 * u;
+    const double m0 = T * r0, m1 = T * r1;  // knot slopes in stride per unit of ph
+    b.stride_phase = 0.5 * static_cast<double>(k % 2) + m0 * (u3 - 2.0 * u2 + u) +
+                     0.5 * (3.0 * u2 - 2.0 * u3) + m1 * (u3 - u2);
+    b.stride_rate =
+        (m0 * (3.0 * u2 - 4.0 * u + 1.0) + 0.5 * (6.0 * u - 6.0 * u2) + m1 * (3.0 * u2 - 2.0 * u)) /
+        T;
+    b.stride_rate_d =
+        (m0 * (6.0 * u - 4.0) + 0.5 * (6.0 - 12.0 * u) + m1 * (6.0 * u - 2.0)) / (T * T);
+    const double a0 = k == 0 ? 0.0 : 0.5 * (arm_amplitude(k - 1) + arm_amplitude(k));
+    const double a1 = k + 1 == n ? 0.0 : 0.5 * (arm_amplitude(k) + arm_amplitude(k + 1));
+    b.arm_amp = a0 + (a1 - a0) * (3.0 * u2 - 2.0 * u3);
+    b.arm_amp_d = (a1 - a0) * (6.0 * u - 6.0 * u2) / T;
+    b.arm_amp_dd = (a1 - a0) * (6.0 - 12.0 * u) / (T * T);
+  }
 
   [[nodiscard]] Body body(double t) const {
     Body b;
@@ -278,7 +313,7 @@ class Simulator {
     b.gait = st.gait;
     b.step_hz = f;
     b.step_len = L;
-    b.stride_phase = (static_cast<double>(k % 2) + ph) / 2.0;
+    stride_motion(static_cast<std::size_t>(k), ph, b);
     const double e = row.running ? 0.08 : 0.12;
     b.s = st.s0 + L * (ph + e * std::sin(kTwoPi * ph) / kTwoPi);
     b.v = L / T * (1.0 + e * std::cos(kTwoPi * ph));
@@ -301,7 +336,9 @@ class Simulator {
       a_up += 4.0 * std::exp(-t_in / 0.02) * std::sin(kTwoPi * 15.0 * t_in);
     }
     const double sway = row.running ? 0.012 : 0.025;
-    const double a_lat = -sway * (M_PI * f) * (M_PI * f) * std::sin(kTwoPi * b.stride_phase);
+    const double th = kTwoPi * b.stride_phase, th_d = kTwoPi * b.stride_rate;
+    const double a_lat =
+        sway * (kTwoPi * b.stride_rate_d * std::cos(th) - th_d * th_d * std::sin(th));
     b.acc_w = {a_fwd, a_lat, a_up};
     const double yaw_amp = (row.running ? 5.0 : 3.0) * kDeg;
     b.trunk = {2.0 * kDeg * std::cos(kTwoPi * b.stride_phase), 1.5 * kDeg * std::cos(kTwoPi * ph),
@@ -309,7 +346,7 @@ class Simulator {
     // The trunk's sway and the hand's tremor build up over the first step and die out over the
     // last, so the phone's orientation stays continuous when the walk starts and stops (a jump
     // is no rotation a body can make, and a gyro sampled at it read 11-22 rad/s for one sample).
-    // The arm swing needs no ramp: it is at the middle of its swing when a stride starts.
+    // The arm swing builds up and dies out with its amplitude (stride_motion).
     const double ramp_in = (t - steps_.front().t0) / steps_.front().period_s;
     const double ramp_out = (t_end_ - t) / steps_.back().period_s;
     b.blend = minjerk(std::clamp(std::min(ramp_in, ramp_out), 0.0, 1.0));
@@ -365,15 +402,22 @@ class Simulator {
         osc = rot_z(tr.z()) * rot_y(tr.y()) * rot_x(tr.x());
         break;
       case PhonePose::kArmSwing: {
-        // Pendulum from the shoulder at stride frequency: hand forward when the opposite foot
-        // strikes. alpha > 0 = hand forward and up; the phone pitches up with the arm.
-        const double a0 =
-            p_.arm_swing_deg * kDeg * (b.moving ? std::min(1.0, b.step_len / 0.7) : 0.0);
+        // Pendulum from the shoulder at stride frequency, in phase with the opposite leg: the
+        // hand is furthest forward when the opposite foot strikes (the left foot strikes at even
+        // steps, stride phase 0) and furthest back when the foot on its own side does. alpha > 0
+        // = hand forward and up; the phone pitches up with the arm. alpha = a(t) cos(theta(t))
+        // with the amplitude and the phase both C1 in time, so the reported acceleration
+        // r alpha'' integrates to the arm's true velocity (a phase rate that jumps at a step
+        // boundary would hide an impulse the accelerometer never sees).
         const double r = 0.38 * p_.height_m;
-        const double w_s = kTwoPi * b.step_hz / 2.0;
-        const double alpha = a0 * std::sin(kTwoPi * b.stride_phase);
-        const double alpha_d = a0 * w_s * std::cos(kTwoPi * b.stride_phase);
-        const double alpha_dd = -a0 * w_s * w_s * std::sin(kTwoPi * b.stride_phase);
+        const double a = b.arm_amp, a_d = b.arm_amp_d, a_dd = b.arm_amp_dd;
+        const double th = kTwoPi * b.stride_phase, th_d = kTwoPi * b.stride_rate,
+                     th_dd = kTwoPi * b.stride_rate_d;
+        const double sn = std::sin(th), cs = std::cos(th);
+        const double alpha = a * cs;
+        const double alpha_d = a_d * cs - a * th_d * sn;
+        const double alpha_dd =
+            a_dd * cs - 2.0 * a_d * th_d * sn - a * (th_dd * sn + th_d * th_d * cs);
         acc_w = {r * (alpha_dd * std::cos(alpha) - alpha_d * alpha_d * std::sin(alpha)), 0.0,
                  r * (alpha_dd * std::sin(alpha) + alpha_d * alpha_d * std::cos(alpha))};
         osc = rot_z(0.5 * tr.z()) * rot_y(-alpha);

@@ -55,9 +55,14 @@ std::vector<CalibrationWalk> simulate_calibration_walks(std::uint64_t first, int
       CalibrationWalk walk;
       walk.height_m = person.height_m;
       walk.distance_m = run.distance_m;
-      for (const auto& s : run.samples)
-        if (pdr.update(s.imu, s.mag_uT).step)
-          walk.step_hz.push_back(pdr.output().step_hz > 0.0 ? pdr.output().step_hz : 1.8);
+      // One entry per step counted, the filled-in ones included (they are laid with the step
+      // that found them, at its frequency).
+      std::size_t counted = 0;
+      for (const auto& s : run.samples) {
+        const PdrOutput& o = pdr.update(s.imu, s.mag_uT);
+        for (; counted < o.steps; ++counted)
+          walk.step_hz.push_back(o.step_hz > 0.0 ? o.step_hz : 1.8);
+      }
       out.push_back(walk);
     }
   }
@@ -84,11 +89,13 @@ double personal_step_scale(const Person& person, std::uint64_t seed, PhonePose p
   return pdr.output().distance_m > 0.0 ? run.distance_m / pdr.output().distance_m : 1.0;
 }
 
-LoopWalkResult simulate_pdr_loop(std::uint64_t seed, LoopVariant variant, bool calibrate) {
+LoopWalkResult simulate_pdr_loop(std::uint64_t seed, LoopVariant variant, bool calibrate,
+                                 std::optional<PhonePose> pose) {
   auto sc = *make_gait_scenario("loop", seed);
   Person person = random_person(seed);
-  if (variant == LoopVariant::kSinglePose)
-    for (auto& seg : sc.segments) seg.pose = sc.segments.front().pose;
+  if (variant == LoopVariant::kSinglePose && !pose) pose = sc.segments.front().pose;
+  if (pose)
+    for (auto& seg : sc.segments) seg.pose = *pose;
   if (variant == LoopVariant::kIdealSensors) {
     sc.errors.acc_bias_m_s2 = sc.errors.gyro_bias_rad_s = sc.errors.mag_bias_uT = 0.0;
     for (int p = 0; p < kPoseCount; ++p) person.mount_yaw_deg[p] = person.mount_tilt_deg[p] = 0.0;

@@ -5,6 +5,7 @@
 /// Person seeds pick the people: train on one range, evaluate on a disjoint one.
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "telltale/fusion/pdr.hpp"
@@ -62,9 +63,11 @@ enum class LoopVariant {
 /// Person and loop drawn from `seed` (people seeds 2001+ are not in the training range 1..23).
 /// Protocol: before the loop the person does one calibration walk of 100 m hand-held
 /// (personal_step_scale, its own noise seed, never the evaluated walk), unless `calibrate` is
-/// false (the population step-length model alone).
+/// false (the population step-length model alone). With `pose`, the whole walk is in that pose
+/// (the variant's switches, if any, are dropped).
 [[nodiscard]] LoopWalkResult simulate_pdr_loop(std::uint64_t seed,
                                                LoopVariant variant = LoopVariant::kAsSimulated,
-                                               bool calibrate = true);
+                                               bool calibrate = true,
+                                               std::optional<PhonePose> pose = std::nullopt);
 
 }  // namespace telltale::fusion::sim
