@@ -26,6 +26,13 @@ double sigmoid(double x) { return 1.0 / (1.0 + std::exp(-x)); }
 
 bool gyro_ok(const ImuSample& s) { return s.gyro_body_rad_s.allFinite(); }
 
+/// [v]x: the matrix of the cross product v x.
+Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return m;
+}
+
 /// The walking frame's forward (its x axis made horizontal) and left, for an up direction in
 /// that frame; false when x is within ~17 deg of vertical (no forward direction).
 bool horizontal_axes(const Eigen::Vector3d& up, Eigen::Vector3d& fwd, Eigen::Vector3d& left) {
@@ -311,6 +318,38 @@ double HeadingFilter::magnetic_heading_rad(const Eigen::Vector3d& mag, const Eig
   return wrap_2pi(std::atan2(x.dot(e), x.dot(n)));
 }
 
+void HeadingFilter::pull_up(double dt, const Eigen::Vector3d& gyro, bool gyro_ok, double t_s) {
+  Eigen::Vector3d f = last_acc_;
+  Eigen::Vector3d& up = state_.up;
+  // Walking round a corner (0.6 m radius at 1.4 m/s: 3 m/s^2, 17 deg of tilt) the
+  // accelerometer also reads the centripetal acceleration v w (toward the centre, left for a
+  // left turn); left in, it tilts the up direction, and the magnetic heading by about
+  // tan(dip) times as much, for seconds after every corner.
+  const double w_up = last_gyro_ok_ ? last_gyro_.dot(up) : 0.0;
+  Eigen::Vector3d fwd, left;
+  if (speed_m_s_ > 0.0 && horizontal_axes(up, fwd, left)) f -= speed_m_s_ * w_up * left;
+  // A swinging arm: the hand's pendulum acceleration (+-10 m/s^2 along the walking direction)
+  // swung the up direction +-8 deg round the vertical every stride, and the magnetic heading
+  // turned that into a bias of 2-3 deg that depends on the heading. Rotation about the
+  // horizontal axes only: turning the body is the corner's business (above).
+  const double span = t_s - before_t_s_;
+  if (params_.lever_arm && gyro_ok && last_gyro_ok_ && before_gyro_ok_ && span > 0.0) {
+    const auto horizontal = [&up](const Eigen::Vector3d& v) { return v - v.dot(up) * up; };
+    const Eigen::Vector3d w = horizontal(last_gyro_);
+    const Eigen::Vector3d w_dot = horizontal((gyro - before_gyro_) / span);
+    const Eigen::Matrix3d a = cross_matrix(w_dot) + cross_matrix(w) * cross_matrix(w);
+    const double keep = std::exp(-dt / params_.lever_arm_tau_s);
+    lever_info_ = keep * lever_info_ + a.transpose() * a * dt;
+    lever_sum_ = keep * lever_sum_ + a.transpose() * (f - kStandardGravity_m_s2 * up) * dt;
+    const double prior = std::pow(params_.lever_arm_noise_m_s2 / params_.lever_arm_prior_m, 2);
+    lever_m_ = (lever_info_ + prior * Eigen::Matrix3d::Identity()).ldlt().solve(lever_sum_);
+    f -= a * lever_m_;
+  }
+  if (!(f.norm() > 1e-3)) return;
+  up += dt / (params_.up_tau_s + dt) * (f.normalized() - up);
+  up.normalize();
+}
+
 void HeadingFilter::update(double t_s, const Eigen::Vector3d& gyro, const Eigen::Vector3d& acc,
                            const Eigen::Vector3d& mag) {
   if (!std::isfinite(t_s) || !acc.allFinite() || !(acc.norm() > 1e-3)) {
@@ -323,6 +362,7 @@ void HeadingFilter::update(double t_s, const Eigen::Vector3d& gyro, const Eigen:
     ++diag_.rejected_non_finite;
     return;
   }
+  const double t_prev = state_.last_t_s;
   state_.last_t_s = t_s;
   // Up direction in the walking frame: gyro-propagated (du/dt = u x w for a world-fixed vector),
   // pulled toward the accelerometer's direction with time constant up_tau_s.
@@ -330,28 +370,22 @@ void HeadingFilter::update(double t_s, const Eigen::Vector3d& gyro, const Eigen:
     state_.up = acc.normalized();
     up_init_ = true;
   } else {
+    pull_up(dt, gyro, gyro_ok, t_s);
     if (gyro_ok) {
       // A world-fixed vector turns back by the body's rotation: trapezoidal rate, exact
       // rotation. A swinging arm turns the phone +-30 deg and back every stride, and the
       // first-order step (u += u x w dt with the end-of-interval rate) drifted the up direction
-      // steadily, held only by the accelerometer's pull: straight arm-swing walks with ideal
-      // sensors had a heading deviation of +-2.1 deg over the headings, +-1.2 deg now.
+      // steadily, held only by the accelerometer's pull.
       state_.up =
           interval_rotation(last_gyro_ok_ ? last_gyro_ : gyro, gyro, dt).conjugate() * state_.up;
     }
-    last_gyro_ = gyro;
-    last_gyro_ok_ = gyro_ok;
-    // Walking round a corner (0.6 m radius at 1.4 m/s: 3 m/s^2, 17 deg of tilt) the
-    // accelerometer also reads the centripetal acceleration v w (toward the centre, left for a
-    // left turn); left in, it tilts the up direction, and the magnetic heading by about
-    // tan(dip) times as much, for seconds after every corner.
-    Eigen::Vector3d f = acc;
-    const double w_up = gyro_ok ? gyro.dot(state_.up) : 0.0;
-    Eigen::Vector3d fwd, left;
-    if (speed_m_s_ > 0.0 && horizontal_axes(state_.up, fwd, left)) f -= speed_m_s_ * w_up * left;
-    state_.up += dt / (params_.up_tau_s + dt) * (f.normalized() - state_.up);
-    state_.up.normalize();
   }
+  before_gyro_ = last_gyro_;
+  before_gyro_ok_ = last_gyro_ok_;
+  before_t_s_ = t_prev;
+  last_gyro_ = gyro;
+  last_gyro_ok_ = gyro_ok;
+  last_acc_ = acc;
   // Prediction: heading rate = -(yaw rate about up) (heading is clockwise).
   if (state_.initialised) {
     const double rate = gyro_ok ? -gyro.dot(state_.up) : 0.0;
@@ -449,20 +483,34 @@ void Pdr::on_step(double t_s) {
   // detected). A gap of about n step intervals while the phone kept moving like a walk
   // (acceleration energy over the last window) counts n - 1 more steps; a stop does not.
   int missed = 0;
+  const double gap = t_s - last_step_t_s_;
   if (!foot && last_step_t_s_ >= 0.0 && interval_ema_s_ > 0.0) {
-    const double gap = t_s - last_step_t_s_;
     const double ratio = gap / interval_ema_s_;
     if (ratio > params_.fill_min_ratio && gap < params_.fill_max_gap_s &&
         features_.features().acc_energy > params_.fill_min_energy)
       missed = static_cast<int>(std::lround(ratio)) - 1;
   }
-  diag_.filled_steps += static_cast<unsigned>(missed);
-  out_.steps += static_cast<std::size_t>(missed);
-  if (last_step_t_s_ >= 0.0) {
-    const double interval = (t_s - last_step_t_s_) / per_event / (1.0 + missed);
-    if (interval < 2.0)
+  // Filling in needs a cadence that was measured. A gap after every step is no missed step but a
+  // cadence that is wrong (learnt from two detections of one step, or from a detector that has
+  // since locked onto the stride): after kMaxFilledRow filled steps in a row the cadence is
+  // learnt again from the gaps. (Learning it from the gaps divided by the steps filled into
+  // them kept any wrong cadence for ever: 2 or 8 steps counted for every one.)
+  constexpr int kMaxFilledRow = 10;
+  filled_row_ = missed > 0 ? filled_row_ + 1 : 0;
+  if (filled_row_ > kMaxFilledRow) {
+    missed = 0;
+    filled_row_ = 0;
+    interval_ema_s_ = 0.0;
+  }
+  if (last_step_t_s_ >= 0.0 && missed == 0 && !handoff_) {
+    const double interval = gap / per_event;
+    if (interval >= params_.min_step_interval_s && interval < 2.0)
       interval_ema_s_ = interval_ema_s_ > 0.0 ? 0.5 * interval_ema_s_ + 0.5 * interval : interval;
   }
+  missed += backfill_steps_;  // the start of a walk in arm swing (phone_step)
+  backfill_steps_ = 0;
+  diag_.filled_steps += static_cast<unsigned>(missed);
+  out_.steps += static_cast<std::size_t>(missed);
   const double t_prev = last_step_t_s_;
   last_step_t_s_ = t_s;
   out_.steps += static_cast<std::size_t>(per_event);
@@ -939,6 +987,50 @@ void Pdr::relay_switch_steps(double heading_after) {
   }
 }
 
+bool Pdr::phone_step(const ImuSample& s, const Eigen::Matrix3d& m, StepEvent& ev) {
+  const bool by_acc = phone_steps_.update(s, ev);
+  // While the phone swings (a swinging arm; a thigh, for a phone in a trouser pocket) its turns
+  // count the steps (SwingStepDetector), whatever the pose: in arm swing the hand's pendulum
+  // swamps the trunk's acceleration and the peak-valley detector loses steps, or the whole
+  // walk at a slow pace (and with it the pose, which is classified at the steps).
+  bool by_swing = false;
+  bool swinging = swing_steps_.swinging(s.t_s);  // before: the last step ends the swing
+  if (gyro_ok(s)) {
+    const Eigen::Vector3d up = m.transpose() * heading_.state().up;  // sensor frame
+    const Eigen::Vector3d& w = s.gyro_body_rad_s;
+    by_swing = swing_steps_.update(s.t_s, w - w.dot(up) * up);
+  }
+  swinging = swinging || swing_steps_.swinging(s.t_s);
+  if (by_acc || by_swing) {
+    if (s.t_s - walk_.last_event_t_s > params_.walk_pause_s) walk_ = {};  // a new walk
+    walk_.last_event_t_s = s.t_s;
+    walk_.swing_events += by_swing ? 1 : 0;
+  }
+  const bool swing = gyro_ok(s) && swinging;
+  if (!(swing ? by_swing : by_acc)) return false;
+  // The arm turns at a heel strike, the acceleration's valley closes a step just after one:
+  // when one detector takes over from the other, a step less than half an interval after the
+  // last one is that same step.
+  if (swing != last_step_by_swing_ && last_step_t_s_ >= 0.0 &&
+      s.t_s - last_step_t_s_ < 0.5 * std::max(interval_ema_s_, swing_steps_.half_swing_s()))
+    return false;
+  // The two detectors mark a step at different moments of it (up to ~0.2 s apart): the interval
+  // across a handoff is no cadence.
+  handoff_ = swing != last_step_by_swing_;
+  last_step_by_swing_ = swing;
+  // A walk that starts swinging: the swing is recognised after two half swings, and the
+  // acceleration may have missed the steps before (the pendulum lifts every valley above the
+  // standing mean). The arm's turns since the walk began say how many: they are counted with
+  // this step, if the walk is that young (its first kBackfillEvents turns).
+  constexpr int kBackfillEvents = 8;
+  if (swing && !walk_.backfilled && walk_.swing_events <= kBackfillEvents)
+    backfill_steps_ = std::max(0, walk_.swing_events - walk_.steps - 1);
+  if (swing) walk_.backfilled = true;
+  ++walk_.steps;
+  ev.t_s = swing ? swing_steps_.step_t_s() : s.t_s;
+  return true;
+}
+
 const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT) {
   out_.step = false;
   if (!std::isfinite(raw.t_s) || !raw.acc_body_m_s2.allFinite() ||
@@ -1039,7 +1131,7 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
                                                          : heading_.heading_rad() * 180.0 / M_PI;
   }
   StepEvent ev;
-  const bool step = foot ? foot_steps_.update(s, ev) : phone_steps_.update(s, ev);
+  const bool step = foot ? foot_steps_.update(s, ev) : phone_step(s, m, ev);
   if (step) {
     on_step(ev.t_s);
     out_.step = true;

@@ -231,6 +231,73 @@ PeakValleyStepDetector::PeakValleyStepDetector(Params params)
   interval_ema_s_ = params_.initial_interval_s;
 }
 
+bool SwingStepDetector::update(double t_s, const Eigen::Vector3d& w) {
+  if (!std::isfinite(t_s) || !w.allFinite() || (have_t_ && !(t_s > last_t_s_))) return false;
+  const double dt = have_t_ ? t_s - last_t_s_ : 0.0;
+  last_t_s_ = t_s;
+  have_t_ = true;
+  // The swing axis: one power-iteration step a sample keeps it continuous (no sign flips) while
+  // it follows the phone into another pose.
+  const double keep = std::exp(-dt / params_.axis_tau_s);
+  rate_cov_ = keep * rate_cov_ + (1.0 - keep) * w * w.transpose();
+  const Eigen::Vector3d next = rate_cov_ * axis_;
+  if (next.norm() > 1e-12) axis_ = next.normalized();
+  return on_rate(t_s, dt, w.dot(axis_));
+}
+
+bool SwingStepDetector::on_rate(double t_s, double dt, double rate) {
+  if (sign_ != 0 && t_s - since_s_ > params_.max_interval_s) {
+    sign_ = 0;
+    peak_ = sweep_rad_ = 0.0;
+    done_sweeps_ = {};
+  }
+  const int sign = rate > 0.0 ? 1 : -1;
+  const double mag = std::abs(rate);
+  if (sign != run_sign_) run_rad_ = 0.0;  // the rate crossed zero
+  run_sign_ = sign;
+  run_rad_ += mag * dt;
+  if (mag >= params_.min_rate_rad_s)
+    slow_since_s_ = -1.0;
+  else if (slow_since_s_ < 0.0)
+    slow_since_s_ = t_s;
+  if (sign == sign_) {
+    peak_ = std::max(peak_, mag);
+    sweep_rad_ += mag * dt;
+  }
+  const double half_sweep = 0.5 * params_.min_sweep_deg * M_PI / 180.0;
+  if (swinging(t_s) && slow_since_s_ >= 0.0 && t_s - slow_since_s_ >= params_.rest_s &&
+      sweep_rad_ >= half_sweep) {
+    // Come to rest after half a swing: the walk's last step.
+    const double rest_t_s = slow_since_s_;
+    reset();
+    last_t_s_ = t_s;
+    have_t_ = true;
+    step_t_s_ = rest_t_s;
+    return true;
+  }
+  if (sign == sign_) return false;
+  const double threshold = std::max(params_.min_rate_rad_s, params_.peak_fraction * peak_);
+  if (mag < threshold) return false;
+  if (sign_ != 0 && t_s - since_s_ < params_.min_interval_s) return false;  // a ripple
+  // A new half swing: the phone has turned at an end of its swing, if the one that ended swept
+  // an angle (a wobble before the first swing, or a hand's tremor, does not).
+  const bool step = sign_ != 0 && sweep_rad_ >= half_sweep;
+  if (sign_ != 0) half_swing_s_ = t_s - since_s_;
+  done_sweeps_ = {sweep_rad_, done_sweeps_[0]};
+  peak_ = mag;
+  sweep_rad_ = run_rad_;  // this half swing since the rate crossed zero
+  sign_ = sign;
+  since_s_ = t_s;
+  if (step) step_t_s_ = t_s;
+  return step;
+}
+
+bool SwingStepDetector::swinging(double t_s) const {
+  const double min_sweep = params_.min_sweep_deg * M_PI / 180.0;
+  return sign_ != 0 && t_s - since_s_ < params_.max_interval_s &&
+         std::min(done_sweeps_[0], done_sweeps_[1]) >= min_sweep;
+}
+
 void PeakValleyStepDetector::reset() { *this = PeakValleyStepDetector(params_); }
 
 bool PeakValleyStepDetector::update(const ImuSample& s, StepEvent& event) {

@@ -185,7 +185,9 @@ TEST(AdaptiveStepDetector, AccelerometerOnlyFootStillCounts) {
   }
 }
 
-// Seed 003: step detection close to 100 % in single poses (phone, walking).
+// Seed 003: step detection close to 100 % in single poses (phone, walking). In arm swing the
+// hand's pendulum (10-25 m/s^2) swamps the trunk's acceleration: there the arm's turns count
+// (SwingStepDetector, next test) and the peak-valley detector's figure is only reported.
 TEST(PeakValleyStepDetector, PhoneInEveryPoseWalking) {
   for (const char* pose : {"hand-held", "call", "pocket", "arm-swing"}) {
     double mean = 0;
@@ -196,8 +198,72 @@ TEST(PeakValleyStepDetector, PhoneInEveryPoseWalking) {
       PeakValleyStepDetector d;
       mean += accuracy(count(d, run.samples, true), run.step_times_s.size()) / 5.0;
     }
-    EXPECT_GE(mean, 0.99) << pose;
+    RecordProperty(std::string(pose) + "_mean_accuracy", std::to_string(mean));
+    if (std::string(pose) != "arm-swing") {
+      EXPECT_GE(mean, 0.99) << pose;
+    }
   }
+}
+
+// The swing detector on the gyro's horizontal part (up from the accelerometer's slow mean, as a
+// phone without a filter would have it).
+std::size_t count_swings(const std::vector<sim::GaitSample>& samples,
+                         bool* ever_swinging = nullptr) {
+  SwingStepDetector d;
+  Eigen::Vector3d up = Eigen::Vector3d::Zero();
+  std::size_t n = 0;
+  bool swinging = false;
+  for (const auto& s : samples) {
+    up += 0.01 * (s.imu.acc_body_m_s2 - up);
+    const Eigen::Vector3d u = up.normalized();
+    const Eigen::Vector3d& w = s.imu.gyro_body_rad_s;
+    n += d.update(s.imu.t_s, w - w.dot(u) * u) ? 1u : 0u;
+    swinging = swinging || d.swinging(s.imu.t_s);
+  }
+  if (ever_swinging) *ever_swinging = swinging;
+  return n;
+}
+
+// Every step of an arm-swing walk, at every pace, for 10 people: one turn of the arm per step,
+// the last one ending at rest. A hand that holds the phone in front of the face or to the ear
+// only wobbles (a few degrees, though at up to ~1 rad/s): never a swing.
+TEST(SwingStepDetector, CountsEveryStepOfASwingingArmAndNoWobble) {
+  for (int p = 1; p <= 10; ++p) {
+    const auto seed = static_cast<std::uint64_t>(p);
+    const sim::Person person = sim::random_person(seed);
+    for (sim::Gait g : {sim::Gait::kSlowWalk, sim::Gait::kWalk, sim::Gait::kFastWalk}) {
+      sim::GaitScenario sc;
+      sc.site = sim::SensorSite::kPhone;
+      sc.segments = {{g, sim::PhonePose::kArmSwing, 30.0}};
+      sc.path = {{1000.0, 0.0}};
+      const auto run = sim::simulate_gait(sc, person, seed);
+      // The turns between steps, and the rest that ends the last one: every step.
+      EXPECT_EQ(count_swings(run.samples), run.step_times_s.size())
+          << "person " << p << " " << sim::gait_name(g);
+    }
+    for (const char* pose : {"hand-held", "call"}) {
+      const auto run = sim::simulate_gait(
+          *sim::make_gait_scenario(std::string("phone-") + pose + "-walk", seed), person, seed);
+      bool swinging = true;
+      (void)count_swings(run.samples, &swinging);
+      EXPECT_FALSE(swinging) << pose << " person " << p;
+    }
+  }
+}
+
+TEST(SwingStepDetector, IgnoresNaNAndTimeThatDoesNotAdvance) {
+  SwingStepDetector d;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::size_t n = 0;
+  for (int k = 0; k < 1000; ++k) {  // 10 s of a 0.9 Hz swing of +-30 deg, 100 Hz
+    const double t = 0.01 * k;
+    const double rate = 0.52 * 2.0 * M_PI * 0.9 * std::cos(2.0 * M_PI * 0.9 * t);
+    n += d.update(t, Eigen::Vector3d(0.0, rate, 0.0)) ? 1u : 0u;
+    EXPECT_FALSE(d.update(t, Eigen::Vector3d(0.0, -rate, 0.0)));  // same time again
+    EXPECT_FALSE(d.update(t + 0.005, Eigen::Vector3d(nan, 0.0, 0.0)));
+  }
+  EXPECT_TRUE(d.swinging(9.99));
+  EXPECT_NEAR(static_cast<double>(n), 17.0, 1.0);  // 18 turns, the first half swing from rest
 }
 
 // --- real phone traces --------------------------------------------------------------------------

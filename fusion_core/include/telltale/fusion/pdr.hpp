@@ -162,6 +162,16 @@ struct HeadingFilterParams {
   double gate_deg = 40.0;          ///< larger innovations are rejected...
   double reset_after_s = 3.0;      ///< ...unless they persist this long (then reset)
   double up_tau_s = 1.5;           ///< time constant of the pull toward the accelerometer
+  /// Lever arm: a phone that swings about a point (the shoulder, the hip) reads that point's
+  /// tangential and centripetal acceleration, w' x p + w x (w x p), with p the phone's position
+  /// from the point, fixed in the phone. p is fitted by weighted least squares (forgetting
+  /// `lever_arm_tau_s`, prior 0 +- `lever_arm_prior_m`, residual noise `lever_arm_noise_m_s2`
+  /// per sqrt(Hz)) from the rotation about the horizontal axes only, and taken out of the
+  /// accelerometer before the up direction is pulled toward it.
+  bool lever_arm = true;
+  double lever_arm_tau_s = 10.0;
+  double lever_arm_prior_m = 0.5;
+  double lever_arm_noise_m_s2 = 3.0;
 };
 class HeadingFilter {
  public:
@@ -193,8 +203,20 @@ class HeadingFilter {
   /// forgets the heading.
   void change_frame(const Eigen::Matrix3d& r) {
     state_.up = r * state_.up;
+    last_acc_ = r * last_acc_;
+    last_gyro_ = r * last_gyro_;
+    before_gyro_ = r * before_gyro_;
+    forget_lever_arm();
     state_.initialised = false;
   }
+  /// The phone moved in the hand: the lever arm is forgotten.
+  void forget_lever_arm() {
+    lever_info_.setZero();
+    lever_sum_.setZero();
+    lever_m_.setZero();
+  }
+  /// The lever arm's estimate (walking frame, m).
+  [[nodiscard]] const Eigen::Vector3d& lever_arm_m() const { return lever_m_; }
   [[nodiscard]] double heading_rad() const { return state_.heading_rad; }
   [[nodiscard]] bool initialised() const { return state_.initialised; }
   [[nodiscard]] const State& state() const { return state_; }
@@ -215,8 +237,19 @@ class HeadingFilter {
   Diagnostics diag_;
   bool up_init_ = false;
   double speed_m_s_ = 0.0;
+  /// Pulls the up direction toward the previous sample's accelerometer reading (its angular
+  /// acceleration needs the rates on both sides of it: `gyro` is the current one).
+  void pull_up(double dt, const Eigen::Vector3d& gyro, bool gyro_ok, double t_s);
+
   Eigen::Vector3d last_gyro_ = Eigen::Vector3d::Zero();  ///< for the trapezoidal rate
   bool last_gyro_ok_ = false;
+  Eigen::Vector3d last_acc_ = Eigen::Vector3d::Zero();     ///< the sample the pull is for
+  Eigen::Vector3d before_gyro_ = Eigen::Vector3d::Zero();  ///< the rate a sample before that
+  bool before_gyro_ok_ = false;
+  double before_t_s_ = 0.0;
+  Eigen::Matrix3d lever_info_ = Eigen::Matrix3d::Zero();  ///< sum of A^T A dt, forgetting
+  Eigen::Vector3d lever_sum_ = Eigen::Vector3d::Zero();   ///< sum of A^T r dt, forgetting
+  Eigen::Vector3d lever_m_ = Eigen::Vector3d::Zero();
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -237,6 +270,8 @@ struct PdrParams {
   double fill_min_ratio = 1.6;         ///< a gap this many step intervals long has missed steps...
   double fill_max_gap_s = 4.0;         ///< ...if shorter than this...
   double fill_min_energy = 0.5;        ///< ...and the phone's acceleration energy says walking
+  double min_step_interval_s = 0.2;    ///< 5 steps/s, a sprinter's: shorter is no cadence
+  double walk_pause_s = 2.0;           ///< no step for this long: the next is a new walk
   bool walking_direction = true;       ///< correct the phone's yaw from the acceleration pattern
   int walking_direction_steps = 4;     ///< straight steps in a pose before the correction applies
   /// How far a phone is yawed in a hand or pocket, rms (a few degrees). The estimate is shrunk
@@ -331,12 +366,26 @@ class Pdr {
   static constexpr int kWave = 16;  ///< points per axis in a step waveform
   using Wave = Eigen::Matrix<double, 3 * kWave, 1>;
   void on_step(double t_s);
+  /// Phone-mounted step detection: the acceleration's peaks and valleys, the arm's turns in arm
+  /// swing.
+  bool phone_step(const ImuSample& s, const Eigen::Matrix3d& m, StepEvent& ev);
   [[nodiscard]] Wave step_wave(double t0_s, double t1_s) const;
 
   Params params_;
   PoseNetwork net_;
   StepLengthModel lengths_;
   PeakValleyStepDetector phone_steps_;
+  SwingStepDetector swing_steps_;  ///< steps while the phone swings (its turns)
+  bool last_step_by_swing_ = false;
+  bool handoff_ = false;  ///< this step's detector is not the last one's
+  struct Walk {           ///< since the last pause (phone_step)
+    double last_event_t_s = -1e9;
+    int swing_events = 0;  ///< the arm's turns
+    int steps = 0;         ///< steps counted (either detector)
+    bool backfilled = false;
+  } walk_;
+  int backfill_steps_ = 0;
+  int filled_row_ = 0;  ///< steps in a row that filled a gap
   AdaptiveStepDetector foot_steps_;
   PoseFeatureWindow features_;
   HeadingFilter heading_;

@@ -240,6 +240,64 @@ class PeakValleyStepDetector final : public StepDetector {
   int n_ = 0;
 };
 
+/// Steps from a swinging arm (a phone carried in the hand, arm swinging): the arm turns forward
+/// and back once per stride, so its rate about the swing axis changes sign at each end of the
+/// swing, once per step. The body's acceleration magnitude is no help there: the hand's pendulum
+/// (10-25 m/s^2) swamps the trunk's and the peak-valley detector loses steps at a fast pace.
+/// A sign change counts once the rate has gone past `peak_fraction` of the previous half swing's
+/// peak the other way (and past `min_rate_rad_s`). A hand that only wobbles (held in front of
+/// the face, or to the ear: a few degrees, though at up to ~1 rad/s) is not a swing: `swinging`
+/// says whether the phone swings, by the angle each half swing sweeps (an arm: 2 x 16-40 deg).
+/// The last half swing of a walk ends at rest, not at a turn: a swinging phone that comes to rest
+/// (the rate under `min_rate_rad_s` for `rest_s`) after half a swing has made its last step.
+struct SwingStepParams {
+  double min_rate_rad_s = 0.5;   ///< smallest rate that starts a half swing, rad/s
+  double min_sweep_deg = 20.0;   ///< smallest angle a half swing of a swinging arm sweeps
+  double peak_fraction = 0.3;    ///< hysteresis relative to the last half swing's peak
+  double min_interval_s = 0.25;  ///< shortest step, s (4 steps/s)
+  double max_interval_s = 1.5;   ///< a longer half swing is no walk: the memory is reset
+  double rest_s = 0.35;          ///< at rest (a turn passes under min_rate in 0.1-0.2 s)
+  double axis_tau_s = 1.0;       ///< memory of the swing axis, s
+};
+class SwingStepDetector {
+ public:
+  using Params = SwingStepParams;
+  explicit SwingStepDetector(Params params = {}) : params_(params) {}
+  /// The angular rate's horizontal part (any frame fixed in the phone; NaN: ignored). The swing
+  /// axis is its principal direction over the last `axis_tau_s`, found whatever the pose.
+  /// True when a step completed.
+  bool update(double t_s, const Eigen::Vector3d& horizontal_rate_rad_s);
+  /// When the last step completed: the turn (the sample it was confirmed at), or for the last
+  /// step of a walk the moment the phone came to rest (confirmed rest_s later).
+  [[nodiscard]] double step_t_s() const { return step_t_s_; }
+  /// How long the last completed half swing took (a step), s; 0 before one completed.
+  [[nodiscard]] double half_swing_s() const { return half_swing_s_; }
+  /// The phone swings: the last two completed half swings swept min_sweep_deg or more each and
+  /// the last turn was less than max_interval_s before t_s.
+  [[nodiscard]] bool swinging(double t_s) const;
+  void reset() { *this = SwingStepDetector(params_); }
+
+ private:
+  /// The step logic on the rate about the swing axis.
+  bool on_rate(double t_s, double dt, double rate);
+
+  Params params_;
+  int sign_ = 0;                         ///< the half swing in progress (0: none yet)
+  double peak_ = 0.0;                    ///< its peak |rate|
+  double sweep_rad_ = 0.0;               ///< the angle it swept so far
+  int run_sign_ = 0;                     ///< the rate's sign...
+  double run_rad_ = 0.0;                 ///< ...and the angle swept since it last crossed zero
+  std::array<double, 2> done_sweeps_{};  ///< of the last two completed half swings, rad
+  double since_s_ = 0.0;                 ///< start of the half swing in progress
+  double last_t_s_ = 0.0;
+  double slow_since_s_ = -1.0;  ///< the rate has been under min_rate_rad_s since (-1: it is not)
+  double step_t_s_ = 0.0;
+  double half_swing_s_ = 0.0;
+  Eigen::Matrix3d rate_cov_ = Eigen::Matrix3d::Zero();  ///< of the horizontal rate, forgetting
+  Eigen::Vector3d axis_ = Eigen::Vector3d::UnitY();     ///< its principal direction
+  bool have_t_ = false;
+};
+
 /// Names accepted by make_step_detector: "adaptive", "peak", "fixed-threshold", "peak-valley".
 [[nodiscard]] std::span<const std::string_view> step_detector_names();
 /// The default detector for a mount: foot -> "adaptive", body -> "peak-valley".
