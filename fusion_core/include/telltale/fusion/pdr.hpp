@@ -21,8 +21,11 @@
 /// the hard-iron offset or the pose's yaw estimate improves (PdrParams::revise_track); the gyro
 /// bias learnt while standing still; in arm swing the walking direction from the arm's swing axis
 /// (PdrParams::swing_axis_ratio); the accelerometer bias learnt from the constancy of the field's
-/// vertical component (PdrParams::learn_acc_bias); a personal step-length factor from one
-/// calibration walk of known length (PdrParams::step_scale).
+/// vertical component (PdrParams::learn_acc_bias); while the phone swings, the steps counted
+/// from its turns (SwingStepDetector, steps.hpp), whatever the pose; the swinging hand's
+/// pendulum acceleration taken out before the up direction follows the accelerometer
+/// (HeadingFilterParams::lever_arm); a personal step-length factor from one calibration walk of
+/// known length (PdrParams::step_scale).
 ///
 /// Frames: the phone's sensor axes are whatever the phone has; the walking frame is x forward, y
 /// left, z up with `v_walking = M_pose v_sensor` (M = I for hand-held and arm swing). Position is
@@ -153,8 +156,9 @@ struct CalibrationWalk {
 /// Heading of the walking frame's x axis from gyro + magnetometer (seed 004, Fig. 2): a two-state
 /// Kalman filter [heading, heading-rate bias]; prediction with the gyro rate about the tracked
 /// up direction, update with the tilt-compensated magnetic heading. The up direction is tracked
-/// by integrating the gyro and pulling toward the accelerometer (`up_tau_s`), so a swinging arm
-/// does not tilt it. Magnetic north (no declination).
+/// by integrating the gyro and pulling toward the accelerometer (`up_tau_s`), with the
+/// centripetal acceleration of turns and a swinging hand's lever-arm acceleration taken out of
+/// the accelerometer first. Magnetic north (no declination).
 struct HeadingFilterParams {
   double gyro_noise_rad_s = 0.02;  ///< heading-rate noise density, rad/s/sqrt(Hz)
   double bias_walk_rad_s2 = 2e-4;  ///< bias random walk, rad/s^2/sqrt(Hz)
