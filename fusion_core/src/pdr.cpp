@@ -1014,8 +1014,9 @@ bool Pdr::phone_step(const ImuSample& s, const Eigen::Matrix3d& m, StepEvent& ev
   if (swing != last_step_by_swing_ && last_step_t_s_ >= 0.0 &&
       s.t_s - last_step_t_s_ < 0.5 * std::max(interval_ema_s_, swing_steps_.half_swing_s()))
     return false;
-  // The two detectors mark a step at different moments of it (up to ~0.2 s apart): the interval
-  // across a handoff is no cadence.
+  // The two detectors mark a step at different moments of it (the acceleration's valley is
+  // confirmed 0.0-0.4 s after the strike, the arm's turn ~0.05 s): the interval across a handoff
+  // is no cadence.
   handoff_ = swing != last_step_by_swing_;
   last_step_by_swing_ = swing;
   // A walk that starts swinging: the swing is recognised after two half swings, and the
