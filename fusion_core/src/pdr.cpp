@@ -341,8 +341,12 @@ void HeadingFilter::pull_up(double dt, const Eigen::Vector3d& gyro, bool gyro_ok
     const double keep = std::exp(-dt / params_.lever_arm_tau_s);
     lever_info_ = keep * lever_info_ + a.transpose() * a * dt;
     lever_sum_ = keep * lever_sum_ + a.transpose() * (f - kStandardGravity_m_s2 * up) * dt;
-    const double prior = std::pow(params_.lever_arm_noise_m_s2 / params_.lever_arm_prior_m, 2);
-    lever_m_ = (lever_info_ + prior * Eigen::Matrix3d::Identity()).ldlt().solve(lever_sum_);
+    // p changes over the forgetting time (10 s): solved again every 0.1 s, not every sample.
+    if (t_s - lever_solved_t_s_ >= 0.1 || t_s < lever_solved_t_s_) {
+      const double prior = std::pow(params_.lever_arm_noise_m_s2 / params_.lever_arm_prior_m, 2);
+      lever_m_ = (lever_info_ + prior * Eigen::Matrix3d::Identity()).ldlt().solve(lever_sum_);
+      lever_solved_t_s_ = t_s;
+    }
     f -= a * lever_m_;
   }
   if (!(f.norm() > 1e-3)) return;
@@ -467,7 +471,7 @@ Pdr::Wave Pdr::step_wave(double t0, double t1) const {
   return w;
 }
 
-void Pdr::on_step(double t_s) {
+void Pdr::on_step(double t_s, StepSource source) {
   const bool foot = params_.mount == StepMount::kFoot;
   // How this step's heading depends on the hard-iron offset (mean over the step).
   const bool have_mag_grad = mag_grad_n_ > 0;
@@ -502,13 +506,12 @@ void Pdr::on_step(double t_s) {
     filled_row_ = 0;
     interval_ema_s_ = 0.0;
   }
-  if (last_step_t_s_ >= 0.0 && missed == 0 && !handoff_) {
+  if (last_step_t_s_ >= 0.0 && missed == 0 && !source.handoff) {
     const double interval = gap / per_event;
     if (interval >= params_.min_step_interval_s && interval < 2.0)
       interval_ema_s_ = interval_ema_s_ > 0.0 ? 0.5 * interval_ema_s_ + 0.5 * interval : interval;
   }
-  missed += backfill_steps_;  // the start of a walk in arm swing (phone_step)
-  backfill_steps_ = 0;
+  missed += source.backfill;  // the start of a swinging walk (phone_step)
   diag_.filled_steps += static_cast<unsigned>(missed);
   out_.steps += static_cast<std::size_t>(missed);
   const double t_prev = last_step_t_s_;
@@ -987,7 +990,8 @@ void Pdr::relay_switch_steps(double heading_after) {
   }
 }
 
-bool Pdr::phone_step(const ImuSample& s, const Eigen::Matrix3d& m, StepEvent& ev) {
+bool Pdr::phone_step(const ImuSample& s, const Eigen::Matrix3d& m, StepEvent& ev,
+                     StepSource& source) {
   const bool by_acc = phone_steps_.update(s, ev);
   // While the phone swings (a swinging arm; a thigh, for a phone in a trouser pocket) its turns
   // count the steps (SwingStepDetector), whatever the pose: in arm swing the hand's pendulum
@@ -1017,7 +1021,7 @@ bool Pdr::phone_step(const ImuSample& s, const Eigen::Matrix3d& m, StepEvent& ev
   // The two detectors mark a step at different moments of it (the acceleration's valley is
   // confirmed 0.0-0.4 s after the strike, the arm's turn ~0.05 s): the interval across a handoff
   // is no cadence.
-  handoff_ = swing != last_step_by_swing_;
+  source.handoff = swing != last_step_by_swing_;
   last_step_by_swing_ = swing;
   // A walk that starts swinging: the swing is recognised after two half swings, and the
   // acceleration may have missed the steps before (the pendulum lifts every valley above the
@@ -1025,7 +1029,7 @@ bool Pdr::phone_step(const ImuSample& s, const Eigen::Matrix3d& m, StepEvent& ev
   // this step, if the walk is that young (its first kBackfillEvents turns).
   constexpr int kBackfillEvents = 8;
   if (swing && !walk_.backfilled && walk_.swing_events <= kBackfillEvents)
-    backfill_steps_ = std::max(0, walk_.swing_events - walk_.steps - 1);
+    source.backfill = std::max(0, walk_.swing_events - walk_.steps - 1);
   if (swing) walk_.backfilled = true;
   ++walk_.steps;
   ev.t_s = swing ? swing_steps_.step_t_s() : s.t_s;
@@ -1132,9 +1136,10 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
                                                          : heading_.heading_rad() * 180.0 / M_PI;
   }
   StepEvent ev;
-  const bool step = foot ? foot_steps_.update(s, ev) : phone_step(s, m, ev);
+  StepSource source;
+  const bool step = foot ? foot_steps_.update(s, ev) : phone_step(s, m, ev, source);
   if (step) {
-    on_step(ev.t_s);
+    on_step(ev.t_s, source);
     out_.step = true;
   }
   out_.pose = applied_pose_;

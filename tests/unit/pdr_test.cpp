@@ -410,11 +410,8 @@ TEST(Pdr, CountsEveryStepOfAnArmSwingWalk) {
     const auto seed = static_cast<std::uint64_t>(i);
     const sim::Person person = sim::random_person(seed);
     for (sim::Gait g : {sim::Gait::kSlowWalk, sim::Gait::kWalk, sim::Gait::kFastWalk}) {
-      sim::GaitScenario sc;
-      sc.site = sim::SensorSite::kPhone;
-      sc.segments = {{g, PhonePose::kArmSwing, 40.0}};
-      sc.path = {{1000.0, 0.0}};
-      const auto run = sim::simulate_gait(sc, person, seed * 32 + static_cast<std::uint64_t>(g));
+      const auto run = sim::simulate_gait(sim::straight_phone_walk(g, PhonePose::kArmSwing, 40.0),
+                                          person, seed * 32 + static_cast<std::uint64_t>(g));
       PdrParams p;
       p.height_m = person.height_m;
       Pdr pdr(p);

@@ -232,11 +232,8 @@ TEST(SwingStepDetector, CountsEveryStepOfASwingingArmAndNoWobble) {
     const auto seed = static_cast<std::uint64_t>(p);
     const sim::Person person = sim::random_person(seed);
     for (sim::Gait g : {sim::Gait::kSlowWalk, sim::Gait::kWalk, sim::Gait::kFastWalk}) {
-      sim::GaitScenario sc;
-      sc.site = sim::SensorSite::kPhone;
-      sc.segments = {{g, sim::PhonePose::kArmSwing, 30.0}};
-      sc.path = {{1000.0, 0.0}};
-      const auto run = sim::simulate_gait(sc, person, seed);
+      const auto run = sim::simulate_gait(
+          sim::straight_phone_walk(g, sim::PhonePose::kArmSwing, 30.0), person, seed);
       // The turns between steps, and the rest that ends the last one: every step.
       EXPECT_EQ(count_swings(run.samples), run.step_times_s.size())
           << "person " << p << " " << sim::gait_name(g);

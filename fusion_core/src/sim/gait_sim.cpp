@@ -676,6 +676,14 @@ GaitRun simulate_gait(const GaitScenario& scenario, const Person& person, std::u
   return sim.run();
 }
 
+GaitScenario straight_phone_walk(Gait gait, PhonePose pose, double duration_s) {
+  GaitScenario sc;
+  sc.site = SensorSite::kPhone;
+  sc.segments = {{gait, pose, duration_s}};
+  sc.path = {{1000.0, 0.0}};
+  return sc;
+}
+
 std::optional<GaitScenario> make_gait_scenario(std::string_view name, std::uint64_t seed) {
   GaitScenario sc;
   sc.name = std::string(name);

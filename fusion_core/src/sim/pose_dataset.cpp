@@ -43,11 +43,8 @@ std::vector<CalibrationWalk> simulate_calibration_walks(std::uint64_t first, int
     const std::uint64_t seed = first + static_cast<std::uint64_t>(i);
     const Person person = random_person(seed);
     for (Gait g : {Gait::kSlowWalk, Gait::kWalk, Gait::kFastWalk}) {
-      GaitScenario sc;
-      sc.site = SensorSite::kPhone;
+      GaitScenario sc = straight_phone_walk(g, pose, 40.0);
       sc.rate_hz = 50.0;
-      sc.segments = {{g, pose, 40.0}};
-      sc.path = {{1000.0, 0.0}};
       const auto run = simulate_gait(sc, person, seed * 32 + static_cast<std::uint64_t>(g));
       PdrParams params;
       params.height_m = person.height_m;

@@ -210,17 +210,11 @@ class HeadingFilter {
     last_acc_ = r * last_acc_;
     last_gyro_ = r * last_gyro_;
     before_gyro_ = r * before_gyro_;
-    forget_lever_arm();
-    state_.initialised = false;
-  }
-  /// The phone moved in the hand: the lever arm is forgotten.
-  void forget_lever_arm() {
-    lever_info_.setZero();
+    lever_info_.setZero();  // the phone sits another way in the hand: a new lever arm
     lever_sum_.setZero();
     lever_m_.setZero();
+    state_.initialised = false;
   }
-  /// The lever arm's estimate (walking frame, m).
-  [[nodiscard]] const Eigen::Vector3d& lever_arm_m() const { return lever_m_; }
   [[nodiscard]] double heading_rad() const { return state_.heading_rad; }
   [[nodiscard]] bool initialised() const { return state_.initialised; }
   [[nodiscard]] const State& state() const { return state_; }
@@ -254,6 +248,7 @@ class HeadingFilter {
   Eigen::Matrix3d lever_info_ = Eigen::Matrix3d::Zero();  ///< sum of A^T A dt, forgetting
   Eigen::Vector3d lever_sum_ = Eigen::Vector3d::Zero();   ///< sum of A^T r dt, forgetting
   Eigen::Vector3d lever_m_ = Eigen::Vector3d::Zero();
+  double lever_solved_t_s_ = -1e9;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -369,10 +364,16 @@ class Pdr {
  private:
   static constexpr int kWave = 16;  ///< points per axis in a step waveform
   using Wave = Eigen::Matrix<double, 3 * kWave, 1>;
-  void on_step(double t_s);
-  /// Phone-mounted step detection: the acceleration's peaks and valleys, the arm's turns in arm
-  /// swing.
-  bool phone_step(const ImuSample& s, const Eigen::Matrix3d& m, StepEvent& ev);
+  /// How a phone step was found (phone_step): steps to count with it that the acceleration
+  /// missed at a walk's swinging start, and whether its detector took over from the other one.
+  struct StepSource {
+    int backfill = 0;
+    bool handoff = false;
+  };
+  void on_step(double t_s, StepSource source);
+  /// Phone-mounted step detection: the acceleration's peaks and valleys, the arm's turns while
+  /// the phone swings.
+  bool phone_step(const ImuSample& s, const Eigen::Matrix3d& m, StepEvent& ev, StepSource& source);
   [[nodiscard]] Wave step_wave(double t0_s, double t1_s) const;
 
   Params params_;
@@ -381,14 +382,12 @@ class Pdr {
   PeakValleyStepDetector phone_steps_;
   SwingStepDetector swing_steps_;  ///< steps while the phone swings (its turns)
   bool last_step_by_swing_ = false;
-  bool handoff_ = false;  ///< this step's detector is not the last one's
-  struct Walk {           ///< since the last pause (phone_step)
+  struct Walk {  ///< since the last pause (phone_step)
     double last_event_t_s = -1e9;
     int swing_events = 0;  ///< the arm's turns
     int steps = 0;         ///< steps counted (either detector)
     bool backfilled = false;
   } walk_;
-  int backfill_steps_ = 0;
   int filled_row_ = 0;  ///< steps in a row that filled a gap
   AdaptiveStepDetector foot_steps_;
   PoseFeatureWindow features_;

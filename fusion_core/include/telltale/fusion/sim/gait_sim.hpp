@@ -163,5 +163,8 @@ struct GaitRun {
 [[nodiscard]] std::optional<GaitScenario> make_gait_scenario(std::string_view name,
                                                              std::uint64_t seed);
 [[nodiscard]] std::vector<std::string> gait_scenario_examples();
+/// A phone carried in one pose at one gait along a straight 1 km line for `duration_s` (the
+/// calibration walks of the step-length model and the arm-swing step tests).
+[[nodiscard]] GaitScenario straight_phone_walk(Gait gait, PhonePose pose, double duration_s);
 
 }  // namespace telltale::fusion::sim
