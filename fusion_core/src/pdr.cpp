@@ -26,6 +26,12 @@ double sigmoid(double x) { return 1.0 / (1.0 + std::exp(-x)); }
 
 bool gyro_ok(const ImuSample& s) { return s.gyro_body_rad_s.allFinite(); }
 
+/// Slot of a (possibly negative) running index in a ring of n.
+std::size_t ring_slot(std::int64_t id, std::size_t n) {
+  const auto m = static_cast<std::int64_t>(n);
+  return static_cast<std::size_t>(((id % m) + m) % m);
+}
+
 /// [v]x: the matrix of the cross product v x.
 Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& v) {
   Eigen::Matrix3d m;
@@ -452,7 +458,9 @@ Pdr::Pdr(Params params, const PoseNetwork& net, const StepLengthModel& lengths)
       }()),
       features_(params.feature_window_s),
       heading_(params.heading),
-      mag_cal_(params.hard_iron) {}
+      mag_cal_(params.hard_iron) {
+  heading_bin_id_.fill(std::numeric_limits<std::int64_t>::min());
+}
 
 const StepDiagnostics& Pdr::step_diagnostics() const {
   return params_.mount == StepMount::kFoot ? foot_steps_.diagnostics() : phone_steps_.diagnostics();
@@ -488,8 +496,8 @@ void Pdr::on_step(double t_s, StepSource source) {
   // (acceleration energy over the last window) counts n - 1 more steps; a stop does not.
   int missed = 0;
   const double gap = t_s - last_step_t_s_;
-  if (!foot && last_step_t_s_ >= 0.0 && interval_ema_s_ > 0.0) {
-    const double ratio = gap / interval_ema_s_;
+  if (!foot && last_step_t_s_ >= 0.0 && interval_s_ > 0.0) {
+    const double ratio = gap / interval_s_;
     if (ratio > params_.fill_min_ratio && gap < params_.fill_max_gap_s &&
         features_.features().acc_energy > params_.fill_min_energy)
       missed = static_cast<int>(std::lround(ratio)) - 1;
@@ -504,12 +512,12 @@ void Pdr::on_step(double t_s, StepSource source) {
   if (filled_row_ > kMaxFilledRow) {
     missed = 0;
     filled_row_ = 0;
-    interval_ema_s_ = 0.0;
+    interval_s_ = 0.0;
+    interval_count_ = 0;
   }
   if (last_step_t_s_ >= 0.0 && missed == 0 && !source.handoff) {
     const double interval = gap / per_event;
-    if (interval >= params_.min_step_interval_s && interval < 2.0)
-      interval_ema_s_ = interval_ema_s_ > 0.0 ? 0.5 * interval_ema_s_ + 0.5 * interval : interval;
+    if (interval >= params_.min_step_interval_s && interval < 2.0) learn_interval(interval);
   }
   missed += source.backfill;  // the start of a swinging walk (phone_step)
   diag_.filled_steps += static_cast<unsigned>(missed);
@@ -517,8 +525,8 @@ void Pdr::on_step(double t_s, StepSource source) {
   const double t_prev = last_step_t_s_;
   last_step_t_s_ = t_s;
   out_.steps += static_cast<std::size_t>(per_event);
-  if (interval_ema_s_ > 0.0) {
-    out_.step_hz = 1.0 / interval_ema_s_;
+  if (interval_s_ > 0.0) {
+    out_.step_hz = 1.0 / interval_s_;
     out_.cadence_spm = 60.0 * out_.step_hz;
   }
   const double f = out_.step_hz;
@@ -640,8 +648,11 @@ void Pdr::on_step(double t_s, StepSource source) {
         candidate_pose_ = *pose;
         candidate_count_ = 1;
       }
+      // (The fallback is for a pose that changes: the old pose's long run of answers must not
+      // end a switch the moment it is detected.)
       const bool may_change =
-          !pose_known_ || settling_ || candidate_count_ >= params_.pose_fallback_steps;
+          !pose_known_ || settling_ ||
+          (candidate_pose_ != applied_pose_ && candidate_count_ >= params_.pose_fallback_steps);
       if (candidate_count_ >= params_.pose_confirm_steps && may_change) {
         settling_ = switching_ = false;
         const Eigen::Matrix3d r =
@@ -649,6 +660,7 @@ void Pdr::on_step(double t_s, StepSource source) {
         if (!r.isIdentity(1e-9)) {
           heading_.change_frame(r);  // new walking frame: heading again from the magnetometer
           sum_sin_ = sum_cos_ = 0.0;
+          heading_bins_from_t_s_ = t_s;
         }
         if (pose_known_ && candidate_pose_ != applied_pose_) ++diag_.pose_changes;
         if (candidate_pose_ != applied_pose_) {
@@ -717,10 +729,17 @@ void Pdr::on_step(double t_s, StepSource source) {
   const double hz = out_.step_hz > 0.0 ? out_.step_hz : 1.8;
   const double step_m = lengths_.length_m(applied_pose_, params_.height_m, hz) *
                         params_.step_scale[static_cast<std::size_t>(applied_pose_)];
-  const double len = (per_event + missed) * step_m;
+  double len = (per_event + missed) * step_m;
   out_.last_step_length_m = len;
   heading_.set_speed(step_m * hz);
   out_.distance_m += len;
+  if (missed > 0 && !replaced) {
+    // The steps a gap held are laid along the heading the gap had part by part (a corner walked
+    // while the detector was blind is a corner, not a diagonal): one displacement, the chord.
+    const Eigen::Vector2d turn = gap_turn(t_prev, t_s, static_cast<int>(per_event) + missed);
+    heading = wrap_2pi(heading + std::atan2(turn.y(), turn.x()));
+    len *= turn.norm();
+  }
   if (!foot && (!pose_known_ || !heading_.initialised())) {
     // At the start the pose (hence the walking frame and the heading) is not known yet: the
     // first steps are laid along the first heading we get (a straight start).
@@ -766,6 +785,62 @@ void Pdr::on_step(double t_s, StepSource source) {
     last_count_ = std::min(last_count_ + 1, kLookback);
   }
   out_.heading_deg = heading * 180.0 / M_PI;
+}
+
+void Pdr::learn_interval(double interval_s) {
+  // A median, not a running mean: a hand moving the phone makes events at any moment, and two
+  // of them 0.3 s apart made the filler count 5 steps for a gap that held 3.
+  for (std::size_t i = 0; i + 1 < kIntervals; ++i) intervals_[i] = intervals_[i + 1];
+  intervals_.back() = interval_s;
+  interval_count_ = std::min(interval_count_ + 1, kIntervals);
+  std::array<double, kIntervals> sorted{};
+  const auto n = static_cast<std::ptrdiff_t>(interval_count_);
+  std::copy(intervals_.end() - n, intervals_.end(), sorted.begin());
+  std::sort(sorted.begin(), sorted.begin() + n);
+  const auto mid = static_cast<std::size_t>(n / 2);
+  interval_s_ = n % 2 ? sorted[mid] : 0.5 * (sorted[mid - 1] + sorted[mid]);
+}
+
+void Pdr::add_heading_bin(double t_s, double heading_rad) {
+  const auto id = static_cast<std::int64_t>(std::floor(t_s / kHeadingBinS));
+  const std::size_t slot = ring_slot(id, kHeadingBins);
+  if (heading_bin_id_[slot] != id) {
+    heading_bin_id_[slot] = id;
+    heading_bins_[slot].setZero();
+  }
+  heading_bins_[slot] += Eigen::Vector2d(std::cos(heading_rad), std::sin(heading_rad));
+}
+
+Eigen::Vector2d Pdr::gap_turn(double t0_s, double t1_s, int parts) const {
+  const Eigen::Vector2d none(1.0, 0.0);
+  if (parts < 2 || !(t1_s > t0_s) || t0_s < heading_bins_from_t_s_ ||
+      t1_s - t0_s > kHeadingBinS * static_cast<double>(kHeadingBins - 2))
+    return none;
+  // Each part's heading: the circular mean of the bins its interval covers.
+  std::array<Eigen::Vector2d, kHeadingBins> part{};
+  Eigen::Vector2d all = Eigen::Vector2d::Zero();
+  const double span = (t1_s - t0_s) / parts;
+  for (int j = 0; j < parts; ++j) {
+    const double a = t0_s + j * span, b = a + span;
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    for (auto id = static_cast<std::int64_t>(std::floor(a / kHeadingBinS));
+         static_cast<double>(id) * kHeadingBinS < b; ++id) {
+      const std::size_t slot = ring_slot(id, kHeadingBins);
+      if (heading_bin_id_[slot] == id) sum += heading_bins_[slot];
+    }
+    if (!(sum.norm() > 1e-9)) return none;  // a part with no heading: no better than one
+    part[static_cast<std::size_t>(j)] = sum.normalized();
+    all += sum;
+  }
+  // Relative to the whole gap's mean: rotate each part's unit vector back by the mean's angle.
+  const double mean = std::atan2(all.y(), all.x());
+  Eigen::Vector2d turn = Eigen::Vector2d::Zero();
+  for (int j = 0; j < parts; ++j) {
+    const Eigen::Vector2d& u = part[static_cast<std::size_t>(j)];
+    const double h = std::atan2(u.y(), u.x()) - mean;
+    turn += Eigen::Vector2d(std::cos(h), std::sin(h));
+  }
+  return turn / parts;
 }
 
 void Pdr::swing_axis_direction() {
@@ -1016,7 +1091,7 @@ bool Pdr::phone_step(const ImuSample& s, const Eigen::Matrix3d& m, StepEvent& ev
   // when one detector takes over from the other, a step less than half an interval after the
   // last one is that same step.
   if (swing != last_step_by_swing_ && last_step_t_s_ >= 0.0 &&
-      s.t_s - last_step_t_s_ < 0.5 * std::max(interval_ema_s_, swing_steps_.half_swing_s()))
+      s.t_s - last_step_t_s_ < 0.5 * std::max(interval_s_, swing_steps_.half_swing_s()))
     return false;
   // The two detectors mark a step at different moments of it (the acceleration's valley is
   // confirmed 0.0-0.4 s after the strike, the arm's turn ~0.05 s): the interval across a handoff
@@ -1131,6 +1206,7 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
   if (heading_.initialised()) {
     sum_sin_ += std::sin(heading_.heading_rad());
     sum_cos_ += std::cos(heading_.heading_rad());
+    add_heading_bin(s.t_s, heading_.heading_rad());
     if (!out_.step)
       out_.heading_deg = switching_ && have_replacement_ ? replacement_heading_rad_ * 180.0 / M_PI
                                                          : heading_.heading_rad() * 180.0 / M_PI;

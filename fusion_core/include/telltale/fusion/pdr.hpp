@@ -35,6 +35,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -497,9 +498,27 @@ class Pdr {
   std::array<Eigen::Vector2d, 2> axis_sum_{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
   int wave_count_ = 0;
   double last_step_t_s_ = -1.0;
-  double interval_ema_s_ = 0.0;
+  /// The step interval: the median of the last kIntervals measured ones (0 until one is).
+  double interval_s_ = 0.0;
+  static constexpr std::size_t kIntervals = 5;
+  std::array<double, kIntervals> intervals_{};
+  std::size_t interval_count_ = 0;
+  void learn_interval(double interval_s);
   // Heading over the current step (circular mean) and of the last three steps.
   double sum_sin_ = 0.0, sum_cos_ = 0.0;
+  /// The heading over the last seconds, in 0.1 s bins (sums of unit vectors, since the walking
+  /// frame last changed): a step that fills a gap lays the steps it adds along the heading each
+  /// part of the gap had (gap_turn).
+  static constexpr std::size_t kHeadingBins = 64;
+  static constexpr double kHeadingBinS = 0.1;
+  std::array<Eigen::Vector2d, kHeadingBins> heading_bins_{};
+  std::array<std::int64_t, kHeadingBins> heading_bin_id_{};
+  double heading_bins_from_t_s_ = 0.0;
+  void add_heading_bin(double t_s, double heading_rad);
+  /// For a gap [t0, t1] walked in `parts` equal steps: the mean of the unit vectors of each
+  /// part's heading relative to the whole gap's (x along, y clockwise); (1, 0) when the bins do
+  /// not cover the gap.
+  [[nodiscard]] Eigen::Vector2d gap_turn(double t0_s, double t1_s, int parts) const;
   std::array<double, 5> recent_heading_rad_{};  ///< oldest first
   int recent_count_ = 0;
   bool switching_ = false;
