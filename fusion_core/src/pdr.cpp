@@ -509,7 +509,7 @@ void Pdr::on_step(double t_s, StepSource source) {
   // them kept any wrong cadence for ever: 2 or 8 steps counted for every one.)
   constexpr int kMaxFilledRow = 10;
   filled_row_ = missed > 0 ? filled_row_ + 1 : 0;
-  if (filled_row_ > kMaxFilledRow) {
+  if (filled_row_ > kMaxFilledRow && !walking_period(interval_s_)) {
     missed = 0;
     filled_row_ = 0;
     interval_s_ = 0.0;
@@ -785,6 +785,29 @@ void Pdr::on_step(double t_s, StepSource source) {
     last_count_ = std::min(last_count_ + 1, kLookback);
   }
   out_.heading_deg = heading * 180.0 / M_PI;
+}
+
+bool Pdr::walking_period(double lag_s) const {
+  // Autocorrelation of |f| over the last few seconds at that lag: a step interval repeats the
+  // step (r ~ 0.5-0.9 even in a pocket, where the stride is the waveform's period); half of one
+  // puts a valley on a peak (r < 0).
+  constexpr double kSpanS = 4.0;
+  if (raw_size_ < 8 || !(lag_s > 0.0)) return false;
+  const double t_end = raw_t_[(raw_head_ + raw_size_ - 1) % kRaw];
+  std::size_t first = 0;
+  while (first < raw_size_ && raw_t_[(raw_head_ + first) % kRaw] < t_end - kSpanS) ++first;
+  const std::size_t n = raw_size_ - first;
+  const double dt = (t_end - raw_t_[(raw_head_ + first) % kRaw]) / static_cast<double>(n - 1);
+  const auto lag = static_cast<std::size_t>(std::lround(lag_s / dt));
+  if (!(dt > 0.0) || lag == 0 || 2 * lag >= n) return false;
+  const auto mag = [&](std::size_t i) { return raw_f_[(raw_head_ + first + i) % kRaw].norm(); };
+  double mean = 0.0;
+  for (std::size_t i = 0; i < n; ++i) mean += mag(i);
+  mean /= static_cast<double>(n);
+  double num = 0.0, den = 0.0;
+  for (std::size_t i = 0; i + lag < n; ++i) num += (mag(i) - mean) * (mag(i + lag) - mean);
+  for (std::size_t i = 0; i < n; ++i) den += (mag(i) - mean) * (mag(i) - mean);
+  return den > 0.0 && num / den * static_cast<double>(n) / static_cast<double>(n - lag) > 0.3;
 }
 
 void Pdr::learn_interval(double interval_s) {

@@ -504,6 +504,8 @@ class Pdr {
   std::array<double, kIntervals> intervals_{};
   std::size_t interval_count_ = 0;
   void learn_interval(double interval_s);
+  /// Whether the phone's acceleration repeats itself after `lag_s` (a step interval does).
+  [[nodiscard]] bool walking_period(double lag_s) const;
   // Heading over the current step (circular mean) and of the last three steps.
   double sum_sin_ = 0.0, sum_cos_ = 0.0;
   /// The heading over the last seconds, in 0.1 s bins (sums of unit vectors, since the walking
