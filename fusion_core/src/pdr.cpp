@@ -487,7 +487,7 @@ void Pdr::on_step(double t_s, StepSource source) {
       have_mag_grad ? Eigen::Vector3d(mag_grad_sum_ / mag_grad_n_) : Eigen::Vector3d::Zero();
   mag_grad_sum_.setZero();
   mag_grad_n_ = 0;
-  const std::array<Eigen::Vector3d, 2> tilts_before = tilts_;
+  const std::array<Eigen::Vector3d, 2> ups_before = ups_;
   const double per_event = foot ? 2.0 : 1.0;  // a foot sensor sees one event per two steps
   // Steps the detector missed (our addition): its thresholds follow the last steps' peaks and
   // valleys, so after an arm swing the smaller steps of the next pose go unseen until its
@@ -559,10 +559,10 @@ void Pdr::on_step(double t_s, StepSource source) {
           correlated_steps_ = 0;
           switch_steps_ = 0;
           // The phone may have begun to move a step or two before the waveforms said so: those
-          // steps join the switch (re-laid at its end) and the gravity before them is the old
-          // pose's.
+          // steps join the switch (re-laid at its end) and the up direction before them is the
+          // old pose's.
           const std::size_t back = last_count_;
-          pre_switch_tilts_ = back > 0 ? last_tilts_before_[kLookback - back] : tilts_;
+          pre_switch_ups_ = back > 0 ? last_ups_before_[kLookback - back] : ups_;
           for (std::size_t i = kLookback - back; i < kLookback; ++i)
             switch_[static_cast<std::size_t>(switch_steps_++)] = last_steps_[i];
           last_count_ = 0;
@@ -609,9 +609,11 @@ void Pdr::on_step(double t_s, StepSource source) {
       }
       waves_[slot] = w;
       tilts_[slot] = tilt;
+      if (step_up_.norm() > 0.0) ups_[slot] = step_up_.normalized();
       last_slot_ = slot;
       ++wave_count_;
     }
+    step_up_.setZero();
     // Pose: classify the feature window at every step. A pose can only change around a detected
     // switch (turns fool the gyro-variance feature), or when one answer persists for
     // pose_fallback_steps; the first pose is the first confirmed answer.
@@ -767,31 +769,37 @@ void Pdr::on_step(double t_s, StepSource source) {
   laid.laid_rad = heading;
   laid.old_frame_rad = step_heading;
   laid.slot = last_slot_;
-  laid.tilt = tilts_[last_slot_];
+  laid.up = ups_[last_slot_];
   laid.axis_sum = {step_axis_x, step_axis_z};
   if (switching_ && switch_steps_ < static_cast<int>(switch_.size()))
     switch_[static_cast<std::size_t>(switch_steps_++)] = laid;
   if (!switching_ && switch_steps_ > 0) {
-    relay_switch_steps(heading);
+    relay_switch_steps(heading, applied_pose_);
     switch_steps_ = 0;
+  } else if (switching_ && candidate_count_ > 0) {
+    // Meanwhile the switch's steps are laid as the pose the classifier now sees would lay them
+    // (again at every step, each time from the latest up direction): a walk may end before the
+    // new pose is confirmed (a phone put away on arrival), and its last metres then point
+    // where they went, not along the heading from before the switch.
+    relay_switch_steps(std::nullopt, candidate_pose_);
   }
   if (!switching_ && !foot) {
     for (std::size_t i = 0; i + 1 < kLookback; ++i) {
       last_steps_[i] = last_steps_[i + 1];
-      last_tilts_before_[i] = last_tilts_before_[i + 1];
+      last_ups_before_[i] = last_ups_before_[i + 1];
     }
     last_steps_.back() = laid;
-    last_tilts_before_.back() = tilts_before;
+    last_ups_before_.back() = ups_before;
     last_count_ = std::min(last_count_ + 1, kLookback);
   }
   out_.heading_deg = heading * 180.0 / M_PI;
 }
 
 bool Pdr::walking_period(double lag_s) const {
+  constexpr double kSpanS = 4.0;
   // Autocorrelation of |f| over the last few seconds at that lag: a step interval repeats the
   // step (r ~ 0.5-0.9 even in a pocket, where the stride is the waveform's period); half of one
   // puts a valley on a peak (r < 0).
-  constexpr double kSpanS = 4.0;
   if (raw_size_ < 8 || !(lag_s > 0.0)) return false;
   const double t_end = raw_t_[(raw_head_ + raw_size_ - 1) % kRaw];
   std::size_t first = 0;
@@ -1027,18 +1035,19 @@ void Pdr::learn_gyro_bias(const ImuSample& s) {
   still_w2_ = still_a_ = still_a2_ = 0.0;
 }
 
-void Pdr::relay_switch_steps(double heading_after) {
+void Pdr::relay_switch_steps(std::optional<double> heading_after, PhonePose pose) {
   // First step after a pose switch (our addition to seed 003). While the phone was moved, the
   // steps were laid with the heading from before the switch; now the new pose is known, each
   // switch step is given the heading it really had:
-  //  - steps whose gravity direction (sensor frame) already matches the new steady one (same
-  //    foot: an arm swing alternates): the phone was in its new place, so the walking
+  //  - steps whose up direction (sensor frame, gyro-tracked: a corner's centripetal
+  //    acceleration does not tilt it) already matches the new steady one (same foot: an arm
+  //    swing alternates): the phone was in its new place, so the walking
   //    direction is the new pose's forward axis, from that step's field and gyro-tracked up
   //    (a turn during the settling steps is then measured, not interpolated);
   //  - steps still in the old orientation: the heading filter's heading in the old frame;
   //  - the steps of the movement itself: interpolated between those.
   const double tol = std::cos(params_.switch_tilt_deg * M_PI / 180.0);
-  const std::size_t axis = pose_rotation(applied_pose_)(0, 0) > 0.5 ? 0 : 1;
+  const std::size_t axis = pose_rotation(pose)(0, 0) > 0.5 ? 0 : 1;
   const auto n = static_cast<std::size_t>(switch_steps_);
   std::array<double, kMaxSwitchSteps> h{};
   std::array<bool, kMaxSwitchSteps> known{};
@@ -1046,14 +1055,14 @@ void Pdr::relay_switch_steps(double heading_after) {
   for (std::size_t k = 0; k < n; ++k) {
     const SwitchStep& r = switch_[k];
     known[k] = false;
-    if (r.tilt.dot(tilts_[r.slot]) > tol) {
+    if (r.up.dot(ups_[r.slot]) > tol) {
       const Eigen::Vector2d& v = r.axis_sum[axis];
       if (v.norm() > 1e-9) {
         h[k] = wrap_2pi(std::atan2(v.x(), v.y()));
         known[k] = true;
       }
       moved = true;
-    } else if (!moved && r.tilt.dot(pre_switch_tilts_[r.slot]) > tol) {
+    } else if (!moved && r.up.dot(pre_switch_ups_[r.slot]) > tol) {
       h[k] = r.old_frame_rad;
       known[k] = true;
     } else {
@@ -1074,7 +1083,7 @@ void Pdr::relay_switch_steps(double heading_after) {
     }
     std::size_t next = k;
     while (next < n && !known[next]) ++next;
-    const double after = next < n ? h[next] : heading_after;
+    const double after = next < n ? h[next] : heading_after ? *heading_after : before;
     const double span =
         static_cast<double>(next) - (have_before_k ? static_cast<double>(before_k) : -1.0);
     const double pos =
@@ -1082,9 +1091,10 @@ void Pdr::relay_switch_steps(double heading_after) {
     h[k] = before + std::remainder(after - before, kTwoPi) * pos / span;
   }
   for (std::size_t k = 0; k < n; ++k) {
-    const SwitchStep& r = switch_[k];
+    SwitchStep& r = switch_[k];
     out_.x_m += r.length_m * (std::sin(h[k]) - std::sin(r.laid_rad));
     out_.y_m += r.length_m * (std::cos(h[k]) - std::cos(r.laid_rad));
+    r.laid_rad = h[k];  // a later re-laying moves it from here
   }
 }
 
@@ -1230,6 +1240,7 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
     sum_sin_ += std::sin(heading_.heading_rad());
     sum_cos_ += std::cos(heading_.heading_rad());
     add_heading_bin(s.t_s, heading_.heading_rad());
+    step_up_ += m.transpose() * heading_.state().up;
     if (!out_.step)
       out_.heading_deg = switching_ && have_replacement_ ? replacement_heading_rad_ * 180.0 / M_PI
                                                          : heading_.heading_rad() * 180.0 / M_PI;

@@ -406,6 +406,12 @@ class Pdr {
   std::size_t raw_head_ = 0, raw_size_ = 0;
   std::array<Wave, 2> waves_{};             ///< the last two step waveforms
   std::array<Eigen::Vector3d, 2> tilts_{};  ///< their mean gravity directions (sensor frame)
+  /// The up direction tracked by the heading filter (gyro, pulled toward the accelerometer with
+  /// the turn's centripetal acceleration taken out), sensor frame: summed over the step in
+  /// progress, and its mean over the last two steps. Unlike the waveform's mean acceleration it
+  /// does not tilt in a corner: the switch's re-laying tells by it where the phone sat.
+  Eigen::Vector3d step_up_ = Eigen::Vector3d::Zero();
+  std::array<Eigen::Vector3d, 2> ups_{};
   bool settling_ = false;  ///< switch over, waiting for the new pose to be confirmed
   int settling_steps_ = 0;
   bool pose_known_ = false;
@@ -415,8 +421,8 @@ class Pdr {
     double length_m = 0.0;
     double laid_rad = 0.0;       ///< heading it was laid with
     double old_frame_rad = 0.0;  ///< heading filter's heading (pose before the switch)
-    Eigen::Vector3d tilt = Eigen::Vector3d::UnitZ();  ///< mean gravity direction, sensor frame
-    std::size_t slot = 0;                             ///< which foot (waves_/tilts_ slot)
+    Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  ///< mean tracked up, sensor frame
+    std::size_t slot = 0;                           ///< which foot (waves_/ups_ slot)
     std::array<Eigen::Vector2d, 2> axis_sum{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
   };
   static constexpr std::size_t kMaxSwitchSteps = 32;
@@ -424,9 +430,11 @@ class Pdr {
   /// the phone began to move, so those are re-laid with the switch.
   static constexpr std::size_t kLookback = 2;
   std::array<SwitchStep, kLookback> last_steps_{};
-  std::array<std::array<Eigen::Vector3d, 2>, kLookback> last_tilts_before_{};
+  std::array<std::array<Eigen::Vector3d, 2>, kLookback> last_ups_before_{};
   std::size_t last_count_ = 0;
-  void relay_switch_steps(double heading_after);
+  /// Re-lays the switch's steps (switch_) for the phone now in `pose`; `heading_after` is the
+  /// heading of the step after them (none: the switch goes on).
+  void relay_switch_steps(std::optional<double> heading_after, PhonePose pose);
   void reset_walking_direction();
   /// Adds one sample (sensor frame) to the step's vertical-field sums.
   void add_vertical_field(const Eigen::Vector3d& gyro, const Eigen::Vector3d& up,
@@ -489,9 +497,8 @@ class Pdr {
   bool have_av_ = false;
   std::array<SwitchStep, kMaxSwitchSteps> switch_{};
   int switch_steps_ = 0;
-  std::array<Eigen::Vector3d, 2> pre_switch_tilts_{
-      Eigen::Vector3d::UnitZ(),
-      Eigen::Vector3d::UnitZ()};  ///< both feet's gravity before the switch
+  std::array<Eigen::Vector3d, 2> pre_switch_ups_{
+      Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitZ()};  ///< both feet's up before the switch
   std::size_t last_slot_ = 0;
   /// Over the current step, sums of unit (east, north) vectors of the horizontal sensor x and
   /// -z axes: the walking direction if the pose's forward axis is that one.
