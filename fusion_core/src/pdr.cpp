@@ -652,9 +652,11 @@ void Pdr::on_step(double t_s, StepSource source) {
       }
       // (The fallback is for a pose that changes: the old pose's long run of answers must not
       // end a switch the moment it is detected.)
-      const bool may_change =
-          !pose_known_ || settling_ ||
-          (candidate_pose_ != applied_pose_ && candidate_count_ >= params_.pose_fallback_steps);
+      const bool same_frame = pose_rotation(candidate_pose_).isApprox(pose_rotation(applied_pose_));
+      const int fallback =
+          same_frame ? params_.pose_fallback_same_frame_steps : params_.pose_fallback_steps;
+      const bool may_change = !pose_known_ || settling_ ||
+                              (candidate_pose_ != applied_pose_ && candidate_count_ >= fallback);
       if (candidate_count_ >= params_.pose_confirm_steps && may_change) {
         settling_ = switching_ = false;
         const Eigen::Matrix3d r =

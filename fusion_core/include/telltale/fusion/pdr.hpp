@@ -263,17 +263,22 @@ struct PdrParams {
   int switch_exit_steps = 2;           ///< correlated steps needed to leave a switch
   int pose_window_steps = 10;          ///< steps after a switch to confirm the new pose
   int pose_fallback_steps = 10;        ///< identical answers that change the pose without a switch
-  double pose_gravity_deg = 45.0;      ///< a pose whose M does not bring gravity this close to
-                                       ///< the walking frame's up is not plausible
-  double straight_deg = 10.0;          ///< 3 steps within this of their mean are "straight"
-  int pose_confirm_steps = 3;          ///< identical classifications before the pose changes
-  double fill_min_ratio = 1.6;         ///< a gap this many step intervals long has missed steps...
-  double fill_max_gap_s = 4.0;         ///< ...if shorter than this...
-  double fill_min_energy = 0.5;        ///< ...and the phone's acceleration energy says walking
-  double min_step_interval_s = 0.2;    ///< 5 steps/s, a sprinter's: shorter is no cadence
-  double walk_pause_s = 2.0;           ///< no step for this long: the next is a new walk
-  bool walking_direction = true;       ///< correct the phone's yaw from the acceleration pattern
-  int walking_direction_steps = 4;     ///< straight steps in a pose before the correction applies
+  /// The same between poses with one walking frame (hand-held and arm swing: no re-orientation
+  /// for the waveforms to see). Fewer are needed: no frame turns with a wrong answer, and until
+  /// the change the old pose's walking-direction correction is applied to the new pose's steps
+  /// (~10 deg after an arm swing, measured).
+  int pose_fallback_same_frame_steps = 5;
+  double pose_gravity_deg = 45.0;    ///< a pose whose M does not bring gravity this close to
+                                     ///< the walking frame's up is not plausible
+  double straight_deg = 10.0;        ///< 3 steps within this of their mean are "straight"
+  int pose_confirm_steps = 3;        ///< identical classifications before the pose changes
+  double fill_min_ratio = 1.6;       ///< a gap this many step intervals long has missed steps...
+  double fill_max_gap_s = 4.0;       ///< ...if shorter than this...
+  double fill_min_energy = 0.5;      ///< ...and the phone's acceleration energy says walking
+  double min_step_interval_s = 0.2;  ///< 5 steps/s, a sprinter's: shorter is no cadence
+  double walk_pause_s = 2.0;         ///< no step for this long: the next is a new walk
+  bool walking_direction = true;     ///< correct the phone's yaw from the acceleration pattern
+  int walking_direction_steps = 4;   ///< straight steps in a pose before the correction applies
   /// How far a phone is yawed in a hand or pocket, rms (a few degrees). The estimate is shrunk
   /// toward 0 by prior^2 / (prior^2 + s^2), s its standard error from the scatter of the steps'
   /// own angles, so a noisy estimate (a pocket, a swinging arm) corrects little and a clean one
