@@ -499,7 +499,8 @@ void Pdr::on_step(double t_s, StepSource source) {
   if (!foot && last_step_t_s_ >= 0.0 && interval_s_ > 0.0) {
     const double ratio = gap / interval_s_;
     if (ratio > params_.fill_min_ratio && gap < params_.fill_max_gap_s &&
-        features_.features().acc_energy > params_.fill_min_energy)
+        features_.features().acc_energy > params_.fill_min_energy &&
+        !quiet_between(last_step_t_s_, t_s))
       missed = static_cast<int>(std::lround(ratio)) - 1;
   }
   // Filling in needs a cadence that was measured. A gap after every step is no missed step but a
@@ -797,6 +798,36 @@ void Pdr::on_step(double t_s, StepSource source) {
   out_.heading_deg = heading * 180.0 / M_PI;
 }
 
+bool Pdr::quiet_between(double t0_s, double t1_s) const {
+  // A walker who stopped holds the phone still for a moment (|f| varies by < 0.1 m/s^2); a
+  // walking trunk never does, for any stretch of a step.
+  const double window_s = params_.fill_quiet_s;
+  const double limit = params_.still_acc_std_m_s2;
+  std::size_t first = 0;
+  while (first < raw_size_ && raw_t_[(raw_head_ + first) % kRaw] < t0_s) ++first;
+  double sum = 0.0, sum2 = 0.0;
+  std::size_t lo = first;
+  for (std::size_t i = first; i < raw_size_; ++i) {
+    const std::size_t k = (raw_head_ + i) % kRaw;
+    if (raw_t_[k] > t1_s) break;
+    const double m = raw_f_[k].norm();
+    sum += m;
+    sum2 += m * m;
+    while (raw_t_[(raw_head_ + lo) % kRaw] < raw_t_[k] - window_s) {
+      const double ml = raw_f_[(raw_head_ + lo) % kRaw].norm();
+      sum -= ml;
+      sum2 -= ml * ml;
+      ++lo;
+    }
+    const auto n = static_cast<double>(i - lo + 1);
+    if (raw_t_[k] - raw_t_[(raw_head_ + lo) % kRaw] >= window_s * 0.9 && n >= 5) {
+      const double var = sum2 / n - (sum / n) * (sum / n);
+      if (var < limit * limit) return true;
+    }
+  }
+  return false;
+}
+
 bool Pdr::walking_period(double lag_s) const {
   constexpr double kSpanS = 4.0;
   // Autocorrelation of |f| over the last few seconds at that lag: a step interval repeats the
@@ -1052,7 +1083,7 @@ void Pdr::relay_switch_steps(std::optional<double> heading_after, PhonePose pose
   const std::size_t axis = pose_rotation(pose)(0, 0) > 0.5 ? 0 : 1;
   const auto n = static_cast<std::size_t>(switch_steps_);
   std::array<double, kMaxSwitchSteps> h{};
-  std::array<bool, kMaxSwitchSteps> known{};
+  std::array<bool, kMaxSwitchSteps> known{}, in_new{};
   bool moved = false;
   for (std::size_t k = 0; k < n; ++k) {
     const SwitchStep& r = switch_[k];
@@ -1061,7 +1092,7 @@ void Pdr::relay_switch_steps(std::optional<double> heading_after, PhonePose pose
       const Eigen::Vector2d& v = r.axis_sum[axis];
       if (v.norm() > 1e-9) {
         h[k] = wrap_2pi(std::atan2(v.x(), v.y()));
-        known[k] = true;
+        known[k] = in_new[k] = true;
       }
       moved = true;
     } else if (!moved && r.up.dot(pre_switch_ups_[r.slot]) > tol) {
@@ -1097,6 +1128,10 @@ void Pdr::relay_switch_steps(std::optional<double> heading_after, PhonePose pose
     out_.x_m += r.length_m * (std::sin(h[k]) - std::sin(r.laid_rad));
     out_.y_m += r.length_m * (std::cos(h[k]) - std::cos(r.laid_rad));
     r.laid_rad = h[k];  // a later re-laying moves it from here
+    // Steps walked in the new pose turn with its walking-direction correction once that is
+    // learnt (revise_pose_yaw), like the pose's later steps: they were laid with its raw axis.
+    if (heading_after && in_new[k])
+      pose_disp_ += r.length_m * Eigen::Vector2d(std::sin(h[k]), std::cos(h[k]));
   }
 }
 

@@ -268,13 +268,17 @@ struct PdrParams {
   /// the change the old pose's walking-direction correction is applied to the new pose's steps
   /// (~10 deg after an arm swing, measured).
   int pose_fallback_same_frame_steps = 5;
-  double pose_gravity_deg = 45.0;    ///< a pose whose M does not bring gravity this close to
-                                     ///< the walking frame's up is not plausible
-  double straight_deg = 10.0;        ///< 3 steps within this of their mean are "straight"
-  int pose_confirm_steps = 3;        ///< identical classifications before the pose changes
-  double fill_min_ratio = 1.6;       ///< a gap this many step intervals long has missed steps...
-  double fill_max_gap_s = 4.0;       ///< ...if shorter than this...
-  double fill_min_energy = 0.5;      ///< ...and the phone's acceleration energy says walking
+  double pose_gravity_deg = 45.0;  ///< a pose whose M does not bring gravity this close to
+                                   ///< the walking frame's up is not plausible
+  double straight_deg = 10.0;      ///< 3 steps within this of their mean are "straight"
+  int pose_confirm_steps = 3;      ///< identical classifications before the pose changes
+  double fill_min_ratio = 1.6;     ///< a gap this many step intervals long has missed steps...
+  double fill_max_gap_s = 4.0;     ///< ...if shorter than this...
+  double fill_min_energy = 0.5;    ///< ...and the phone's acceleration energy says walking
+  /// ...and the phone was never still (|f| within still_acc_std_m_s2) for this long in the gap:
+  /// a walker who stops and then moves the phone (puts it away, lifts it to the ear) makes one
+  /// event after a gap that held no steps (2-3 steps too many on 10 of 400 loops).
+  double fill_quiet_s = 0.6;
   double min_step_interval_s = 0.2;  ///< 5 steps/s, a sprinter's: shorter is no cadence
   double walk_pause_s = 2.0;         ///< no step for this long: the next is a new walk
   bool walking_direction = true;     ///< correct the phone's yaw from the acceleration pattern
@@ -518,6 +522,8 @@ class Pdr {
   void learn_interval(double interval_s);
   /// Whether the phone's acceleration repeats itself after `lag_s` (a step interval does).
   [[nodiscard]] bool walking_period(double lag_s) const;
+  /// Whether the phone was still (|f| steady) for fill_quiet_s somewhere in [t0, t1].
+  [[nodiscard]] bool quiet_between(double t0_s, double t1_s) const;
   // Heading over the current step (circular mean) and of the last three steps.
   double sum_sin_ = 0.0, sum_cos_ = 0.0;
   /// The heading over the last seconds, in 0.1 s bins (sums of unit vectors, since the walking
