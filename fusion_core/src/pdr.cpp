@@ -500,7 +500,7 @@ void Pdr::on_step(double t_s, StepSource source) {
     const double ratio = gap / interval_s_;
     if (ratio > params_.fill_min_ratio && gap < params_.fill_max_gap_s &&
         features_.features().acc_energy > params_.fill_min_energy &&
-        !quiet_between(last_step_t_s_, t_s))
+        !(params_.fill_quiet_s > 0.0 && quiet_between(last_step_t_s_, t_s)))
       missed = static_cast<int>(std::lround(ratio)) - 1;
   }
   // Filling in needs a cadence that was measured. A gap after every step is no missed step but a

@@ -423,6 +423,43 @@ TEST(Pdr, CountsEveryStepOfAnArmSwingWalk) {
   }
 }
 
+// A walker who stops, stands two seconds and then puts the phone away (from the hand into the
+// trouser pocket) makes step events with the hand's movement after a gap of several step
+// intervals. The gap held no steps: the phone was still in it. Measured on these 8 people: 3-7
+// steps too many without that test (fill_quiet_s = 0), 1-2 with it (the movement's own events,
+// each counted as a step: a walk's first step is not confirmed by a second, see the issue note).
+TEST(Pdr, AStopThenThePhonePutAwayFillsNoGap) {
+  for (int i = 1; i <= 8; ++i) {
+    const auto seed = static_cast<std::uint64_t>(i);
+    const sim::Person person = sim::random_person(seed);
+    sim::GaitScenario sc = sim::straight_phone_walk(sim::Gait::kWalk, PhonePose::kHandHeld, 60.0);
+    sc.path = {{14.0, 0.0}};
+    sc.closed = true;
+    sc.standing_s = 4.0;
+    sc.segments.push_back({sim::Gait::kWalk, PhonePose::kPocket, 60.0});
+    // The walk's end for this person, then the switch two seconds after it.
+    const double walk_end_s = sim::simulate_gait(sc, person, seed).step_times_s.back();
+    sc.segments.front().duration_s = walk_end_s + 2.0 - sc.standing_s;
+    const auto run = sim::simulate_gait(sc, person, seed);
+    const auto first_switching = std::find_if(run.samples.begin(), run.samples.end(),
+                                              [](const auto& s) { return s.switching; });
+    ASSERT_NE(first_switching, run.samples.end()) << "person " << i;
+    ASSERT_GT(first_switching->imu.t_s, run.step_times_s.back() + 1.5) << "person " << i;
+    const auto extra = [&run, &person](double quiet_s) {
+      PdrParams p;
+      p.height_m = person.height_m;
+      p.fill_quiet_s = quiet_s;
+      Pdr pdr(p);
+      for (const auto& s : run.samples) (void)pdr.update(s.imu, s.mag_uT);
+      return static_cast<long>(pdr.output().steps) - static_cast<long>(run.step_times_s.size());
+    };
+    const long with = extra(PdrParams{}.fill_quiet_s), without = extra(0.0);
+    EXPECT_GE(with, 0) << "person " << i;
+    EXPECT_LE(with, 2) << "person " << i;
+    EXPECT_GE(without, with + 2) << "person " << i;
+  }
+}
+
 // Given loops walked with the phone at the ear (a hard-iron offset the magnetometer calibration
 // only learns at the first corner), then re-laying the steps already walked when the offset is
 // known closes the loops far better: 20 walks, measured median 0.86 % with, 1.59 % without, and
@@ -462,28 +499,25 @@ TEST(Pdr, RevisingTheTrackWithTheLearntHardIronClosesLoops) {
 }
 
 // Issue 5's closed-loop target: end-point error <= 2 % of the distance in >= 90 % of walks (seed
-// 003: 85 %). With pose switches it is NOT reached. Measured (fusion_cli steps-eval --tables pdr,
-// seeds 2001-2040, each person first calibrated by a 100 m hand-held walk): 31 of 40 walks within
-// 2 %, median 1.22 %, 90th percentile 2.71 % (200 fresh walks, --first-seed 3001 --loops 200:
-// 147, 74 %). These 20 walks measure median 1.61 %, 14 within 2 %, 18th 2.71 %; the test holds
-// that line.
-TEST(Pdr, ClosedLoopsWithPoseSwitchesMeasuredFigures) {
+// 003: 85 %), with pose switches, each person first calibrated by a 100 m hand-held walk.
+// Measured (fusion_cli steps-eval --tables pdr): these 40 walks (seeds 2001-2040) 37 within 2 %,
+// median 0.97 %, 37th 1.98 %; 400 walks no change was tuned on (--first-seed 5001 --loops 400)
+// 368, 92 %. The test asserts the target on these 40 walks and the median.
+TEST(Pdr, ClosedLoopsWithPoseSwitchesReachTheTarget) {
   std::vector<double> err;
-  for (int i = 0; i < 20; ++i)
+  for (int i = 0; i < 40; ++i)
     err.push_back(sim::simulate_pdr_loop(static_cast<std::uint64_t>(2001 + i)).error_fraction);
   std::sort(err.begin(), err.end());
   const auto within = std::count_if(err.begin(), err.end(), [](double e) { return e <= 0.02; });
   RecordProperty("within_2_percent", std::to_string(within));
-  RecordProperty("median_percent", std::to_string(100 * err[10]));
-  RecordProperty("18th_percent", std::to_string(100 * err[17]));
-  EXPECT_LE(err[10], 0.017);
-  EXPECT_GE(within, 13);
-  EXPECT_LE(err[17], 0.029);
+  RecordProperty("median_percent", std::to_string(100 * err[20]));
+  EXPECT_GE(within, 36);
+  EXPECT_LE(err[20], 0.012);
 }
 
-// The same walks in one pose (the first of each schedule) reach the target: measured 40 of 40
-// within 2 % on seeds 2001-2040 and 197 of 200 fresh walks (98.5 %); in arm swing alone 198 of
-// 200. These 20 walks: the test asserts >= 90 % within 2 % and the median.
+// The same walks in one pose (the first of each schedule): measured 40 of 40 within 2 % on seeds
+// 2001-2040 and 396 of 400 on seeds 5001-5400; in arm swing alone 385 of 400. These 20 walks:
+// the test asserts >= 90 % within 2 % and the median.
 TEST(Pdr, ClosedLoopsInOnePoseReachTheTarget) {
   std::vector<double> err;
   for (int i = 0; i < 20; ++i)

@@ -13,8 +13,11 @@
 ///
 /// Our additions (each measured on closed loops, `fusion_cli steps-eval --tables pdr`): online
 /// gyro-aided hard-iron calibration of the magnetometer (hard_iron.hpp); a switch's steps, and
-/// the one or two before it was detected, re-laid with the heading each really had once the new
-/// pose is known; steps the detector left in a gap of several intervals counted; the phone's yaw
+/// the one or two before it was detected, re-laid with the heading each really had (at every
+/// step while it lasts, with the pose the classifier sees, and once the new pose is confirmed);
+/// steps the detector left in a gap of several intervals counted (the cadence the median of the
+/// last measured intervals, the gap laid along the heading it had, a gap with a still phone a
+/// stop); between poses with one walking frame a faster pose change; the phone's yaw
 /// from the walking direction removed using the step's acceleration pattern (shrunk toward 0
 /// while the pose is young, from straight steps only); the centripetal acceleration of turns
 /// taken out before the up direction follows the accelerometer; steps already walked re-laid when
@@ -277,7 +280,7 @@ struct PdrParams {
   double fill_min_energy = 0.5;    ///< ...and the phone's acceleration energy says walking
   /// ...and the phone was never still (|f| within still_acc_std_m_s2) for this long in the gap:
   /// a walker who stops and then moves the phone (puts it away, lifts it to the ear) makes one
-  /// event after a gap that held no steps (2-3 steps too many on 10 of 400 loops).
+  /// event after a gap that held no steps (2-3 steps too many on 10 of 400 loops). 0: off.
   double fill_quiet_s = 0.6;
   double min_step_interval_s = 0.2;  ///< 5 steps/s, a sprinter's: shorter is no cadence
   double walk_pause_s = 2.0;         ///< no step for this long: the next is a new walk
