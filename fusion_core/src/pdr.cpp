@@ -865,14 +865,14 @@ void Pdr::learn_interval(double interval_s) {
   interval_s_ = n % 2 ? sorted[mid] : 0.5 * (sorted[mid - 1] + sorted[mid]);
 }
 
-void Pdr::add_heading_bin(double t_s, double heading_rad) {
+void Pdr::add_heading_bin(double t_s, const Eigen::Vector2d& unit) {
   const auto id = static_cast<std::int64_t>(std::floor(t_s / kHeadingBinS));
   const std::size_t slot = ring_slot(id, kHeadingBins);
   if (heading_bin_id_[slot] != id) {
     heading_bin_id_[slot] = id;
     heading_bins_[slot].setZero();
   }
-  heading_bins_[slot] += Eigen::Vector2d(std::cos(heading_rad), std::sin(heading_rad));
+  heading_bins_[slot] += unit;
 }
 
 Eigen::Vector2d Pdr::gap_turn(double t0_s, double t1_s, int parts) const {
@@ -1274,9 +1274,10 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
     if (hz.norm() > 1e-9) axis_sum_[1] += hz.normalized();
   }
   if (heading_.initialised()) {
-    sum_sin_ += std::sin(heading_.heading_rad());
-    sum_cos_ += std::cos(heading_.heading_rad());
-    add_heading_bin(s.t_s, heading_.heading_rad());
+    const Eigen::Vector2d unit(std::cos(heading_.heading_rad()), std::sin(heading_.heading_rad()));
+    sum_sin_ += unit.y();
+    sum_cos_ += unit.x();
+    add_heading_bin(s.t_s, unit);
     step_up_ += m.transpose() * heading_.state().up;
     if (!out_.step)
       out_.heading_deg = switching_ && have_replacement_ ? replacement_heading_rad_ * 180.0 / M_PI

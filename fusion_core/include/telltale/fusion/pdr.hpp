@@ -537,7 +537,7 @@ class Pdr {
   std::array<Eigen::Vector2d, kHeadingBins> heading_bins_{};
   std::array<std::int64_t, kHeadingBins> heading_bin_id_{};
   double heading_bins_from_t_s_ = 0.0;
-  void add_heading_bin(double t_s, double heading_rad);
+  void add_heading_bin(double t_s, const Eigen::Vector2d& unit);  ///< (cos, sin) of the heading
   /// For a gap [t0, t1] walked in `parts` equal steps: the mean of the unit vectors of each
   /// part's heading relative to the whole gap's (x along, y clockwise); (1, 0) when the bins do
   /// not cover the gap.
