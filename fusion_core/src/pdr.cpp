@@ -500,7 +500,7 @@ void Pdr::on_step(double t_s, StepSource source) {
     const double ratio = gap / interval_s_;
     if (ratio > params_.fill_min_ratio && gap < params_.fill_max_gap_s &&
         features_.features().acc_energy > params_.fill_min_energy &&
-        !(params_.fill_quiet_s > 0.0 && quiet_between(last_step_t_s_, t_s)))
+        !(params_.stand_still_s > 0.0 && quiet_between(last_step_t_s_, t_s)))
       missed = static_cast<int>(std::lround(ratio)) - 1;
   }
   // Filling in needs a cadence that was measured. A gap after every step is no missed step but a
@@ -799,13 +799,17 @@ void Pdr::on_step(double t_s, StepSource source) {
 }
 
 bool Pdr::quiet_between(double t0_s, double t1_s) const {
-  // A walker who stopped holds the phone still for a moment (|f| varies by < 0.1 m/s^2); a
-  // walking trunk never does, for any stretch of a step.
-  const double window_s = params_.fill_quiet_s;
+  // A walker who stopped holds the phone still for a moment: |f| steady and little rotation
+  // (|f| alone is steady in a slow arm swing, whose pendulum acceleration is mostly across
+  // gravity). A walking trunk never is, for any stretch of a step. Without a gyroscope the
+  // rotation is unknown and no stretch counts as still.
+  const double window_s = params_.stand_still_s;
+  if (!(window_s > 0.0)) return false;
+  const double w2_limit = params_.stand_gyro_rad_s * params_.stand_gyro_rad_s;
   const double limit = params_.still_acc_std_m_s2;
   std::size_t first = 0;
   while (first < raw_size_ && raw_t_[(raw_head_ + first) % kRaw] < t0_s) ++first;
-  double sum = 0.0, sum2 = 0.0;
+  double sum = 0.0, sum2 = 0.0, sum_w2 = 0.0;
   std::size_t lo = first;
   for (std::size_t i = first; i < raw_size_; ++i) {
     const std::size_t k = (raw_head_ + i) % kRaw;
@@ -813,16 +817,19 @@ bool Pdr::quiet_between(double t0_s, double t1_s) const {
     const double m = raw_f_[k].norm();
     sum += m;
     sum2 += m * m;
+    sum_w2 += raw_w2_[k];
     while (raw_t_[(raw_head_ + lo) % kRaw] < raw_t_[k] - window_s) {
-      const double ml = raw_f_[(raw_head_ + lo) % kRaw].norm();
+      const std::size_t kl = (raw_head_ + lo) % kRaw;
+      const double ml = raw_f_[kl].norm();
       sum -= ml;
       sum2 -= ml * ml;
+      sum_w2 -= raw_w2_[kl];
       ++lo;
     }
     const auto n = static_cast<double>(i - lo + 1);
     if (raw_t_[k] - raw_t_[(raw_head_ + lo) % kRaw] >= window_s * 0.9 && n >= 5) {
       const double var = sum2 / n - (sum / n) * (sum / n);
-      if (var < limit * limit) return true;
+      if (var < limit * limit && sum_w2 / n < w2_limit) return true;
     }
   }
   return false;
@@ -857,11 +864,16 @@ void Pdr::learn_interval(double interval_s) {
   for (std::size_t i = 0; i + 1 < kIntervals; ++i) intervals_[i] = intervals_[i + 1];
   intervals_.back() = interval_s;
   interval_count_ = std::min(interval_count_ + 1, kIntervals);
+  // The newest interval_count_ of them, sorted by insertion (at most 5).
   std::array<double, kIntervals> sorted{};
-  const auto n = static_cast<std::ptrdiff_t>(interval_count_);
-  std::copy(intervals_.end() - n, intervals_.end(), sorted.begin());
-  std::sort(sorted.begin(), sorted.begin() + n);
-  const auto mid = static_cast<std::size_t>(n / 2);
+  const std::size_t n = interval_count_;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double v = intervals_[kIntervals - n + i];
+    std::size_t j = i;
+    for (; j > 0 && sorted[j - 1] > v; --j) sorted[j] = sorted[j - 1];
+    sorted[j] = v;
+  }
+  const std::size_t mid = n / 2;
   interval_s_ = n % 2 ? sorted[mid] : 0.5 * (sorted[mid - 1] + sorted[mid]);
 }
 
@@ -1069,9 +1081,10 @@ void Pdr::learn_gyro_bias(const ImuSample& s) {
 }
 
 void Pdr::relay_switch_steps(std::optional<double> heading_after, PhonePose pose) {
-  // First step after a pose switch (our addition to seed 003). While the phone was moved, the
-  // steps were laid with the heading from before the switch; now the new pose is known, each
-  // switch step is given the heading it really had:
+  // At each step of a pose switch and at the first after it (our addition to seed 003). While
+  // the phone was moved, the steps were laid with the heading from before the switch; with the
+  // pose the classifier sees (at the end, the confirmed one), each switch step is given the
+  // heading it really had:
   //  - steps whose up direction (sensor frame, gyro-tracked: a corner's centripetal
   //    acceleration does not tilt it) already matches the new steady one (same foot: an arm
   //    swing alternates): the phone was in its new place, so the walking
@@ -1167,6 +1180,24 @@ bool Pdr::phone_step(const ImuSample& s, const Eigen::Matrix3d& m, StepEvent& ev
   // confirmed 0.0-0.4 s after the strike, the arm's turn ~0.05 s): the interval across a handoff
   // is no cadence.
   source.handoff = swing != last_step_by_swing_;
+  // A walk after a stand (the phone still since the last step) begins with its first event
+  // held until a second follows within walk_start_intervals with no stand between: a hand
+  // moving the phone (putting it away, lifting it to the ear) makes one event, or two far apart.
+  if (params_.walk_start_intervals > 0.0 && last_step_t_s_ >= 0.0 && interval_s_ > 0.0 &&
+      quiet_between(last_step_t_s_, s.t_s)) {
+    const bool confirmed =
+        start_pending_t_s_ >= 0.0 &&
+        s.t_s - start_pending_t_s_ < params_.walk_start_intervals * interval_s_ &&
+        !quiet_between(start_pending_t_s_, s.t_s);
+    if (!confirmed) {
+      start_pending_t_s_ = s.t_s;
+      return false;
+    }
+    start_pending_t_s_ = -1.0;
+    ++source.backfill;      // the held event
+    ++walk_.steps;          // (a swinging start's backfill must know it was counted)
+    source.handoff = true;  // and no cadence across the stand
+  }
   last_step_by_swing_ = swing;
   // A walk that starts swinging: the swing is recognised after two half swings, and the
   // acceleration may have missed the steps before (the pendulum lifts every valley above the
@@ -1174,7 +1205,7 @@ bool Pdr::phone_step(const ImuSample& s, const Eigen::Matrix3d& m, StepEvent& ev
   // this step, if the walk is that young (its first kBackfillEvents turns).
   constexpr int kBackfillEvents = 8;
   if (swing && !walk_.backfilled && walk_.swing_events <= kBackfillEvents)
-    source.backfill = std::max(0, walk_.swing_events - walk_.steps - 1);
+    source.backfill += std::max(0, walk_.swing_events - walk_.steps - 1);
   if (swing) walk_.backfilled = true;
   ++walk_.steps;
   ev.t_s = swing ? swing_steps_.step_t_s() : s.t_s;
@@ -1205,6 +1236,8 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
     }
     raw_t_[(raw_head_ + raw_size_) % kRaw] = s.t_s;
     raw_f_[(raw_head_ + raw_size_) % kRaw] = s.acc_body_m_s2;
+    raw_w2_[(raw_head_ + raw_size_) % kRaw] =
+        gyro_ok(s) ? s.gyro_body_rad_s.squaredNorm() : kNoGyroW2;
     ++raw_size_;
   }
   // Into the walking frame of the pose in force (eqs. (14)-(15)).

@@ -423,40 +423,80 @@ TEST(Pdr, CountsEveryStepOfAnArmSwingWalk) {
   }
 }
 
-// A walker who stops, stands two seconds and then puts the phone away (from the hand into the
-// trouser pocket) makes step events with the hand's movement after a gap of several step
-// intervals. The gap held no steps: the phone was still in it. Measured on these 8 people: 3-7
-// steps too many without that test (fill_quiet_s = 0), 1-2 with it (the movement's own events,
-// each counted as a step: a walk's first step is not confirmed by a second, see the issue note).
-TEST(Pdr, AStopThenThePhonePutAwayFillsNoGap) {
+// A walker who stops, stands one to three seconds and then puts the phone away (from the hand
+// into the trouser pocket) makes step events with the hand's movement. After a stand (the phone
+// still since the last step) a gap holds no missed steps, and a walk's first event counts only
+// if a second follows within two step intervals. Measured on these 8 people and 3 pauses: every
+// count exact; without the stand (stand_still_s = 0) 55 steps too many in all, up to 7 in one.
+TEST(Pdr, AStopThenThePhonePutAwayCountsNoSteps) {
+  long extra_without = 0, worst_without = 0;
   for (int i = 1; i <= 8; ++i) {
     const auto seed = static_cast<std::uint64_t>(i);
     const sim::Person person = sim::random_person(seed);
-    sim::GaitScenario sc = sim::straight_phone_walk(sim::Gait::kWalk, PhonePose::kHandHeld, 60.0);
-    sc.path = {{14.0, 0.0}};
-    sc.closed = true;
-    sc.standing_s = 4.0;
-    sc.segments.push_back({sim::Gait::kWalk, PhonePose::kPocket, 60.0});
-    // The walk's end for this person, then the switch two seconds after it.
-    const double walk_end_s = sim::simulate_gait(sc, person, seed).step_times_s.back();
-    sc.segments.front().duration_s = walk_end_s + 2.0 - sc.standing_s;
-    const auto run = sim::simulate_gait(sc, person, seed);
-    const auto first_switching = std::find_if(run.samples.begin(), run.samples.end(),
-                                              [](const auto& s) { return s.switching; });
-    ASSERT_NE(first_switching, run.samples.end()) << "person " << i;
-    ASSERT_GT(first_switching->imu.t_s, run.step_times_s.back() + 1.5) << "person " << i;
-    const auto extra = [&run, &person](double quiet_s) {
-      PdrParams p;
-      p.height_m = person.height_m;
-      p.fill_quiet_s = quiet_s;
-      Pdr pdr(p);
-      for (const auto& s : run.samples) (void)pdr.update(s.imu, s.mag_uT);
-      return static_cast<long>(pdr.output().steps) - static_cast<long>(run.step_times_s.size());
-    };
-    const long with = extra(PdrParams{}.fill_quiet_s), without = extra(0.0);
-    EXPECT_GE(with, 0) << "person " << i;
-    EXPECT_LE(with, 2) << "person " << i;
-    EXPECT_GE(without, with + 2) << "person " << i;
+    for (const double pause_s : {1.0, 2.0, 3.0}) {
+      sim::GaitScenario sc = sim::straight_phone_walk(sim::Gait::kWalk, PhonePose::kHandHeld, 60.0);
+      sc.path = {{14.0, 0.0}};
+      sc.closed = true;
+      sc.standing_s = 4.0;
+      sc.segments.push_back({sim::Gait::kWalk, PhonePose::kPocket, 60.0});
+      // The walk's end for this person, then the switch after the pause.
+      const double walk_end_s = sim::simulate_gait(sc, person, seed).step_times_s.back();
+      sc.segments.front().duration_s = walk_end_s + pause_s - sc.standing_s;
+      const auto run = sim::simulate_gait(sc, person, seed);
+      const auto first_switching = std::find_if(run.samples.begin(), run.samples.end(),
+                                                [](const auto& s) { return s.switching; });
+      ASSERT_NE(first_switching, run.samples.end()) << "person " << i;
+      ASSERT_GT(first_switching->imu.t_s, run.step_times_s.back() + 0.5 * pause_s)
+          << "person " << i;
+      const auto extra = [&run, &person](double stand_s) {
+        PdrParams p;
+        p.height_m = person.height_m;
+        p.stand_still_s = stand_s;
+        Pdr pdr(p);
+        for (const auto& s : run.samples) (void)pdr.update(s.imu, s.mag_uT);
+        return static_cast<long>(pdr.output().steps) - static_cast<long>(run.step_times_s.size());
+      };
+      EXPECT_EQ(extra(PdrParams{}.stand_still_s), 0) << "person " << i << " pause " << pause_s;
+      const long without = extra(0.0);
+      extra_without += without;
+      worst_without = std::max(worst_without, without);
+    }
+  }
+  RecordProperty("extra_steps_without", std::to_string(extra_without));
+  EXPECT_GE(extra_without, 40);  // the case is real and the test sees it
+  EXPECT_GE(worst_without, 3);
+}
+
+// A walk, a stand of six seconds, the same walk again (two runs back to back), in every pose
+// and at three paces: the second walk's first step is held until the next confirms it, and
+// counted then. Measured: every count exact (5 people x 3 paces x 4 poses).
+TEST(Pdr, AWalkResumedAfterAStandCountsEveryStep) {
+  for (int i = 1; i <= 5; ++i) {
+    const auto seed = static_cast<std::uint64_t>(i);
+    const sim::Person person = sim::random_person(seed);
+    for (int k = 0; k < kPoseCount; ++k) {
+      const auto pose = static_cast<PhonePose>(k);
+      for (sim::Gait g : {sim::Gait::kSlowWalk, sim::Gait::kWalk, sim::Gait::kFastWalk}) {
+        sim::GaitScenario sc = sim::straight_phone_walk(g, pose, 60.0);
+        sc.path = {{20.0, 0.0}};
+        sc.closed = true;
+        sc.standing_s = 3.0;
+        const auto g_seed = seed * 7 + static_cast<std::uint64_t>(g);
+        const auto first = sim::simulate_gait(sc, person, g_seed);
+        const auto second = sim::simulate_gait(sc, person, g_seed + 100);
+        PdrParams p;
+        p.height_m = person.height_m;
+        Pdr pdr(p);
+        for (const auto& s : first.samples) (void)pdr.update(s.imu, s.mag_uT);
+        const double offset_s = first.samples.back().imu.t_s + 0.02;
+        for (auto s : second.samples) {
+          s.imu.t_s += offset_s;
+          (void)pdr.update(s.imu, s.mag_uT);
+        }
+        EXPECT_EQ(pdr.output().steps, first.step_times_s.size() + second.step_times_s.size())
+            << "person " << i << " pose " << k << " " << sim::gait_name(g);
+      }
+    }
   }
 }
 

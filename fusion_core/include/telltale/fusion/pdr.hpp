@@ -17,7 +17,8 @@
 /// step while it lasts, with the pose the classifier sees, and once the new pose is confirmed);
 /// steps the detector left in a gap of several intervals counted (the cadence the median of the
 /// last measured intervals, the gap laid along the heading it had, a gap with a still phone a
-/// stop); between poses with one walking frame a faster pose change; the phone's yaw
+/// stop); after a stand, a walk's first event held until a second confirms it; between poses
+/// with one walking frame a faster pose change; the phone's yaw
 /// from the walking direction removed using the step's acceleration pattern (shrunk toward 0
 /// while the pose is young, from straight steps only); the centripetal acceleration of turns
 /// taken out before the up direction follows the accelerometer; steps already walked re-laid when
@@ -278,10 +279,16 @@ struct PdrParams {
   double fill_min_ratio = 1.6;     ///< a gap this many step intervals long has missed steps...
   double fill_max_gap_s = 4.0;     ///< ...if shorter than this...
   double fill_min_energy = 0.5;    ///< ...and the phone's acceleration energy says walking
-  /// ...and the phone was never still (|f| within still_acc_std_m_s2) for this long in the gap:
-  /// a walker who stops and then moves the phone (puts it away, lifts it to the ear) makes one
-  /// event after a gap that held no steps (2-3 steps too many on 10 of 400 loops). 0: off.
-  double fill_quiet_s = 0.6;
+  /// ...and held no stand: the phone still (|f| within still_acc_std_m_s2, rotating at less
+  /// than stand_gyro_rad_s rms) for stand_still_s.
+  /// A walker who stops and then moves the phone (puts it away, lifts it to the ear) makes
+  /// events after a gap that held no steps (2-3 steps too many on 10 of 400 loops). 0: off.
+  double stand_still_s = 0.6;
+  /// After a stand a walk's first event counts only if a second follows within this many step
+  /// intervals, without a stand between (the hand's movement made 1-2 lone events). 0: off.
+  double walk_start_intervals = 2.0;
+  /// A stand's rotation rate, rms: a still hand (0.05 rad/s), not a swinging arm (1-3 rad/s).
+  double stand_gyro_rad_s = 0.2;
   double min_step_interval_s = 0.2;  ///< 5 steps/s, a sprinter's: shorter is no cadence
   double walk_pause_s = 2.0;         ///< no step for this long: the next is a new walk
   bool walking_direction = true;     ///< correct the phone's yaw from the acceleration pattern
@@ -401,7 +408,8 @@ class Pdr {
     int steps = 0;         ///< steps counted (either detector)
     bool backfilled = false;
   } walk_;
-  int filled_row_ = 0;  ///< steps in a row that filled a gap
+  int filled_row_ = 0;               ///< steps in a row that filled a gap
+  double start_pending_t_s_ = -1.0;  ///< a walk's first event after a stand, held (phone_step)
   AdaptiveStepDetector foot_steps_;
   PoseFeatureWindow features_;
   HeadingFilter heading_;
@@ -415,6 +423,8 @@ class Pdr {
   static constexpr std::size_t kRaw = 512;
   std::array<double, kRaw> raw_t_{};
   std::array<Eigen::Vector3d, kRaw> raw_f_{};
+  std::array<double, kRaw> raw_w2_{};       ///< |w|^2 (kNoGyroW2 without a gyroscope)
+  static constexpr double kNoGyroW2 = 1e6;  ///< far above any stand's
   std::size_t raw_head_ = 0, raw_size_ = 0;
   std::array<Wave, 2> waves_{};             ///< the last two step waveforms
   std::array<Eigen::Vector3d, 2> tilts_{};  ///< their mean gravity directions (sensor frame)
@@ -525,7 +535,8 @@ class Pdr {
   void learn_interval(double interval_s);
   /// Whether the phone's acceleration repeats itself after `lag_s` (a step interval does).
   [[nodiscard]] bool walking_period(double lag_s) const;
-  /// Whether the phone was still (|f| steady) for fill_quiet_s somewhere in [t0, t1].
+  /// Whether the phone was still (|f| steady, little rotation) for stand_still_s somewhere in
+  /// [t0, t1]: a stand.
   [[nodiscard]] bool quiet_between(double t0_s, double t1_s) const;
   // Heading over the current step (circular mean) and of the last three steps.
   double sum_sin_ = 0.0, sum_cos_ = 0.0;
