@@ -242,8 +242,9 @@ void register_steps_eval(CLI::App& app) {
                   "tests/data/oxford_steps)");
   cmd->add_option("--loops", opts->loops, "simulated closed-loop PDR walks")->capture_default_str();
   cmd->add_option("--first-seed", opts->first_seed,
-                  "seed of the first loop walk (2001: the report set; 100: the set the PDR was "
-                  "tuned on; people seeds 1-23 trained the model)")
+                  "seed of the first loop walk (2001: the report set; 100, 3001-3200, "
+                  "4001-4400: sets the PDR was tuned on; 5001-5400: never tuned on; people "
+                  "seeds 1-23 trained the model)")
       ->check(CLI::Range(24, 1000000000))
       ->capture_default_str();
   cmd->add_option("--tables", opts->tables, "comma list: gait, oxford, pose, pdr")

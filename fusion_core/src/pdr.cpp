@@ -469,7 +469,9 @@ const StepDiagnostics& Pdr::step_diagnostics() const {
 Pdr::Wave Pdr::step_wave(double t0, double t1) const {
   Wave w = Wave::Zero();
   if (raw_size_ == 0) return w;
-  std::size_t j = 0;  // index into the ring from the oldest
+  // Index into the ring from the oldest: the last sample before t0 (the ring holds 10 s).
+  std::size_t j = raw_first_at(t0);
+  j = j > 0 ? j - 1 : 0;
   for (int i = 0; i < kWave; ++i) {
     const double t = t0 + (t1 - t0) * (i + 0.5) / kWave;
     while (j + 1 < raw_size_ && raw_t_[(raw_head_ + j + 1) % kRaw] <= t) ++j;
@@ -499,8 +501,7 @@ void Pdr::on_step(double t_s, StepSource source) {
   if (!foot && last_step_t_s_ >= 0.0 && interval_s_ > 0.0) {
     const double ratio = gap / interval_s_;
     if (ratio > params_.fill_min_ratio && gap < params_.fill_max_gap_s &&
-        features_.features().acc_energy > params_.fill_min_energy &&
-        !(params_.stand_still_s > 0.0 && quiet_between(last_step_t_s_, t_s)))
+        features_.features().acc_energy > params_.fill_min_energy && !source.after_stand)
       missed = static_cast<int>(std::lround(ratio)) - 1;
   }
   // Filling in needs a cadence that was measured. A gap after every step is no missed step but a
@@ -798,6 +799,13 @@ void Pdr::on_step(double t_s, StepSource source) {
   out_.heading_deg = heading * 180.0 / M_PI;
 }
 
+std::size_t Pdr::raw_first_at(double t_s) const {
+  // From the newest back: a step's worth of samples, not the whole ring.
+  std::size_t i = raw_size_;
+  while (i > 0 && raw_t_[(raw_head_ + i - 1) % kRaw] >= t_s) --i;
+  return i;
+}
+
 bool Pdr::quiet_between(double t0_s, double t1_s) const {
   // A walker who stopped holds the phone still for a moment: |f| steady and little rotation
   // (|f| alone is steady in a slow arm swing, whose pendulum acceleration is mostly across
@@ -807,8 +815,7 @@ bool Pdr::quiet_between(double t0_s, double t1_s) const {
   if (!(window_s > 0.0)) return false;
   const double w2_limit = params_.stand_gyro_rad_s * params_.stand_gyro_rad_s;
   const double limit = params_.still_acc_std_m_s2;
-  std::size_t first = 0;
-  while (first < raw_size_ && raw_t_[(raw_head_ + first) % kRaw] < t0_s) ++first;
+  const std::size_t first = raw_first_at(t0_s);
   double sum = 0.0, sum2 = 0.0, sum_w2 = 0.0;
   std::size_t lo = first;
   for (std::size_t i = first; i < raw_size_; ++i) {
@@ -842,8 +849,7 @@ bool Pdr::walking_period(double lag_s) const {
   // puts a valley on a peak (r < 0).
   if (raw_size_ < 8 || !(lag_s > 0.0)) return false;
   const double t_end = raw_t_[(raw_head_ + raw_size_ - 1) % kRaw];
-  std::size_t first = 0;
-  while (first < raw_size_ && raw_t_[(raw_head_ + first) % kRaw] < t_end - kSpanS) ++first;
+  const std::size_t first = raw_first_at(t_end - kSpanS);
   const std::size_t n = raw_size_ - first;
   const double dt = (t_end - raw_t_[(raw_head_ + first) % kRaw]) / static_cast<double>(n - 1);
   const auto lag = static_cast<std::size_t>(std::lround(lag_s / dt));
@@ -1180,11 +1186,11 @@ bool Pdr::phone_step(const ImuSample& s, const Eigen::Matrix3d& m, StepEvent& ev
   // confirmed 0.0-0.4 s after the strike, the arm's turn ~0.05 s): the interval across a handoff
   // is no cadence.
   source.handoff = swing != last_step_by_swing_;
+  source.after_stand = last_step_t_s_ >= 0.0 && quiet_between(last_step_t_s_, s.t_s);
   // A walk after a stand (the phone still since the last step) begins with its first event
   // held until a second follows within walk_start_intervals with no stand between: a hand
   // moving the phone (putting it away, lifting it to the ear) makes one event, or two far apart.
-  if (params_.walk_start_intervals > 0.0 && last_step_t_s_ >= 0.0 && interval_s_ > 0.0 &&
-      quiet_between(last_step_t_s_, s.t_s)) {
+  if (params_.walk_start_intervals > 0.0 && interval_s_ > 0.0 && source.after_stand) {
     const bool confirmed =
         start_pending_t_s_ >= 0.0 &&
         s.t_s - start_pending_t_s_ < params_.walk_start_intervals * interval_s_ &&

@@ -385,10 +385,12 @@ class Pdr {
   static constexpr int kWave = 16;  ///< points per axis in a step waveform
   using Wave = Eigen::Matrix<double, 3 * kWave, 1>;
   /// How a phone step was found (phone_step): steps to count with it that the acceleration
-  /// missed at a walk's swinging start, and whether its detector took over from the other one.
+  /// missed at a walk's swinging start, whether its detector took over from the other one, and
+  /// whether the walker stood still since the last step.
   struct StepSource {
     int backfill = 0;
     bool handoff = false;
+    bool after_stand = false;  ///< the phone stood still since the last step (quiet_between)
   };
   void on_step(double t_s, StepSource source);
   /// Phone-mounted step detection: the acceleration's peaks and valleys, the arm's turns while
@@ -535,6 +537,8 @@ class Pdr {
   void learn_interval(double interval_s);
   /// Whether the phone's acceleration repeats itself after `lag_s` (a step interval does).
   [[nodiscard]] bool walking_period(double lag_s) const;
+  /// Index, from the oldest, of the first raw sample at or after t_s (raw_size_ if none).
+  [[nodiscard]] std::size_t raw_first_at(double t_s) const;
   /// Whether the phone was still (|f| steady, little rotation) for stand_still_s somewhere in
   /// [t0, t1]: a stand.
   [[nodiscard]] bool quiet_between(double t0_s, double t1_s) const;
