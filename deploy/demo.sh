@@ -8,7 +8,7 @@ secure=0
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 echo "building (log: $root/build/build.log)..."
 mkdir -p "$root/build"
-"$root/deploy/build.sh" >"$root/build/build.log" 2>&1 || { tail -n 40 "$root/build/build.log"; exit 1; }
+"$root/deploy/build.sh" shore_server boat_node wearable_node >"$root/build/build.log" 2>&1 || { tail -n 40 "$root/build/build.log"; exit 1; }
 bin="$root/build/bin"
 export TELLTALE_DOMAIN=${TELLTALE_DOMAIN:-$((10 + $$ % 90))}
 port=${TELLTALE_HTTP_PORT:-8080}
