@@ -1,6 +1,10 @@
 #include "session_log.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cstring>
 #include <map>
 #include <stdexcept>
@@ -69,6 +73,56 @@ std::optional<std::uint64_t> first_seq_of(const std::filesystem::path& p,
   }
 }
 
+/// Records in `bytes` with first <= seq <= last, in file order. Where the bytes at a record
+/// boundary are not a valid record (torn by a crash or a full disk), it moves on byte by byte to
+/// the next valid magic + CRC: nothing intact after a torn record is skipped. `clean` is set
+/// false if it had to.
+std::vector<LogRecord> scan_records(const unsigned char* bytes, std::size_t n, std::uint64_t first,
+                                    std::uint64_t last, bool& clean) {
+  std::vector<LogRecord> out;
+  std::size_t pos = 0;
+  while (pos + kLogRecordBytes <= n) {
+    const auto r = decode_record(bytes + pos);
+    if (!r) {
+      clean = false;
+      ++pos;
+      continue;
+    }
+    if (r->seq > last) break;
+    if (r->seq >= first) out.push_back(*r);
+    pos += kLogRecordBytes;
+  }
+  return out;
+}
+
+/// The whole file (only for a damaged one: an intact file is read at its grid offsets).
+std::vector<unsigned char> read_all(const std::filesystem::path& p) {
+  std::vector<unsigned char> out;
+  std::FILE* f = std::fopen(p.c_str(), "rb");
+  if (!f) return out;
+  unsigned char buf[65536];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) out.insert(out.end(), buf, buf + n);
+  std::fclose(f);
+  return out;
+}
+
+/// True if the file is on the record grid: a whole number of records, the last of which holds
+/// the seq its position says (checked by reading that one record).
+bool intact(const std::filesystem::path& p, std::uint64_t first_seq, std::uint64_t size) {
+  if (size % kLogRecordBytes != 0) return false;
+  if (size == 0) return true;
+  std::optional<LogRecord> tail;
+  if (std::FILE* f = std::fopen(p.c_str(), "rb")) {
+    unsigned char buf[kLogRecordBytes];
+    if (std::fseek(f, static_cast<long>(size - kLogRecordBytes), SEEK_SET) == 0 &&
+        std::fread(buf, 1, sizeof buf, f) == sizeof buf)
+      tail = decode_record(buf);
+    std::fclose(f);
+  }
+  return tail && tail->seq == first_seq + size / kLogRecordBytes - 1;
+}
+
 }  // namespace
 
 void encode_record(const LogRecord& r, unsigned char* out) {
@@ -120,34 +174,123 @@ SessionLog::SessionLog(SessionLogConfig config) : config_(std::move(config)) {
   if (ec)
     throw std::runtime_error("cannot create log directory " + config_.dir.string() + ": " +
                              ec.message());
+  // The directory may exist and still refuse files (a read-only mount, permissions): find out
+  // now, before the node says it is ready. A full disk is not a refusal: the log holds records
+  // until it has room again.
+  const auto probe = config_.dir / ("." + file_prefix(config_.boat_id, config_.boot_id) + "probe");
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    const int err = errno;
+    if (err != ENOSPC && err != EDQUOT)
+      throw std::runtime_error("cannot write the session log in " + config_.dir.string() + ": " +
+                               std::strerror(err));
+    fail(err);
+  } else {
+    ::close(fd);
+    ::unlink(probe.c_str());
+  }
 }
 
 SessionLog::~SessionLog() {
-  if (file_) std::fclose(file_);
+  (void)write_pending();
+  if (fd_ >= 0) ::close(fd_);
 }
 
-void SessionLog::open_next(std::uint64_t first_seq) {
-  if (file_) std::fclose(file_);
+void SessionLog::fail(int err) {
+  ++write_errors_;
+  last_error_ = std::strerror(err);
+}
+
+SessionLogHealth SessionLog::health() const {
+  return {pending_.size() / kLogRecordBytes, dropped_, write_errors_, last_error_};
+}
+
+bool SessionLog::open_next(std::uint64_t first_seq) {
+  if (fd_ >= 0) ::close(fd_);
   char seq[24];
   std::snprintf(seq, sizeof seq, "%012llu", static_cast<unsigned long long>(first_seq));
   current_ = config_.dir / (file_prefix(config_.boat_id, config_.boot_id) + seq + ".tlog");
-  file_ = std::fopen(current_.c_str(), "ab");
+  // A file of this name can only be an earlier attempt that holds no record (a roll lands on a
+  // seq no file holds yet): start it afresh.
+  fd_ = ::open(current_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  file_first_seq_ = first_seq;
   in_file_ = 0;
+  if (fd_ < 0) {
+    fail(errno);
+    return false;
+  }
   enforce_limit();
-}
-
-bool SessionLog::append(const LogRecord& record) {
-  if (!file_ || in_file_ >= config_.records_per_file) open_next(record.seq);
-  if (!file_) return false;
-  unsigned char buf[kLogRecordBytes];
-  encode_record(record, buf);
-  if (std::fwrite(buf, 1, sizeof buf, file_) != sizeof buf) return false;
-  ++in_file_;
   return true;
 }
 
-void SessionLog::flush() {
-  if (file_) std::fflush(file_);
+bool SessionLog::append(const LogRecord& record) {
+  const std::uint64_t held = pending_.size() / kLogRecordBytes;
+  if (held > 0 && record.seq != pending_first_seq_ + held) {
+    // Not the next seq (the caller broke the contract): what is held cannot share a file grid
+    // with it. Write it if the disk takes it, else give it up.
+    if (!write_pending()) {
+      dropped_ += held;
+      pending_.clear();
+    }
+  }
+  if (pending_.empty()) pending_first_seq_ = record.seq;
+  const std::size_t at = pending_.size();
+  pending_.resize(at + kLogRecordBytes);
+  encode_record(record, pending_.data() + at);
+  if (pending_.size() > std::max(config_.max_pending_bytes, kLogRecordBytes)) {
+    // Writes have failed for long: the oldest held record goes (the file rolls past the hole).
+    pending_.erase(pending_.begin(),
+                   pending_.begin() + static_cast<std::ptrdiff_t>(kLogRecordBytes));
+    ++pending_first_seq_;
+    ++dropped_;
+  }
+  // Batches of about 4 KB, like the stdio buffer this replaces; while writes fail, every append
+  // tries again (a cheap failed syscall at the publish rate).
+  if (pending_.size() >= 4096 || !last_error_.empty()) return write_pending();
+  return true;
+}
+
+bool SessionLog::flush() { return write_pending(); }
+
+bool SessionLog::write_pending() {
+  while (!pending_.empty()) {
+    if (fd_ < 0 || in_file_ >= config_.records_per_file ||
+        pending_first_seq_ != file_first_seq_ + in_file_) {
+      if (!open_next(pending_first_seq_)) return false;
+    }
+    const std::uint64_t room = config_.records_per_file - in_file_;
+    const std::size_t want =
+        std::min<std::size_t>(pending_.size(), static_cast<std::size_t>(room) * kLogRecordBytes);
+    const auto base = static_cast<off_t>(in_file_ * kLogRecordBytes);
+    std::size_t done = 0;
+    int err = 0;
+    while (done < want) {
+      const ssize_t n =
+          ::pwrite(fd_, pending_.data() + done, want - done, base + static_cast<off_t>(done));
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        err = n < 0 ? errno : ENOSPC;
+        break;
+      }
+      done += static_cast<std::size_t>(n);
+    }
+    // Whole records written count; a torn tail is cut off so the file stays on the grid (and the
+    // next attempt writes at the grid offset anyway, over whatever is left).
+    const std::size_t whole = done / kLogRecordBytes * kLogRecordBytes;
+    if (whole != done) {
+      const int cut = ::ftruncate(fd_, base + static_cast<off_t>(whole));
+      (void)cut;  // if it fails, the next attempt writes over the torn bytes at the grid offset
+    }
+    pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(whole));
+    in_file_ += whole / kLogRecordBytes;
+    pending_first_seq_ += whole / kLogRecordBytes;
+    if (err != 0) {
+      fail(err);
+      return false;
+    }
+  }
+  last_error_.clear();
+  return true;
 }
 
 void SessionLog::enforce_limit() {
@@ -196,18 +339,31 @@ std::vector<LogRecord> SessionLogReader::read(std::uint64_t first_seq, std::uint
     const std::uint64_t start = files[i].first;
     const std::uint64_t next = i + 1 < files.size() ? files[i + 1].first : UINT64_MAX;
     if (next <= first_seq || start > last_seq) continue;
-    std::FILE* f = std::fopen(files[i].second.c_str(), "rb");
-    if (!f) continue;
-    const std::uint64_t from = std::max(first_seq, start);
-    std::fseek(f, static_cast<long>((from - start) * kLogRecordBytes), SEEK_SET);
-    unsigned char buf[kLogRecordBytes];
-    while (std::fread(buf, 1, sizeof buf, f) == sizeof buf) {
-      const auto r = decode_record(buf);
-      if (!r) continue;
-      if (r->seq > last_seq) break;
-      if (r->seq >= first_seq) out.push_back(*r);
+    const auto& path = files[i].second;
+    const std::uint64_t size = std::filesystem::file_size(path, ec);
+    if (ec) continue;
+    std::vector<LogRecord> got;
+    bool clean = true;
+    if (intact(path, start, size)) {
+      // Seq s sits at (s - start) records: read just the range.
+      const std::uint64_t from = std::max(first_seq, start);
+      const std::uint64_t records = size / kLogRecordBytes;
+      if (from - start >= records) continue;
+      const std::uint64_t to = std::min(last_seq, start + records - 1);
+      std::vector<unsigned char> bytes((to - from + 1) * kLogRecordBytes);
+      std::size_t n = 0;
+      if (std::FILE* f = std::fopen(path.c_str(), "rb")) {
+        if (std::fseek(f, static_cast<long>((from - start) * kLogRecordBytes), SEEK_SET) == 0)
+          n = std::fread(bytes.data(), 1, bytes.size(), f);
+        std::fclose(f);
+      }
+      got = scan_records(bytes.data(), n, first_seq, last_seq, clean);
+    } else {
+      // Off the grid (a torn record, lost records): scan all of it.
+      const auto all = read_all(path);
+      got = scan_records(all.data(), all.size(), first_seq, last_seq, clean);
     }
-    std::fclose(f);
+    out.insert(out.end(), got.begin(), got.end());
   }
   return out;
 }
@@ -218,8 +374,17 @@ std::uint64_t SessionLogReader::last_seq() const {
   for (const auto& e : std::filesystem::directory_iterator(dir_, ec)) {
     const auto first = first_seq_of(e.path(), prefix_);
     if (!first) continue;
-    const auto records = e.file_size(ec) / kLogRecordBytes;
-    if (!ec && records > 0) last = std::max(last, *first + records - 1);
+    const auto size = e.file_size(ec);
+    const auto records = size / kLogRecordBytes;
+    if (ec || records == 0) continue;
+    if (intact(e.path(), *first, size)) {
+      last = std::max(last, *first + records - 1);
+      continue;
+    }
+    const auto all = read_all(e.path());
+    bool clean = true;
+    const auto got = scan_records(all.data(), all.size(), 0, UINT64_MAX, clean);
+    if (!got.empty()) last = std::max(last, got.back().seq);
   }
   return last;
 }

@@ -2,9 +2,14 @@
 // each one goes on disk.
 #include "session_log.hpp"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sched.h>
+#include <sys/mount.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -71,6 +76,112 @@ TEST_F(SessionLogRuns, EarlierRunsOfThisBoatOnlyUntilDelivered) {
   std::ofstream(dir_ / "a-0000000000000066.tlog") << "x";
   EXPECT_EQ(undelivered_runs(dir_, "a", 0x44, std::chrono::hours(300)),
             (std::vector<std::uint64_t>{0x22}));
+}
+
+/// A private mount namespace for this test process (root only), so tmpfs mounts with a size limit
+/// or read-only ones stay invisible to everything else. False where that is not allowed.
+bool private_mounts() {
+  static const bool ok = [] {
+    if (::geteuid() != 0 || ::unshare(CLONE_NEWNS) != 0) return false;
+    return ::mount(nullptr, "/", nullptr, MS_REC | MS_PRIVATE, nullptr) == 0;
+  }();
+  return ok;
+}
+
+class SessionLogFaults : public SessionLogRuns {
+ protected:
+  void TearDown() override {
+    ::umount2(dir_.c_str(), MNT_DETACH);
+    SessionLogRuns::TearDown();
+  }
+  /// A real small filesystem at dir_ (tmpfs, `options` e.g. "size=256k" or "ro").
+  bool mount_tmpfs(const std::string& options, unsigned long flags = 0) {
+    std::filesystem::create_directories(dir_);
+    return private_mounts() && ::mount("tmpfs", dir_.c_str(), "tmpfs", flags, options.c_str()) == 0;
+  }
+  static LogRecord record(std::uint64_t seq) {
+    LogRecord r;
+    r.seq = seq;
+    r.t_utc_ns = seq * 40'000'000;
+    r.heel_deg = static_cast<double>(seq) * 0.01;
+    return r;
+  }
+};
+
+// Given a log on a small real filesystem, when a ballast file fills the disk for a while and is
+// then removed, then every record appended before, during and after the spell is read back in
+// order (none torn, none off the record grid).
+TEST_F(SessionLogFaults, DiskFullSpellLosesNothingAndReportsIt) {
+  if (!mount_tmpfs("size=256k,mode=0755")) GTEST_SKIP() << "needs root and mount namespaces";
+  const auto ballast = dir_ / "ballast";
+  {
+    // Fill the filesystem, then give back a little over one page.
+    const int fd = ::open(ballast.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ASSERT_GE(fd, 0);
+    std::vector<char> block(4096, 'x');
+    while (::write(fd, block.data(), block.size()) > 0) {
+    }
+    ::close(fd);
+  }
+  std::filesystem::resize_file(ballast, std::filesystem::file_size(ballast) - 6000);
+  SessionLog log({dir_, "full", 0xf1, 100000, 1ULL << 30});
+  std::uint64_t seq = 0;
+  for (; seq < 400; ++seq) {  // 38 KB: the disk fills after about 60 records
+    (void)log.append(record(seq + 1));
+    if (seq % 10 == 9) log.flush();
+  }
+  // The spell is seen and reported: records held in memory, the error named.
+  const SessionLogHealth during = log.health();
+  EXPECT_GT(during.pending_records, 0u);
+  EXPECT_GT(during.write_errors, 0u);
+  EXPECT_NE(during.last_error.find("No space"), std::string::npos) << during.last_error;
+  std::filesystem::remove(ballast);  // the spell ends
+  for (; seq < 600; ++seq) {
+    (void)log.append(record(seq + 1));
+    if (seq % 10 == 9) log.flush();
+  }
+  EXPECT_TRUE(log.flush());
+  EXPECT_EQ(log.health().pending_records, 0u);
+  EXPECT_EQ(log.health().dropped_records, 0u);
+  EXPECT_TRUE(log.health().last_error.empty());
+  SessionLogReader reader(dir_, "full", 0xf1);
+  const auto back = reader.read(1, 600);
+  ASSERT_EQ(back.size(), 600u);
+  for (std::uint64_t i = 0; i < back.size(); ++i) ASSERT_EQ(back[i].seq, i + 1);
+  EXPECT_EQ(reader.last_seq(), 600u);
+}
+
+// Given a log file with a torn record in the middle (a crash or a full disk mid-write), the
+// reader finds every intact record after it.
+TEST_F(SessionLogRuns, ReaderResynchronisesAfterATornRecord) {
+  write_run("torn", 0x7, 10);
+  const auto file = dir_ / "torn-0000000000000007-000000000001.tlog";
+  ASSERT_TRUE(std::filesystem::exists(file));
+  {
+    std::ofstream out(file, std::ios::binary | std::ios::app);
+    unsigned char buf[kLogRecordBytes];
+    encode_record(LogRecord{.seq = 11, .t_utc_ns = 11}, buf);
+    out.write(reinterpret_cast<const char*>(buf), 50);  // torn
+    for (std::uint64_t seq = 11; seq <= 20; ++seq) {
+      encode_record(LogRecord{.seq = seq, .t_utc_ns = seq}, buf);
+      out.write(reinterpret_cast<const char*>(buf), sizeof buf);
+    }
+  }
+  SessionLogReader reader(dir_, "torn", 0x7);
+  const auto all = reader.read(1, 20);
+  ASSERT_EQ(all.size(), 20u);
+  for (std::uint64_t i = 0; i < all.size(); ++i) EXPECT_EQ(all[i].seq, i + 1);
+  const auto part = reader.read(12, 15);
+  ASSERT_EQ(part.size(), 4u);
+  EXPECT_EQ(part.front().seq, 12u);
+  EXPECT_EQ(reader.last_seq(), 20u);
+}
+
+// Given a log directory that exists but cannot be written (a read-only mount), the log refuses
+// to open: a boat must not say "ready" and then sail without a log.
+TEST_F(SessionLogFaults, ReadOnlyDirectoryIsRefused) {
+  if (!mount_tmpfs("size=64k", MS_RDONLY)) GTEST_SKIP() << "needs root and mount namespaces";
+  EXPECT_THROW(SessionLog({dir_, "ro", 0x1, 100000, 1ULL << 30}), std::runtime_error);
 }
 
 }  // namespace
