@@ -108,6 +108,14 @@ struct HttpApi::Impl {
                 {"stream_clients", ctx.hub.clients()},
                 {"samples_committed", ctx.store.committed()}};
       if (!store_error.empty()) j["store_error"] = store_error;
+      // The writer: a failing disk shows as a backlog, refused samples and the next retry.
+      const StoreHealth sh = ctx.store.health();
+      j["store"] = {{"failing", sh.failing},
+                    {"backlog", sh.backlog},
+                    {"dropped", sh.dropped},
+                    {"failed_commits", sh.failed_commits},
+                    {"retry_in_s", sh.retry_in_s}};
+      if (sh.failing || sh.dropped > 0) j["status"] = "degraded";
       res.set_content(j.dump(), "application/json");
     });
     server.Get("/api/v1/openapi.json", [](const httplib::Request&, httplib::Response& res) {

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <map>
 
 namespace telltale::shore {
 namespace {
@@ -44,7 +46,8 @@ CREATE TABLE IF NOT EXISTS sessions (
   boat_id TEXT NOT NULL,
   start_ns INTEGER NOT NULL,
   end_ns INTEGER NOT NULL,
-  samples INTEGER NOT NULL
+  samples INTEGER NOT NULL,
+  received_ns INTEGER NOT NULL DEFAULT 0
 );
 CREATE INDEX IF NOT EXISTS sessions_by_boat ON sessions (boat_id, end_ns);
 CREATE TABLE IF NOT EXISTS alarm_rules (
@@ -160,9 +163,10 @@ sqlite3* open_db(const std::string& path, int flags) {
 }
 
 /// The schema this build writes. Version 1: attitude gained boot_id (the boats' run id, for
-/// backfill receipts). Databases from earlier builds are migrated in place; a database from a
-/// newer build is refused rather than misread.
-constexpr int kSchemaVersion = 1;
+/// backfill receipts). Version 2: sessions gained received_ns (the shore's arrival time, for
+/// retention; 0 in older rows: their end_ns stands in). Databases from earlier builds are
+/// migrated in place; a database from a newer build is refused rather than misread.
+constexpr int kSchemaVersion = 2;
 
 void migrate(sqlite3* db) {
   Stmt version_q(db, "PRAGMA user_version");
@@ -173,6 +177,10 @@ void migrate(sqlite3* db) {
   Stmt has_boot(db, "SELECT COUNT(*) FROM pragma_table_info('attitude') WHERE name = 'boot_id'");
   if (has_boot.step() && has_boot.i64(0) == 0)
     exec(db, "ALTER TABLE attitude ADD COLUMN boot_id INTEGER NOT NULL DEFAULT 0");
+  Stmt has_received(
+      db, "SELECT COUNT(*) FROM pragma_table_info('sessions') WHERE name = 'received_ns'");
+  if (has_received.step() && has_received.i64(0) == 0)
+    exec(db, "ALTER TABLE sessions ADD COLUMN received_ns INTEGER NOT NULL DEFAULT 0");
   exec(db, ("PRAGMA user_version = " + std::to_string(kSchemaVersion)).c_str());
 }
 
@@ -246,7 +254,36 @@ Store::~Store() {
     stopping_ = true;
   }
   cv_.notify_all();
-  writer_.join();
+  writer_.join();  // its last round commits what is queued, backoff or not
+  if (!queue_.empty()) {
+    // Not on disk and never acknowledged: say loudly what, per boat run. The boats still hold
+    // these samples in their session logs and deliver them at their next contact with a shore.
+    std::map<std::pair<std::string, std::uint64_t>, std::pair<std::uint64_t, std::uint64_t>> runs;
+    for (const auto& s : queue_) {
+      const auto it = runs.try_emplace({s.boat_id, s.boot_id}, s.seq, s.seq).first;
+      it->second.first = std::min(it->second.first, s.seq);
+      it->second.second = std::max(it->second.second, s.seq);
+    }
+    std::string what;
+    for (const auto& [key, range] : runs) {
+      char line[160];
+      std::snprintf(line, sizeof line, "%s%s run %016llx seq %llu-%llu", what.empty() ? "" : ", ",
+                    key.first.c_str(), static_cast<unsigned long long>(key.second),
+                    static_cast<unsigned long long>(range.first),
+                    static_cast<unsigned long long>(range.second));
+      what += line;
+    }
+    std::fprintf(stderr,
+                 "shore_server: STORE: %zu samples could not be saved at stop (%s): %s. They were "
+                 "never acknowledged, so the boats keep them in their session logs and resend "
+                 "them to the next shore that runs.\n",
+                 queue_.size(), last_error_.c_str(), what.c_str());
+  }
+  if (dropped_ > 0)
+    std::fprintf(stderr,
+                 "shore_server: STORE: %llu samples were refused while the backlog was full; "
+                 "never acknowledged, the boats resend them from their logs.\n",
+                 static_cast<unsigned long long>(dropped_));
   sqlite3_finalize(insert_);
   sqlite3_close(reader_);
   sqlite3_close(db_);  // the last connection checkpoints and removes the WAL
@@ -254,6 +291,12 @@ Store::~Store() {
 
 void Store::enqueue(const AttitudeSample& sample) {
   std::lock_guard lock(mutex_);
+  if (queue_.size() >= config_.max_backlog) {
+    // Commits are failing and the backlog is full: memory stays bounded. The sample is never
+    // acknowledged, so its boat resends it from the session log once the shore stores again.
+    ++dropped_;
+    return;
+  }
   queue_.push_back(sample);
   ++enqueued_;
 }
@@ -322,7 +365,7 @@ void Store::flush() {
   const std::uint64_t target = enqueued_;
   cv_.notify_all();
   flushed_cv_.wait_for(lock, std::chrono::seconds(10),
-                       [&] { return processed_ >= target || stopping_; });
+                       [&] { return processed_ >= target || stopping_ || backoff_.count() > 0; });
 }
 
 void Store::writer_loop() {
@@ -334,14 +377,27 @@ void Store::writer_loop() {
       std::unique_lock lock(mutex_);
       cv_.wait_for(lock, config_.commit_interval, [this] { return stopping_; });
       stop = stopping_;
+      // While commits fail, wait out the backoff (the queue keeps what came): retrying the whole
+      // backlog every commit interval only burns CPU. At stop, one last attempt regardless.
+      if (!stop && backoff_.count() > 0 && std::chrono::steady_clock::now() < retry_at_) continue;
       batch.swap(queue_);
       wearable.swap(wearable_queue_);
     }
     if (!wearable.empty()) commit_wearable(wearable);
     wearable.clear();
-    if (!batch.empty() && commit(batch)) {
+    if (!batch.empty()) {
+      const std::size_t n = batch.size();
+      const bool ok = commit(batch);
       std::lock_guard lock(mutex_);
-      processed_ += batch.size();
+      if (ok) {
+        processed_ += n;
+        backoff_ = std::chrono::milliseconds(0);
+      } else {
+        ++failed_commits_;
+        backoff_ = std::min(std::max(2 * backoff_, config_.commit_interval),
+                            std::max(config_.max_retry_interval, config_.commit_interval));
+        retry_at_ = std::chrono::steady_clock::now() + backoff_;
+      }
     }
     flushed_cv_.notify_all();
     batch.clear();
@@ -356,6 +412,10 @@ void Store::writer_loop() {
 bool Store::commit(std::vector<AttitudeSample>& batch) {
   std::lock_guard db_lock(db_mutex_);
   std::uint64_t inserted = 0;
+  batch_received_ns_ =
+      static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                     std::chrono::system_clock::now().time_since_epoch())
+                                     .count());
   try {
     exec(db_, "BEGIN");
     // In time order per boat, so sessions grow forward.
@@ -388,11 +448,14 @@ bool Store::commit(std::vector<AttitudeSample>& batch) {
         extend_session(s.boat_id, s.t_utc_ns);
       }
     }
-    Stmt up(db_, "UPDATE sessions SET start_ns = ?, end_ns = ?, samples = ? WHERE id = ?");
+    Stmt up(db_,
+            "UPDATE sessions SET start_ns = ?, end_ns = ?, samples = ?, received_ns = ? "
+            "WHERE id = ?");
     for (const auto& boat : dirty_sessions_) {
       const SessionInfo& sess = open_sessions_.at(boat);
       up.reset();
-      up.bind_u(1, sess.start_ns).bind_u(2, sess.end_ns).bind(3, sess.samples).bind(4, sess.id);
+      up.bind_u(1, sess.start_ns).bind_u(2, sess.end_ns).bind(3, sess.samples);
+      up.bind_u(4, batch_received_ns_).bind(5, sess.id);
       up.step();
     }
     dirty_sessions_.clear();
@@ -407,6 +470,9 @@ bool Store::commit(std::vector<AttitudeSample>& batch) {
     return true;
   } catch (const StoreError& e) {
     sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    // A full disk: give the WAL's space back (a checkpoint moves its pages into the database and
+    // truncates it), which may be just what the next attempt needs.
+    sqlite3_wal_checkpoint_v2(db_, nullptr, SQLITE_CHECKPOINT_TRUNCATE, nullptr, nullptr);
     open_sessions_.clear();  // reload from disk: the rolled-back changes are gone
     dirty_sessions_.clear();
     backfilled_.clear();
@@ -415,6 +481,13 @@ bool Store::commit(std::vector<AttitudeSample>& batch) {
     std::lock_guard lock(mutex_);
     last_error_ = e.what();
     queue_.insert(queue_.begin(), batch.begin(), batch.end());
+    if (queue_.size() > config_.max_backlog) {
+      // What came while this batch was out: the newest beyond the bound go (never acknowledged).
+      const std::size_t excess = queue_.size() - config_.max_backlog;
+      queue_.resize(config_.max_backlog);
+      dropped_ += excess;
+      processed_ += excess;  // dealt with, for flush()
+    }
     return false;
   }
 }
@@ -445,19 +518,23 @@ void Store::extend_session(const std::string& boat_id, std::uint64_t t_ns) {
       backfilled_.insert(boat_id);
       Stmt q(db_,
              "UPDATE sessions SET start_ns = MIN(start_ns, ?1), end_ns = MAX(end_ns, ?1), "
-             "samples = samples + 1 WHERE id = (SELECT id FROM sessions WHERE boat_id = ?2 "
-             "AND start_ns <= ?1 + ?3 AND end_ns + ?3 >= ?1 LIMIT 1)");
-      q.bind_u(1, t_ns).bind(2, boat_id).bind_u(3, gap);
+             "samples = samples + 1, received_ns = ?4 WHERE id = (SELECT id FROM sessions "
+             "WHERE boat_id = ?2 AND start_ns <= ?1 + ?3 AND end_ns + ?3 >= ?1 LIMIT 1)");
+      q.bind_u(1, t_ns).bind(2, boat_id).bind_u(3, gap).bind_u(4, batch_received_ns_);
       q.step();
       if (sqlite3_changes(db_) == 1) return;
-      Stmt ins(db_, "INSERT INTO sessions (boat_id, start_ns, end_ns, samples) VALUES (?,?,?,1)");
-      ins.bind(1, boat_id).bind_u(2, t_ns).bind_u(3, t_ns);
+      Stmt ins(db_,
+               "INSERT INTO sessions (boat_id, start_ns, end_ns, samples, received_ns) "
+               "VALUES (?,?,?,1,?)");
+      ins.bind(1, boat_id).bind_u(2, t_ns).bind_u(3, t_ns).bind_u(4, batch_received_ns_);
       ins.step();
       return;
     }
   }
-  Stmt ins(db_, "INSERT INTO sessions (boat_id, start_ns, end_ns, samples) VALUES (?,?,?,0)");
-  ins.bind(1, boat_id).bind_u(2, t_ns).bind_u(3, t_ns);
+  Stmt ins(db_,
+           "INSERT INTO sessions (boat_id, start_ns, end_ns, samples, received_ns) "
+           "VALUES (?,?,?,0,?)");
+  ins.bind(1, boat_id).bind_u(2, t_ns).bind_u(3, t_ns).bind_u(4, batch_received_ns_);
   ins.step();
   open_sessions_[boat_id] = {sqlite3_last_insert_rowid(db_), boat_id, t_ns, t_ns, 1};
   dirty_sessions_.insert(boat_id);
@@ -483,8 +560,10 @@ void Store::merge_sessions(const std::string& boat_id) {
     if (next.start_ns > prev.end_ns + gap) continue;
     prev.end_ns = std::max(prev.end_ns, next.end_ns);
     prev.samples += next.samples;
-    Stmt up(db_, "UPDATE sessions SET end_ns = ?, samples = ? WHERE id = ?");
-    up.bind_u(1, prev.end_ns).bind(2, prev.samples).bind(3, prev.id);
+    Stmt up(db_,
+            "UPDATE sessions SET end_ns = ?1, samples = ?2, received_ns = MAX(received_ns, "
+            "(SELECT received_ns FROM sessions WHERE id = ?4)) WHERE id = ?3");
+    up.bind_u(1, prev.end_ns).bind(2, prev.samples).bind(3, prev.id).bind(4, next.id);
     up.step();
     Stmt del(db_, "DELETE FROM sessions WHERE id = ?");
     del.bind(1, next.id);
@@ -545,15 +624,44 @@ void Store::apply_retention() {
   const auto cutoff = static_cast<std::uint64_t>(cutoff_s * 1e9);
   std::lock_guard db_lock(db_mutex_);
   try {
-    Stmt a(db_, "DELETE FROM attitude WHERE t_utc_ns < ?");
-    a.bind_u(1, cutoff).step();
-    Stmt s(db_, "DELETE FROM sessions WHERE end_ns < ?");
-    s.bind_u(1, cutoff).step();
+    exec(db_, "BEGIN");
+    // Age is the shore's: when the session last received a sample (rows from before the column
+    // existed have 0 there and go by their end time). A boat's clock days behind makes old-looking
+    // samples that arrived today; they stay.
+    struct Gone {
+      std::int64_t id;
+      std::string boat_id;
+      std::uint64_t start_ns, end_ns;
+    };
+    std::vector<Gone> gone;
+    {
+      Stmt q(db_,
+             "SELECT id, boat_id, start_ns, end_ns FROM sessions WHERE "
+             "(CASE WHEN received_ns > 0 THEN received_ns ELSE end_ns END) < ?");
+      q.bind_u(1, cutoff);
+      while (q.step()) gone.push_back({q.i64(0), q.text(1), q.u64(2), q.u64(3)});
+    }
+    Stmt del_session(db_, "DELETE FROM sessions WHERE id = ?");
+    // The session's samples, except any a kept session of the boat covers.
+    Stmt del_samples(db_,
+                     "DELETE FROM attitude WHERE boat_id = ?1 AND t_utc_ns BETWEEN ?2 AND ?3 "
+                     "AND NOT EXISTS (SELECT 1 FROM sessions k WHERE k.boat_id = ?1 AND "
+                     "k.start_ns <= attitude.t_utc_ns AND k.end_ns >= attitude.t_utc_ns)");
+    for (const auto& g : gone) {
+      del_session.reset();
+      del_session.bind(1, g.id).step();
+      del_samples.reset();
+      del_samples.bind(1, g.boat_id).bind_u(2, g.start_ns).bind_u(3, g.end_ns).step();
+    }
     Stmt e(db_, "DELETE FROM alarm_events WHERE phase = 'cleared' AND cleared_ns < ?");
     e.bind_u(1, cutoff).step();
+    exec(db_, "COMMIT");
     open_sessions_.clear();
     dirty_sessions_.clear();
   } catch (const StoreError& e) {
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    open_sessions_.clear();
+    dirty_sessions_.clear();
     std::lock_guard lock(mutex_);
     last_error_ = std::string("retention: ") + e.what();
   }
@@ -715,6 +823,20 @@ std::uint64_t Store::max_event_id() {
 std::uint64_t Store::committed() const {
   std::lock_guard lock(mutex_);
   return committed_;
+}
+
+StoreHealth Store::health() const {
+  std::lock_guard lock(mutex_);
+  StoreHealth h;
+  h.failing = backoff_.count() > 0;
+  h.backlog = queue_.size();
+  h.dropped = dropped_;
+  h.failed_commits = failed_commits_;
+  if (h.failing)
+    h.retry_in_s = std::max(
+        0.0, std::chrono::duration<double>(retry_at_ - std::chrono::steady_clock::now()).count());
+  h.last_error = last_error_;
+  return h;
 }
 
 std::string Store::last_error() const {

@@ -12,6 +12,16 @@
 /// Sessions: continuous activity of one boat. A sample within `session_gap` of a boat's session
 /// extends it; otherwise it starts a new one.
 ///
+/// Retention (`retention_days`) goes by the shore's clock: a session goes once no sample has
+/// arrived into it for that long (`received_ns`, the shore's arrival time), whatever the boat's
+/// clock said: a boat without a time fix can be days behind, and its samples are still new.
+///
+/// A failing disk (full, read-only): the batch stays queued and is retried with exponential
+/// backoff (commit_interval doubling up to `max_retry_interval`), the WAL is checkpointed to give
+/// space back, and the queue is bounded (`max_backlog`: later samples are dropped and counted).
+/// Nothing dropped or left unsaved at stop was acknowledged, so the boats still hold it in their
+/// session logs and resend it when the shore's receipts show it missing. health() says all this.
+///
 /// Reads go through a second, read-only connection, so a long export never blocks ingest; range
 /// reads page through the data (keyset on time), so memory does not grow with the range.
 
@@ -44,7 +54,19 @@ struct StoreConfig {
   std::string path;
   std::chrono::milliseconds commit_interval{250};
   std::chrono::seconds session_gap{60};
-  double retention_days = 0.0;  ///< 0: keep everything
+  double retention_days = 0.0;                          ///< 0: keep everything
+  std::size_t max_backlog = 200000;                     ///< samples queued while commits fail
+  std::chrono::milliseconds max_retry_interval{30000};  ///< backoff cap while commits fail
+};
+
+/// The writer's state for /healthz.
+struct StoreHealth {
+  bool failing = false;       ///< the latest commit failed
+  std::size_t backlog = 0;    ///< samples queued, not committed
+  std::uint64_t dropped = 0;  ///< samples refused: backlog full (never acknowledged)
+  std::uint64_t failed_commits = 0;
+  double retry_in_s = 0.0;  ///< until the next attempt while failing
+  std::string last_error;
 };
 
 struct SessionInfo {
@@ -131,6 +153,7 @@ class Store {
   [[nodiscard]] std::vector<Ack> acks() const;
 
   [[nodiscard]] std::uint64_t committed() const;
+  [[nodiscard]] StoreHealth health() const;
   /// Last error of the writer thread, empty if none.
   [[nodiscard]] std::string last_error() const;
 
@@ -141,6 +164,8 @@ class Store {
   void commit_wearable(const std::vector<WearableSample>& batch);
   void extend_session(const std::string& boat_id, std::uint64_t t_ns);
   void apply_retention();
+  /// Shore time (ns since 1970) of the batch being committed: the sessions' arrival time.
+  std::uint64_t batch_received_ns_ = 0;
   void track_receipt(const AttitudeSample& sample);
   /// Joins this boat's sessions that backfill has brought within the session gap of each other.
   void merge_sessions(const std::string& boat_id);
@@ -173,6 +198,10 @@ class Store {
   std::uint64_t enqueued_ = 0;
   std::uint64_t processed_ = 0;  ///< enqueued samples the writer has dealt with
   std::uint64_t committed_ = 0;
+  std::uint64_t dropped_ = 0;
+  std::uint64_t failed_commits_ = 0;
+  std::chrono::milliseconds backoff_{0};            ///< 0 while commits succeed
+  std::chrono::steady_clock::time_point retry_at_;  ///< next attempt while failing
   bool stopping_ = false;
   std::string last_error_;
   std::chrono::steady_clock::time_point next_retention_;

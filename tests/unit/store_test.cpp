@@ -2,12 +2,16 @@
 // of re-sent samples, sessions split on gaps, and the receipts that drive the boats' backfill.
 #include "store.hpp"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sched.h>
 #include <sqlite3.h>
+#include <sys/mount.h>
 #include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
+#include <thread>
 
 namespace telltale::shore {
 namespace {
@@ -160,6 +164,126 @@ TEST_F(StoreTest, BackfillThatClosesTheGapMergesTheSessions) {
   EXPECT_EQ(sessions[0].end_ns, kT0 + 306 * kSecond);
   EXPECT_EQ(sessions[0].samples, 307);
   EXPECT_EQ(store.count("b"), 307);
+}
+
+// Given a shore keeping 7 days and a boat whose clock is 10 days behind (no RTC, no fix yet),
+// when the retention pass runs, then the samples that arrived today stay: age is the shore's
+// arrival time, not the boat's clock.
+TEST_F(StoreTest, RetentionGoesByArrivalNotByTheBoatsClock) {
+  const auto now_ns =
+      static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                     std::chrono::system_clock::now().time_since_epoch())
+                                     .count());
+  const std::uint64_t behind = now_ns - 10 * 86400 * kSecond;
+  {
+    Store store(config());
+    for (std::uint64_t i = 1; i <= 50; ++i)
+      store.enqueue(sample("late", 3, i, behind + i * kSecond));
+    store.flush();
+  }
+  auto c = config();
+  c.retention_days = 7;
+  {
+    Store store(c);  // the first retention pass runs at start
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    EXPECT_EQ(store.count("late"), 50);
+    EXPECT_EQ(store.sessions(std::string("late"), 0, UINT64_MAX).size(), 1u);
+  }
+  // The same session once it arrived more than 7 days ago (set in the file): it goes, samples
+  // and all.
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(c.path.c_str(), &db), SQLITE_OK);
+    const std::string sql =
+        "UPDATE sessions SET received_ns = " + std::to_string(now_ns - 8 * 86400 * kSecond);
+    ASSERT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
+    sqlite3_close(db);
+  }
+  Store store(c);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_EQ(store.count("late"), 0);
+  EXPECT_TRUE(store.sessions(std::string("late"), 0, UINT64_MAX).empty());
+}
+
+/// A private mount namespace for this test process (root only): tmpfs mounts with a size limit
+/// stay invisible to everything else. False where that is not allowed.
+bool private_mounts() {
+  static const bool ok = [] {
+    if (::geteuid() != 0 || ::unshare(CLONE_NEWNS) != 0) return false;
+    return ::mount(nullptr, "/", nullptr, MS_REC | MS_PRIVATE, nullptr) == 0;
+  }();
+  return ok;
+}
+
+/// Fills the filesystem of `path` with one file until a write fails.
+void fill_disk(const std::filesystem::path& path) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  ASSERT_GE(fd, 0);
+  std::vector<char> block(4096, 'x');
+  while (::write(fd, block.data(), block.size()) > 0) {
+  }
+  ::close(fd);
+}
+
+// Given a shore whose disk fills up (a real small tmpfs), then commits back off exponentially
+// instead of retrying the whole backlog every commit interval, the backlog stays bounded (later
+// samples refused and counted, never acknowledged), health() says so; when space returns
+// everything queued is committed; and at a stop with the disk still full, the samples it could
+// not save are named on stderr.
+TEST_F(StoreTest, FullDiskBacksOffBoundsTheBacklogAndSaysWhatIsLost) {
+  const auto mnt = dir_ / "full";
+  std::filesystem::create_directories(mnt);
+  if (!private_mounts() || ::mount("tmpfs", mnt.c_str(), "tmpfs", 0, "size=1m,mode=0755") != 0)
+    GTEST_SKIP() << "needs root and mount namespaces";
+  struct Unmount {
+    std::filesystem::path p;
+    ~Unmount() { ::umount2(p.c_str(), MNT_DETACH); }
+  } unmount{mnt};
+  auto c = config();
+  c.path = (mnt / "s.db").string();
+  c.max_backlog = 3000;
+  c.max_retry_interval = std::chrono::milliseconds(1000);
+  std::uint64_t seq = 0;
+  {
+    Store store(c);
+    for (int i = 0; i < 100; ++i, ++seq)
+      store.enqueue(sample("d", 5, seq + 1, kT0 + seq * kSecond));
+    store.flush();
+    ASSERT_EQ(store.count("d"), 100);
+    fill_disk(mnt / "ballast");
+    for (int round = 0; round < 20; ++round) {
+      for (int i = 0; i < 1000; ++i, ++seq)
+        store.enqueue(sample("d", 5, seq + 1, kT0 + seq * kSecond));
+      std::this_thread::sleep_for(std::chrono::milliseconds(150));
+    }
+    const StoreHealth h = store.health();
+    EXPECT_TRUE(h.failing) << h.last_error;
+    EXPECT_FALSE(h.last_error.empty());
+    EXPECT_LE(h.backlog, 3000u);
+    EXPECT_GE(h.dropped, 15000u);
+    // 3 s of failure: 20 ms doubling to 1 s is about 8 attempts (150 at a fixed 20 ms).
+    EXPECT_LE(h.failed_commits, 12u);
+    EXPECT_GE(h.failed_commits, 3u);
+    // Space again: the backlog goes in (at the next attempt, within the 1 s cap).
+    std::filesystem::remove(mnt / "ballast");
+    for (int i = 0; i < 40 && store.health().failing; ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    store.flush();
+    EXPECT_FALSE(store.health().failing);
+    EXPECT_EQ(store.health().backlog, 0u);
+    // Everything not refused is stored.
+    EXPECT_EQ(store.count("d"), static_cast<std::int64_t>(seq - store.health().dropped));
+    // A second spell, and a stop during it.
+    fill_disk(mnt / "ballast");
+    for (int i = 0; i < 500; ++i, ++seq)
+      store.enqueue(sample("d", 5, seq + 1, kT0 + seq * kSecond));
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    ::testing::internal::CaptureStderr();
+  }
+  const std::string said = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(said.find("could not be saved"), std::string::npos) << said;
+  EXPECT_NE(said.find("d run 0000000000000005 seq"), std::string::npos) << said;
+  EXPECT_NE(said.find("session logs"), std::string::npos) << said;
 }
 
 }  // namespace
