@@ -279,7 +279,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   bool calibrating = o.calibrate_s > 0;
   std::uint64_t seq = 0;
   std::uint32_t health = telltale::msg::SENSOR_OK;
-  unsigned write_failures = 0, log_failures = 0, bad_samples = 0;
+  unsigned write_failures = 0, bad_samples = 0;
   auto next_status = start;
   auto next_console = start;
   auto next_flush = start + std::chrono::seconds(1);
@@ -354,7 +354,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       r.leds[3] = leds.down;
       r.led_count = led_params.leds_per_bar;
       r.level = static_cast<std::uint8_t>(level);
-      if (!log.append(r)) ++log_failures;
+      (void)log.append(r);  // on failure held in memory, retried, reported in the status
       fill(r, boot_id, out);
       if (!dds.publish(out)) ++write_failures;
       backfiller->on_published(r.seq);
@@ -386,9 +386,20 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       const auto& diag = filter.diagnostics();
       if (diag.rejected_non_finite) h |= telltale::msg::SENSOR_NON_FINITE;
       if (diag.gyro_saturated || diag.acc_saturated) h |= telltale::msg::SENSOR_SATURATED;
-      std::string text = h == 0 ? "ok" : "sensor flags " + std::to_string(h);
+      // The log's trouble first: it is what loses data for good (the text is cut at 128).
+      const auto log_health = log.health();
+      std::string text;
+      if (log_health.pending_records > 0 || log_health.dropped_records > 0) {
+        text = "SESSION LOG FAILING (" + log_health.last_error + "): " +
+               std::to_string(log_health.pending_records) + " held in memory";
+        if (log_health.dropped_records > 0)
+          text += ", " + std::to_string(log_health.dropped_records) + " not logged";
+        text += "; ";
+      }
+      text += h == 0 ? "ok" : "sensor flags " + std::to_string(h);
       if (write_failures) text += "; dds write failures " + std::to_string(write_failures);
-      if (log_failures) text += "; session log write failures " + std::to_string(log_failures);
+      if (log_health.write_errors)
+        text += "; session log write errors " + std::to_string(log_health.write_errors);
       if (!backfiller->shore_seen()) text += "; no shore receipt yet";
       if (const auto n = earlier->pending())
         text += "; delivering " + std::to_string(n) + " earlier run(s) from the log";
@@ -401,7 +412,14 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       health = telltale::msg::SENSOR_OK;  // flags cover the last second
     }
   }
-  log.flush();
+  if (!log.flush()) {
+    const auto lh = log.health();
+    std::fprintf(stderr,
+                 "boat_node: session log: %llu records could not be written (%s); %llu were "
+                 "never logged\n",
+                 static_cast<unsigned long long>(lh.pending_records), lh.last_error.c_str(),
+                 static_cast<unsigned long long>(lh.dropped_records));
+  }
   if (o.console && tty) std::printf("\n");
   // Hand the shore what it is missing before going: 3 s if the shore is not heard, up to 10 s
   // while it is (the service manager's stop timeout is longer).
