@@ -41,10 +41,23 @@ void Backfiller::on_ack(std::uint64_t boot_id, std::uint64_t acked_seq, bool new
     force_resend_.store(true);
   shore_seen_.store(true);
   if (boot_id == config_.boot_id) {
-    std::uint64_t prev = acked_.load();
-    while (acked_seq > prev && !acked_.compare_exchange_weak(prev, acked_seq)) {
-    }
+    const std::uint64_t prev = acked_.exchange(acked_seq);
     if (acked_seq > prev) progress_ns_.store(now_ns);
+    if (acked_seq < prev) {
+      // The shore holds less than it said before (a fresh or replaced database, a restore): its
+      // receipt is the truth. Resend from there, in order, once; the receipt then climbs as the
+      // start of the run arrives (the shore already holds the tail).
+      // At most once per resend_after: two shores on one domain, one of them empty, would
+      // otherwise have the run resent at every receipt.
+      progress_ns_.store(now_ns);
+      const auto every_ns =
+          std::chrono::duration_cast<std::chrono::nanoseconds>(config_.resend_after).count();
+      const std::int64_t last_follow = followed_down_ns_.load();
+      if (last_follow == 0 || now_ns - last_follow >= every_ns) {
+        followed_down_ns_.store(now_ns);
+        force_resend_.store(true);
+      }
+    }
   }
   cv_.notify_all();
 }

@@ -41,9 +41,10 @@ class Backfiller {
   ~Backfiller();
 
   void on_published(std::uint64_t seq) { published_.store(seq); }
-  /// A receipt for this boat, any run: each one shows the shore is there; one for this run moves
-  /// acked(). `new_shore` (a shore instance not heard before) resends the missing range at
-  /// once, as does a receipt after a silence.
+  /// A receipt for this boat, any run: each one shows the shore is there; one for this run sets
+  /// acked(), downward too (a shore on a fresh database: the run is resent from its receipt).
+  /// `new_shore` (a shore instance not heard before) resends the missing range at once, as does
+  /// a receipt after a silence.
   void on_ack(std::uint64_t boot_id, std::uint64_t acked_seq, bool new_shore = false);
   /// Sends everything up to the last published sample and waits for the shore's receipt. Gives
   /// up after `quiet` if the shore has not been heard for `quiet` (a cut link, a shore gone: the
@@ -74,6 +75,7 @@ class Backfiller {
   std::atomic<std::uint64_t> send_failures_{0};
   std::atomic<std::int64_t> last_ack_ns_{0};  ///< steady clock of the latest receipt
   std::atomic<std::int64_t> progress_ns_{0};  ///< steady clock of the latest move of acked_
+  std::atomic<std::int64_t> followed_down_ns_{0};  ///< steady clock of the latest lower receipt
   std::atomic<bool> shore_seen_{false};
   std::atomic<bool> draining_{false};
   std::atomic<bool> force_resend_{false};

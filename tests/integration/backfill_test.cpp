@@ -3,6 +3,7 @@
 // longer than two publish periods. Real processes, real DDS, real SQLite.
 #include <signal.h>
 #include <sqlite3.h>
+#include <unistd.h>
 
 #include "shore_fixture.hpp"
 #include "stored_seqs.hpp"
@@ -71,6 +72,42 @@ TEST_F(BackfillTest, ShoreKilledAndRestartedLosesNothing) {
   const long published = stop_boat(boat);
   ASSERT_GT(published, 25 * 20);
   expect_complete("bf1", published);
+}
+
+// Given a log directory that exists but is read-only (a mount gone read-only), the boat refuses
+// to start: no "ready" line, exit status 1 (it would otherwise sail with no log at all).
+TEST_F(BackfillTest, ReadOnlyLogDirectoryRefusesToStart) {
+  if (::geteuid() != 0 || !std::filesystem::exists("/usr/bin/unshare"))
+    GTEST_SKIP() << "needs root and unshare for a private read-only mount";
+  const std::string ro = dir_ + "/rolog";
+  std::filesystem::create_directories(ro);
+  Process boat({"/usr/bin/unshare", "-m", "--propagation", "private", "sh", "-c",
+                "mount -t tmpfs -o ro,size=64k tmpfs '" + ro + "' && exec '" + bin_dir() +
+                    "/boat_node' --domain " + std::to_string(domain_) +
+                    " --boat-id ro1 --log-dir '" + ro + "'"});
+  EXPECT_FALSE(boat.wait_for_line("boat_node ready: ", 5s)) << boat.output();
+  EXPECT_EQ(boat.stop(SIGINT, 5s), 1) << boat.output();
+}
+
+// Given a boat sailing, when its shore is replaced by one on an empty database (a fresh or
+// replaced disk), then the boat follows the new shore's lower receipt: it sends the run from its
+// start, in order, once (not the whole tail every 5 s), and the new database holds all of it.
+TEST_F(BackfillTest, ShoreOnAnEmptyDatabaseGetsTheRunFromItsStart) {
+  Process& boat = start_boat("bf9", {"--log-dir", dir_ + "/boatlog"});
+  ASSERT_TRUE(eventually([&] { return boats_by_id().count("bf9") == 1; }, 10s));
+  std::this_thread::sleep_for(6s);
+  ASSERT_EQ(shore_->stop(SIGINT), 0);
+  for (const char* ext : {"", "-wal", "-shm"}) std::filesystem::remove(db_path() + ext);
+  start_shore();
+  ASSERT_TRUE(eventually([&] { return boats_by_id().count("bf9") == 1; }, 15s));
+  std::this_thread::sleep_for(12s);
+  const long published = stop_boat(boat);
+  ASSERT_GT(published, 25 * 15);
+  expect_complete("bf9", published);
+  std::smatch m;
+  const std::string out = boat.output();
+  ASSERT_TRUE(std::regex_search(out, m, std::regex(R"(resent=(\d+))"))) << out;
+  EXPECT_LE(std::stol(m[1]), 2 * published) << "the tail resent again and again";
 }
 
 // Given a boat whose every outgoing packet is dropped for 15 s (Fast DDS's test transport), when
