@@ -1,29 +1,32 @@
 #pragma once
 /// \file
 /// Telltale's production heel/pitch filter: the default of `fusion_cli attitude` and of the boat
-/// node. It keeps the paper's idea (trust the accelerometer only while the motion is inertial) and
-/// adds what is needed to hold +-1 deg on a boat:
-///   - full 3-D kinematics: the gyro is integrated as a quaternion (no per-axis Euler integration),
-///     each sample as the mean rate over the interval that ends at it (decimation filter);
-///   - the accelerometer is rotated into a quasi-inertial frame (the gyro-integrated frame I) and
-///     low-passed THERE (two first-order stages, tau_acc_s each): in an earth-fixed frame the
-///     mean of any bounded motion's acceleration is dv/T -> 0, so waves, a pendulum's swing, a
-///     turntable's centripetal acceleration (a vector that rotates with the yaw) average out while
-///     gravity stays put (the idea of Laidig & Seel's VQF, 2023);
-///   - a non-inertial test that sees horizontal accelerations (|a_I - lowpass(a_I)|, not |a| ~ g),
-///     with a peak hold: while it is high the accelerometer's correction is scaled down
-///     (weight -> w_min) and the gyro carries the attitude;
-///   - a turn test (centripetal acceleration across the heading, toward the turn): during a tack
-///     the low-pass is not fed either, so the tack's acceleration is not remembered as a tilt;
-///   - gyro bias estimated online: fast at rest (rest detection), slowly in motion from the
-///     corrections the accelerometer has to make;
-///   - non-uniform time steps, dropped samples (gaps up to max_gap_s are integrated, longer gaps
-///     only counted and the quality lowered), saturated gyro/accelerometer samples, NaN/Inf.
+/// node. It keeps the paper's idea (the accelerometer tells the vertical only where the motion is
+/// inertial on average) and builds it from the physics, after Laidig & Seel's VQF (2023):
+///   - strapdown: the gyro (minus the estimated bias) is integrated as a quaternion into an
+///     almost-inertial frame I; each sample is the mean rate over the interval that ends at it
+///     (a MEMS decimation filter);
+///   - the specific force is rotated into I and low-passed THERE by a 2nd-order Butterworth of
+///     time constant tau_acc_s. In an earth-fixed frame the mean of the acceleration of any
+///     bounded motion over T is dv / T -> 0, so waves, a pendulum's swing, a hand's shake and a
+///     turntable's centripetal acceleration (which turns with the yaw) average out, while gravity
+///     stays put. A steady turn is a rotation the gyro sees; it never looks like a tilt;
+///   - the vertical is the direction of that low-passed vector (the inclination correction that
+///     maps it to "up"), seen in the body through the gyro quaternion;
+///   - the gyro bias is a Kalman state with its own 3x3 covariance: learnt at rest (rest = the
+///     gyro AND the accelerometer steady about their own 0.5 s means, AND the gyro reading what
+///     the bias can be: a constant rotation is not rest), and in motion from how fast the
+///     low-passed vertical drifts in I (horizontal components only: the bias about the vertical
+///     does not move the vertical);
+///   - fast start: for the first tau_acc_s the low-pass is the mean of everything seen since the
+///     start (the best estimate of a constant from a growing window), so a filter started under
+///     way converges in seconds; the same after a gap too long to integrate;
+///   - non-uniform time steps, dropped samples, saturated samples, NaN/Inf.
 ///
 /// Call order: update() once per sample, time strictly increasing; read output() afterwards.
 /// Cannot observe: the gyro bias about the vertical (heading drift; irrelevant to heel/pitch),
 /// an accelerometer offset (it becomes a tilt error of offset/g rad), a linear acceleration that
-/// is sustained in one earth direction for longer than ~tau_acc_s while looking inertial.
+/// is sustained in one earth direction for longer than ~tau_acc_s (its mean is a tilt).
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -35,64 +38,69 @@ namespace telltale::fusion {
 /// Settings of TelltaleAttitudeFilter.
 struct TelltaleAttitudeParams {
   double g_m_s2 = kStandardGravity_m_s2;
-  /// Time constant of each of the two low-pass stages on the accelerometer in the inertial frame.
-  double tau_acc_s = 3.5;
-  /// Same, while the sensor is at rest (nothing to reject; converge fast).
-  double tau_acc_rest_s = 0.2;
-  /// Non-inertial test: |a_I - lowpass| (m/s^2) below low -> weight 1, above high -> w_min.
-  double nonin_low_m_s2 = 0.4;
-  double nonin_high_m_s2 = 2.0;
-  double nonin_lp_tau_s = 1.0;   ///< the test compares a_I with its low-pass of this time constant
-  double nonin_release_s = 1.0;  ///< decay time of the peak hold of the non-inertial measure
-  /// Turn test: a vehicle turning while it moves accelerates toward the inside of the turn.
-  /// Measure = low-pass(lateral horizontal acceleration * clamp(yaw rate / turn_rate_rad_s, +-1)),
-  /// with a peak hold; between turn_low and turn_high the low-pass input and the weight fade
-  /// to lp_turn_min and w_min.
-  double turn_rate_rad_s = 0.1;
-  double turn_tau_s = 0.5;
-  double turn_release_s = 2.0;
-  double turn_low_m_s2 = 0.4;
-  double turn_high_m_s2 = 1.5;
-  double lp_turn_min = 0.1;
-  double w_min = 0.05;  ///< floor of the accelerometer weight (keeps long-run correction)
-  /// Rest detection (gyro bias learning): deviations below these for rest_min_s.
-  double rest_gyro_rad_s = 0.035;  ///< 2 deg/s
-  double rest_acc_m_s2 = 0.4;
-  double rest_min_s = 1.0;
-  double rest_bias_match_rad_s = 0.0026;  ///< 0.15 deg/s: rest = the gyro reads the known bias
-  double rest_bias_tau_s = 5.0;  ///< bias refinement at rest after the first (which sets it)
-  double rest_lp_tau_s = 0.5;    ///< low-pass of gyro/acc for the rest test and the bias
-  /// Bias learning in motion: time constant of the integral of the accelerometer corrections.
-  double bias_motion_tau_s = 60.0;
-  double max_bias_rad_s = 0.35;  ///< |bias| clamp (20 deg/s, twice the L3G4200D zero-rate spread)
-  double gyro_range_rad_s = 250.0 * M_PI / 180.0;       ///< full scale (L3G4200D default 250 dps)
+  /// Time constant of the 2nd-order Butterworth low-pass on the specific force in frame I
+  /// (cut-off sqrt(2) / (2 pi tau)). 3 s: longer than a wave, a pendulum's 2 s period and a
+  /// hand's shake (they average out), short against the drift a residual bias of 0.1 deg/s makes.
+  double tau_acc_s = 3.0;
+  /// The same while at rest (the specific force is gravity: nothing to average out).
+  double tau_acc_rest_s = 0.5;
+  /// Rest detection: deviations of the gyro / accelerometer from their own rest_lp_tau_s
+  /// low-pass below these for rest_min_s.
+  double rest_gyro_rad_s = 2.0 * M_PI / 180.0;
+  double rest_acc_m_s2 = 0.5;
+  double rest_min_s = 1.5;
+  double rest_lp_tau_s = 0.5;
+  /// Rest also needs the gyro's mean to be a possible bias: within 3 sigma of the bias estimate
+  /// on each axis, and never further than this floor below it (a steady turn of more than
+  /// 0.5 deg/s is a turn, not a rest).
+  double rest_bias_gate_rad_s = 0.5 * M_PI / 180.0;
+  /// Bias Kalman filter (units rad/s). Initial sigma: the zero-rate spread of an uncalibrated
+  /// MEMS gyro (L3G4200D +-10 deg/s uniform -> 5.8 deg/s); at rest the gyro mean is a
+  /// measurement of 0.03 deg/s; in motion the steady-state sigma is 0.1 deg/s; the bias is
+  /// forgotten at (0.1 deg/s)^2 per bias_forgetting_s (temperature drift).
+  double bias_sigma_init_rad_s = 5.8 * M_PI / 180.0;
+  double bias_sigma_rest_rad_s = 0.03 * M_PI / 180.0;
+  double bias_sigma_motion_rad_s = 0.1 * M_PI / 180.0;
+  double bias_forgetting_s = 100.0;
+  double max_bias_rad_s = 20.0 * M_PI / 180.0;     ///< |bias| clamp (twice the L3G4200D spread)
+  double gyro_range_rad_s = 250.0 * M_PI / 180.0;  ///< full scale (L3G4200D default 250 dps)
   double acc_range_m_s2 = 2.0 * kStandardGravity_m_s2;  ///< full scale (LSM303DLH default 2 g)
   double saturation_fraction = 0.98;                    ///< |reading| >= this * range -> saturated
-  double max_gap_s = 1.0;                               ///< longer gaps are not integrated
+  double max_gap_s = 1.0;  ///< longer gaps are not integrated (the low-pass restarts)
+  /// Group delay of the IMU: its samples describe the motion this long before their time stamp
+  /// (a MEMS sensor's digital low-pass and its transfer take a few ms). The output is carried
+  /// forward over it with the gyro (output() only). 2.5 ms: the lag of BROAD's IMU behind its
+  /// optical reference, the same on all eight shared trials (1.75..3.5 ms all within 0.01 deg of
+  /// the best mean); a rotation at w rad/s moves the vertical by w * delay, so a wrong delay
+  /// costs at most 0.25 deg at 100 deg/s. Set it to the boat's sensor's figure when known.
+  double sensor_delay_s = 2.5e-3;
 };
 
 class TelltaleAttitudeFilter final : public AttitudeFilter {
  public:
   using Params = TelltaleAttitudeParams;
+  /// Everything the update carries from one sample to the next (copyable, fixed size).
   struct State {
     Eigen::Quaterniond q_gyro = Eigen::Quaterniond::Identity();  ///< body -> inertial frame I
-    Eigen::Vector3d up_i = Eigen::Vector3d::UnitZ();  ///< the earth's vertical in frame I (unit)
-    Eigen::Vector3d bias_rad_s = Eigen::Vector3d::Zero();  ///< gyro bias, body
-    Eigen::Vector3d acc_lp1_i = Eigen::Vector3d::Zero();   ///< first low-pass stage, frame I
-    Eigen::Vector3d acc_lp2_i = Eigen::Vector3d::Zero();   ///< second stage, frame I
-    Eigen::Vector3d acc_fast_i = Eigen::Vector3d::Zero();  ///< 1 s low-pass for the gate, frame I
+    Eigen::Vector3d bias_rad_s = Eigen::Vector3d::Zero();        ///< gyro bias, body
+    Eigen::Matrix3d bias_cov = Eigen::Matrix3d::Zero();          ///< its covariance, (rad/s)^2
+    /// Low-passed in frame I, as one block: column 0 the specific force (m/s^2), 1..3 the
+    /// rotation matrix body -> I, 4 R * bias (the motion-bias model). Output and two Butterworth
+    /// (transposed direct form II) states.
+    Eigen::Matrix<double, 3, 5> lp = Eigen::Matrix<double, 3, 5>::Zero();
+    Eigen::Matrix<double, 3, 5> lp_s0 = Eigen::Matrix<double, 3, 5>::Zero();
+    Eigen::Matrix<double, 3, 5> lp_s1 = Eigen::Matrix<double, 3, 5>::Zero();
+    double tau_scale = 1.0;     ///< tau_acc_s / the time constant in use (>= 1, see update)
+    double lp_elapsed_s = 0.0;  ///< time since the low-pass (re)started
+    bool lp_running = false;    ///< false: still the growing mean of the fast start
+    Eigen::Vector3d up_i = Eigen::Vector3d::UnitZ();  ///< the vertical in I (unit)
     Eigen::Vector3d gyro_rest_lp_rad_s = Eigen::Vector3d::Zero();
     Eigen::Vector3d acc_rest_lp_m_s2 = Eigen::Vector3d::Zero();
     double rest_time_s = 0.0;
-    bool bias_known = false;  ///< a rest has been seen
-    double nonin_hold_m_s2 = 0.0;
-    double turn_m_s2 = 0.0;
-    double turn_hold_m_s2 = 0.0;
     double weight = 0.0;
-    double tilt_var_rad2 = 0.0;  ///< rough tilt variance behind `quality`
     double last_t_s = 0.0;
-    /// The output's inputs (output() is computed from them on demand): the corrected vertical
-    /// seen in the body (unit) and the bias-corrected body rate of the last update.
+    /// The output's inputs (output() is computed from them on demand): the vertical seen in the
+    /// body (unit) and the bias-corrected body rate of the last update.
     Eigen::Vector3d up_body = Eigen::Vector3d::UnitZ();
     Eigen::Vector3d rate_rad_s = Eigen::Vector3d::Zero();
     bool initialised = false;
@@ -101,15 +109,15 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
   struct Diagnostics {
     unsigned rejected_non_finite = 0;
     unsigned rejected_time = 0;
-    unsigned gaps = 0;            ///< dt > max_gap_s (not integrated)
+    unsigned gaps = 0;            ///< dt > max_gap_s (not integrated, the low-pass restarted)
     unsigned gyro_saturated = 0;  ///< samples with a gyro axis at full scale
-    unsigned acc_saturated = 0;   ///< samples with an accelerometer axis at full scale
+    unsigned acc_saturated = 0;   ///< samples with an accelerometer axis at full scale (not fused)
     unsigned rest_samples = 0;    ///< samples spent learning the bias at rest
   };
 
   explicit TelltaleAttitudeFilter(Params params = {});
   void update(const ImuSample& sample) override;
-  /// Computed on demand from the state (a read costs ~155 instructions; update() does not pay it).
+  /// Computed on demand from the state (update() does not pay for the two atan2).
   [[nodiscard]] AttitudeOutput output() const override;
   [[nodiscard]] const State& state() const { return state_; }
   void set_state(const State& s) { state_ = s; }
@@ -118,17 +126,7 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
 
  private:
   void initialise(const ImuSample& s);
-  /// 1 / time constant (and 1 / threshold span) of every Params entry used per sample, so the
-  /// update multiplies instead of dividing; the saturation thresholds; 1 + low / span of the two
-  /// weight ramps (w = one - measure / span); the Newton step 1 / |l| ~ newton_a - newton_b |l|^2
-  /// from 1 / g.
-  struct Rates {
-    double rest_lp, rest_bias, nonin_lp, nonin_release, turn_lp, turn_release, acc, acc_rest,
-        bias_motion, nonin_range, turn_range, turn_rate, gyro_sat_rad_s, acc_sat_m_s2, inv_g,
-        inv_g2, nonin_one, turn_one, newton_a, newton_b;
-  };
   Params params_;
-  Rates rates_{};
   State state_;
   Diagnostics diag_;
 };
