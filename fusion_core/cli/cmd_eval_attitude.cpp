@@ -24,6 +24,7 @@ struct EvalAttitudeOptions {
   std::vector<std::string> scenarios;  // empty = all
   std::string broad_dir;               // empty = look in the usual places
   bool skip_broad = false;
+  bool skip_sim = false;
   bool uncalibrated = false;  ///< raw datasheet sensor errors instead of the calibrated instrument
 };
 
@@ -61,7 +62,7 @@ void run_eval_attitude(const EvalAttitudeOptions& o) {
       throw UsageError("unknown scenario '" + s + "'");
   }
   const fusion::sim::ImuErrorParams raw = fusion::sim::ImuErrorParams::uncalibrated();
-  for (const double rate : o.rates_hz) {
+  for (const double rate : o.skip_sim ? std::vector<double>{} : o.rates_hz) {
     std::printf(
         "\n## attitude: simulator (%s sensors), %d seeds, %.0f Hz: heel RMS, pitch RMS (heel max, "
         "pitch max), deg\n\n",
@@ -146,6 +147,7 @@ void register_eval_attitude(CLI::App& eval, std::vector<std::function<void()>>& 
   cmd->add_option("--broad-dir", opts->broad_dir,
                   "BROAD CSV folder (default: /work/shared/data/broad or ../shared/data/broad)");
   cmd->add_flag("--no-broad", opts->skip_broad, "skip the BROAD recordings");
+  cmd->add_flag("--no-sim", opts->skip_sim, "skip the simulator (BROAD only)");
   cmd->add_flag("--uncalibrated", opts->uncalibrated,
                 "simulate the sensors with raw datasheet errors (no instrument calibration)");
   cmd->callback([opts] { run_eval_attitude(*opts); });

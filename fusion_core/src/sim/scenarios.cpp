@@ -276,6 +276,48 @@ class DinghyTrajectory final : public SmoothTrajectory {
   double wind_dir_;
 };
 
+// ---------------------------------------------------------------------------------------------
+/// Issue 18's steady turn: the instrument fixed at the turntable's tilt (heel -17.5 deg, pitch
+/// 7.5 deg) ON the rotation axis, still for rest_s, then spun up about the vertical (a smooth
+/// step ~2 s wide around rest_s + 2) to a constant yaw rate. The accelerometer reads the same,
+/// exactly right tilt the whole time; a filter that takes a rotation for a tilt or learns it as
+/// a gyro bias shows it here.
+class SteadyYawTrajectory final : public SmoothTrajectory {
+ public:
+  SteadyYawTrajectory(double rate_rad_s, double rest_s) : rate_(rate_rad_s), t0_(rest_s + 2.0) {}
+  [[nodiscard]] Eigen::Quaterniond attitude(double t) const override {
+    return attitude_from_euler(kHeel, kPitch, yaw(t));
+  }
+  [[nodiscard]] Eigen::Vector3d velocity_world(double) const override {
+    return Eigen::Vector3d::Zero();
+  }
+  static constexpr double kHeel = -17.5 * kDeg;
+  static constexpr double kPitch = 7.5 * kDeg;
+
+ private:
+  /// yaw = rate * integral of smooth_step(t, t0, kTau): 0.5 ((t - t0) + kTau ln(2 cosh z)),
+  /// z = (t - t0) / kTau, with ln(2 cosh z) = |z| + log1p(exp(-2 |z|)) (no overflow).
+  [[nodiscard]] double yaw(double t) const {
+    constexpr double kTau = 0.5;
+    const double z = std::abs((t - t0_) / kTau);
+    return rate_ * 0.5 * ((t - t0_) + kTau * (z + std::log1p(std::exp(-2.0 * z))));
+  }
+  double rate_, t0_;
+};
+
+/// A trajectory joined late: motion(t) of the inner one at t + offset_s (a node started while
+/// the boat is already sailing).
+class LateStartTrajectory final : public Trajectory {
+ public:
+  LateStartTrajectory(std::unique_ptr<Trajectory> inner, double offset_s)
+      : inner_(std::move(inner)), offset_(offset_s) {}
+  RigidMotion motion(double t) override { return inner_->motion(t + offset_); }
+
+ private:
+  std::unique_ptr<Trajectory> inner_;
+  double offset_;
+};
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -346,6 +388,8 @@ const std::vector<std::string>& scenario_names() {
       }
     }
     n.insert(n.end(), {"turntable", "desk", "dinghy"});
+    for (int r : {10, 30, 60, 90, 120}) n.push_back("yaw-" + std::to_string(r));
+    n.insert(n.end(), {"underway-5", "underway-15"});
     return n;
   }();
   return names;
@@ -353,6 +397,7 @@ const std::vector<std::string>& scenario_names() {
 
 double scenario_default_duration_s(std::string_view name) {
   if (name == "dinghy") return 300.0;
+  if (name.starts_with("underway-")) return 60.0;
   return 65.0;
 }
 
@@ -392,6 +437,27 @@ std::unique_ptr<ImuScenario> make_scenario(std::string_view name, std::uint64_t 
     return std::make_unique<ImuScenario>(std::make_unique<DinghyTrajectory>(seed, kAshore),
                                          DinghyTrajectory::lever_arm(), rate_hz, duration_s,
                                          kAshore, seed, options);
+  }
+  if (name.starts_with("yaw-")) {
+    const std::string rate(name.substr(4));
+    if (rate != "10" && rate != "30" && rate != "60" && rate != "90" && rate != "120") {
+      return nullptr;
+    }
+    // Scored from the end of the rest: the spin-up is part of the test.
+    return std::make_unique<ImuScenario>(
+        std::make_unique<SteadyYawTrajectory>(std::stod(rate) * kDeg, kRest),
+        Eigen::Vector3d::Zero(), rate_hz, duration_s, kRest, seed, options);
+  }
+  if (name == "underway-5" || name == "underway-15") {
+    // The dinghy joined 100 + 20 * u seconds into its script (ashore 10 s, under way from ~15 s):
+    // sailing in waves, instrument on the bow, no rest before the first sample. Scored from
+    // 5 s or from 15 s after the start (issue 18: within 2 deg after 5 s, 1 deg after 15 s).
+    const double offset = 100.0 + 20.0 * hash_uniform(seed, 30, 0);
+    const double warmup = name == "underway-5" ? 5.0 : 15.0;
+    return std::make_unique<ImuScenario>(
+        std::make_unique<LateStartTrajectory>(std::make_unique<DinghyTrajectory>(seed, 10.0),
+                                              offset),
+        DinghyTrajectory::lever_arm(), rate_hz, duration_s, warmup, seed, options);
   }
   return nullptr;
 }

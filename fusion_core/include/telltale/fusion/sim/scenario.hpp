@@ -20,6 +20,11 @@
 ///     ~40 s (90 deg in ~4 s, heel flips +-12 deg), gusts (+3..8 deg of heel), waves (heave, surge,
 ///     sway ~1.5 m/s^2; roll +-3 deg, pitch +-5 deg), instrument on the bow (1.5 m ahead of the
 ///     CG).
+///   yaw-{10,30,60,90,120}: the instrument at heel -17.5 deg, pitch 7.5 deg ON the axis of a
+///     turntable, 5 s still, then spun up (~2 s) to a steady yaw rate of that many deg/s; scored
+///     from the end of the rest.
+///   underway-5, underway-15: the dinghy joined 100..120 s into its script (sailing in waves,
+///     instrument on the bow, no rest before the first sample), 60 s; scored from 5 s or 15 s.
 /// Sensor: ImuErrorModel with the L3G4200D/LSM303DLH defaults of imu_errors.hpp.
 
 #include <cstdint>
