@@ -116,6 +116,14 @@ struct HttpApi::Impl {
                     {"failed_commits", sh.failed_commits},
                     {"retry_in_s", sh.retry_in_s}};
       if (sh.failing || sh.dropped > 0) j["status"] = "degraded";
+      // Two nodes sailing with one boat id: flagged (their samples still share sessions).
+      json duplicates = json::array();
+      for (const auto& d : ctx.store.duplicate_ids())
+        duplicates.push_back({{"boat_id", d.boat_id}, {"runs", {d.boot_a, d.boot_b}}});
+      if (!duplicates.empty()) {
+        j["duplicate_boat_ids"] = duplicates;
+        j["status"] = "degraded";
+      }
       res.set_content(j.dump(), "application/json");
     });
     server.Get("/api/v1/openapi.json", [](const httplib::Request&, httplib::Response& res) {

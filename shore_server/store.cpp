@@ -598,6 +598,10 @@ void Store::track_receipt(const AttitudeSample& s) {
     }
   }
   r.touched = now;
+  RunSpan& span = spans_[s.boat_id][s.boot_id];
+  span.min_t_ns = std::min(span.min_t_ns, s.t_utc_ns);
+  span.max_t_ns = std::max(span.max_t_ns, s.t_utc_ns);
+  span.touched = now;
   if (s.seq > r.acked) {
     r.ahead.insert(s.seq);
     while (!r.ahead.empty() && *r.ahead.begin() <= r.acked + 1) {
@@ -605,8 +609,34 @@ void Store::track_receipt(const AttitudeSample& s) {
       r.ahead.erase(r.ahead.begin());
     }
   }
-  if (++receipt_updates_ % 1024 == 0)
+  if (++receipt_updates_ % 1024 == 0) {
     std::erase_if(receipts_, [&](const auto& e) { return now - e.second.touched > kIdle; });
+    for (auto& [boat, runs] : spans_)
+      std::erase_if(runs, [&](const auto& e) { return now - e.second.touched > kIdle; });
+    std::erase_if(spans_, [](const auto& e) { return e.second.empty(); });
+  }
+}
+
+std::vector<Store::DuplicateId> Store::duplicate_ids() const {
+  // Both runs storing within this window, and their spans overlapping by more than a second: a
+  // restarted boat's runs follow each other in time, two boats with one id interleave.
+  constexpr auto kWindow = std::chrono::seconds(30);
+  constexpr std::uint64_t kOverlap_ns = 1'000'000'000;
+  const auto now = std::chrono::steady_clock::now();
+  std::lock_guard lock(receipts_mutex_);
+  std::vector<DuplicateId> out;
+  for (const auto& [boat, runs] : spans_) {
+    for (auto a = runs.begin(); a != runs.end(); ++a) {
+      if (now - a->second.touched > kWindow) continue;
+      for (auto b = std::next(a); b != runs.end(); ++b) {
+        if (now - b->second.touched > kWindow) continue;
+        const std::uint64_t lo = std::max(a->second.min_t_ns, b->second.min_t_ns);
+        const std::uint64_t hi = std::min(a->second.max_t_ns, b->second.max_t_ns);
+        if (hi > lo && hi - lo > kOverlap_ns) out.push_back({boat, a->first, b->first});
+      }
+    }
+  }
+  return out;
 }
 
 std::vector<Store::Ack> Store::acks() const {

@@ -152,6 +152,17 @@ class Store {
   };
   [[nodiscard]] std::vector<Ack> acks() const;
 
+  /// Two runs of one boat id storing samples of the same time span, both within the last
+  /// `kDuplicateWindow`: two nodes configured with one id (a restart or an earlier run's delivery
+  /// never overlaps the new run in time). Flagged, not yet kept apart: their samples still share
+  /// the boat's sessions.
+  struct DuplicateId {
+    std::string boat_id;
+    std::uint64_t boot_a;
+    std::uint64_t boot_b;
+  };
+  [[nodiscard]] std::vector<DuplicateId> duplicate_ids() const;
+
   [[nodiscard]] std::uint64_t committed() const;
   [[nodiscard]] StoreHealth health() const;
   /// Last error of the writer thread, empty if none.
@@ -180,6 +191,13 @@ class Store {
   /// (boat, run) -> receipt: the boat's current run and earlier runs it is still delivering.
   std::map<std::pair<std::string, std::uint64_t>, Receipt> receipts_;
   std::uint64_t receipt_updates_ = 0;  ///< under receipts_mutex_
+  struct RunSpan {
+    std::uint64_t min_t_ns = UINT64_MAX;
+    std::uint64_t max_t_ns = 0;
+    std::chrono::steady_clock::time_point touched;
+  };
+  /// boat -> run -> the time span it stored (under receipts_mutex_), for duplicate_ids().
+  std::map<std::string, std::map<std::uint64_t, RunSpan>> spans_;
 
   StoreConfig config_;
   sqlite3* db_ = nullptr;      ///< writer connection (samples, sessions, alarms)

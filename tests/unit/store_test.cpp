@@ -205,6 +205,30 @@ TEST_F(StoreTest, RetentionGoesByArrivalNotByTheBoatsClock) {
   EXPECT_TRUE(store.sessions(std::string("late"), 0, UINT64_MAX).empty());
 }
 
+// Given two nodes sailing with one boat id (two runs interleaving in time), the store flags the
+// id; a boat's restart (runs one after the other) and an earlier run delivered beside the new
+// one are not flagged.
+TEST_F(StoreTest, TwoRunsOfOneIdAtOnceAreFlagged) {
+  Store store(config());
+  // A restart: run 1 for 10 s, then run 2; run 1's tail delivered late.
+  for (std::uint64_t i = 1; i <= 10; ++i) store.enqueue(sample("r", 1, i, kT0 + i * kSecond));
+  for (std::uint64_t i = 1; i <= 10; ++i)
+    store.enqueue(sample("r", 2, i, kT0 + (20 + i) * kSecond));
+  store.flush();
+  EXPECT_TRUE(store.duplicate_ids().empty());
+  // Two nodes named "d" at once, over the same 10 s.
+  for (std::uint64_t i = 1; i <= 10; ++i) {
+    store.enqueue(sample("d", 7, i, kT0 + i * kSecond));
+    store.enqueue(sample("d", 8, i, kT0 + i * kSecond + kSecond / 50));
+  }
+  store.flush();
+  const auto dups = store.duplicate_ids();
+  ASSERT_EQ(dups.size(), 1u);
+  EXPECT_EQ(dups[0].boat_id, "d");
+  EXPECT_EQ(dups[0].boot_a, 7u);
+  EXPECT_EQ(dups[0].boot_b, 8u);
+}
+
 /// A private mount namespace for this test process (root only): tmpfs mounts with a size limit
 /// stay invisible to everything else. False where that is not allowed.
 bool private_mounts() {
