@@ -11,7 +11,8 @@ namespace {
 
 std::string_view trim(std::string_view s) {
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r'))
+    s.remove_suffix(1);
   return s;
 }
 
@@ -36,8 +37,8 @@ bool is_nan_word(std::string_view s) {
 }  // namespace
 
 CsvReader::CsvReader(std::string path, std::vector<CsvColumn> columns,
-                     std::optional<std::string> time_column)
-    : path_(std::move(path)), columns_(std::move(columns)), in_(path_) {
+                     std::optional<std::string> time_column, TimeOrder order)
+    : path_(std::move(path)), columns_(std::move(columns)), in_(path_), order_(order) {
   if (!in_) throw CsvError(path_ + ":0:0: cannot open file");
   if (!std::getline(in_, buffer_)) throw CsvError(path_ + ":1:0: empty file (no header line)");
   line_ = 1;
@@ -79,9 +80,9 @@ bool CsvReader::next(std::vector<double>& values) {
   }
   split(buffer_, cells_);
   if (cells_.size() != header_.size())
-    fail(std::min(cells_.size(), header_.size()) + 1,
-         "expected " + std::to_string(header_.size()) + " fields, found " +
-             std::to_string(cells_.size()));
+    fail(std::min(cells_.size(), header_.size()) + 1, "expected " + std::to_string(header_.size()) +
+                                                          " fields, found " +
+                                                          std::to_string(cells_.size()));
   values.resize(columns_.size());
   for (std::size_t i = 0; i < columns_.size(); ++i) {
     const int src = source_index_[i];
@@ -99,18 +100,23 @@ bool CsvReader::next(std::vector<double>& values) {
     double v = 0.0;
     const auto [end, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), v);
     if (ec != std::errc() || end != cell.data() + cell.size())
-      fail(column, "not a number in column '" + columns_[i].name + "': '" + std::string(cell) + "'");
-    if (!std::isfinite(v))
-      fail(column, "non-finite value in column '" + columns_[i].name + "'");
+      fail(column,
+           "not a number in column '" + columns_[i].name + "': '" + std::string(cell) + "'");
+    if (!std::isfinite(v)) fail(column, "non-finite value in column '" + columns_[i].name + "'");
     values[i] = v;
   }
   if (time_index_ >= 0) {
     const double t = values[static_cast<std::size_t>(time_index_)];
-    const auto column = static_cast<std::size_t>(source_index_[static_cast<std::size_t>(time_index_)]) + 1;
+    const auto column =
+        static_cast<std::size_t>(source_index_[static_cast<std::size_t>(time_index_)]) + 1;
     if (!std::isfinite(t)) fail(column, "missing time");
-    if (have_time_ && !(t > last_time_))
-      fail(column, "time not increasing (" + std::to_string(t) + " after " +
-                       std::to_string(last_time_) + ")");
+    if (have_time_ && t == last_time_ && order_ == TimeOrder::kNonDecreasing) {
+      ++repeated_times_;
+    } else if (have_time_ && !(t > last_time_)) {
+      fail(column, std::string(order_ == TimeOrder::kNonDecreasing ? "time goes backwards"
+                                                                   : "time not increasing") +
+                       " (" + std::to_string(t) + " after " + std::to_string(last_time_) + ")");
+    }
     last_time_ = t;
     have_time_ = true;
   }

@@ -29,16 +29,24 @@ struct CsvColumn {
   bool allow_missing = false;  ///< empty cell or "nan" -> NaN instead of an error
 };
 
+/// What the time column may do from one row to the next.
+enum class TimeOrder {
+  kIncreasing,     ///< strictly increasing: a repeated time stamp is an error
+  kNonDecreasing,  ///< a repeated time stamp is returned (and counted); backwards is an error
+};
+
 /// Streams the rows of a CSV file with a header line, picking columns by name in any order.
 /// Extra columns are ignored. Numbers are parsed strictly (no trailing text); NaN/Inf are errors
 /// unless the column allows missing values (then an empty cell or "nan" reads as NaN).
-/// If `time_column` is set, its values must be finite and strictly increasing.
+/// If `time_column` is set, its values must be finite and follow `order`; time going backwards
+/// is always an error naming the file, line and column.
 class CsvReader {
  public:
   /// Opens the file and reads the header. Throws CsvError (missing file, empty file, missing
   /// required column).
   CsvReader(std::string path, std::vector<CsvColumn> columns,
-            std::optional<std::string> time_column = std::nullopt);
+            std::optional<std::string> time_column = std::nullopt,
+            TimeOrder order = TimeOrder::kIncreasing);
 
   /// Reads the next data row into `values` (one entry per requested column, in request order;
   /// an absent optional column reads as NaN). Returns false at end of file. Throws CsvError.
@@ -49,6 +57,8 @@ class CsvReader {
   [[nodiscard]] const std::string& path() const { return path_; }
   /// 1-based line number of the row last returned.
   [[nodiscard]] std::size_t line() const { return line_; }
+  /// Rows returned so far whose time equals the previous row's (TimeOrder::kNonDecreasing).
+  [[nodiscard]] std::size_t repeated_times() const { return repeated_times_; }
 
  private:
   [[noreturn]] void fail(std::size_t column_1based, const std::string& what) const;
@@ -58,7 +68,9 @@ class CsvReader {
   std::ifstream in_;
   std::vector<int> source_index_;  ///< per requested column: index in the file, -1 if absent
   std::vector<std::string> header_;
-  int time_index_ = -1;            ///< index into columns_ of the time column
+  int time_index_ = -1;  ///< index into columns_ of the time column
+  TimeOrder order_ = TimeOrder::kIncreasing;
+  std::size_t repeated_times_ = 0;
   double last_time_ = 0.0;
   bool have_time_ = false;
   std::size_t line_ = 0;

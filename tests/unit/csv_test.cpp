@@ -60,10 +60,39 @@ TEST_F(CsvTest, ErrorsNameFileLineAndColumn) {
   expect_error("t_s,a\n1,2x\n", {{"t_s"}, {"a"}}, "2:2: not a number in column 'a': '2x'");
 }
 
+// Real phones write repeated time stamps: with TimeOrder::kNonDecreasing the rows are returned
+// and counted; time going backwards stays an error naming file, line and column. The default
+// (strict) order still refuses a repeated stamp.
+TEST_F(CsvTest, RepeatedTimeStampsAcceptedAndCountedWhenAsked) {
+  const auto p = write("t_s,a\n0,1\n0.01,2\n0.01,3\n0.01,4\n0.02,5\n0.02,6\n0.03,7\n");
+  CsvReader r(p, {{"t_s"}, {"a"}}, "t_s", TimeOrder::kNonDecreasing);
+  std::vector<double> row;
+  std::vector<double> a;
+  while (r.next(row)) a.push_back(row[1]);
+  EXPECT_EQ(a, (std::vector<double>{1, 2, 3, 4, 5, 6, 7}));
+  EXPECT_EQ(r.repeated_times(), 3u);
+  const std::string strict = error_of(p, {{"t_s"}, {"a"}});
+  EXPECT_EQ(strict.rfind(p + ":4:1: time not increasing", 0), 0u) << strict;
+}
+
+TEST_F(CsvTest, TimeGoingBackwardsStaysAnErrorWithRepeatedStampsAllowed) {
+  const auto p = write("x,t_s,a\n0,0,1\n0,0.01,2\n0,0.01,3\n0,0.005,4\n");
+  CsvReader r(p, {{"t_s"}, {"a"}}, "t_s", TimeOrder::kNonDecreasing);
+  std::vector<double> row;
+  std::string err;
+  try {
+    while (r.next(row)) {
+    }
+  } catch (const CsvError& e) {
+    err = e.what();
+  }
+  EXPECT_EQ(err.rfind(p + ":5:2: time goes backwards", 0), 0u) << err;
+}
+
 TEST_F(CsvTest, MissingValuesWhereAllowed) {
   const auto p = write("t_s,h1_deg,h2_deg\n0,,1\n0.1,nan,2\n");
-  const auto t = read_csv(p, {{"t_s"}, {"h1_deg", true, true}, {"h2_deg", true, true},
-                             {"h3_deg", false, true}}, "t_s");
+  const auto t = read_csv(
+      p, {{"t_s"}, {"h1_deg", true, true}, {"h2_deg", true, true}, {"h3_deg", false, true}}, "t_s");
   EXPECT_TRUE(std::isnan(t.col("h1_deg")[0]));
   EXPECT_TRUE(std::isnan(t.col("h1_deg")[1]));
   EXPECT_TRUE(std::isnan(t.col("h3_deg")[0]));
