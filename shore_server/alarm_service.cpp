@@ -51,7 +51,7 @@ void AlarmService::publish(const std::vector<AlarmEvent>& changed) {
   for (const auto& e : changed) {
     store_.save_event(e);
     if (sinks_.push_event) sinks_.push_event(e);
-    hub_.publish_event("alarm", event_object(e).dump(), e.boat_id);
+    hub_.publish_event("alarm", to_json_text(event_object(e)), e.boat_id);
     boats.insert(e.boat_id);
   }
   for (const auto& boat : boats) {

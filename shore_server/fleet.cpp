@@ -4,9 +4,21 @@
 
 namespace telltale::shore {
 
+namespace {
+/// Removes the entry silent the longest.
+template <class Map>
+void evict_oldest(Map& m) {
+  auto oldest = m.begin();
+  for (auto it = m.begin(); it != m.end(); ++it)
+    if (it->second.last_arrival < oldest->second.last_arrival) oldest = it;
+  if (oldest != m.end()) m.erase(oldest);
+}
+}  // namespace
+
 BoatView FleetModel::update(const AttitudeSample& sample, SteadyTime arrival,
-                        std::uint64_t arrival_utc_ns) {
+                            std::uint64_t arrival_utc_ns) {
   std::lock_guard lock(mutex_);
+  if (boats_.size() >= kMaxFleetEntries && !boats_.count(sample.boat_id)) evict_oldest(boats_);
   auto it = boats_.try_emplace(sample.boat_id).first;
   BoatView& b = it->second;
   // Clock offset: the minimum of (arrival - sample time) over a 10 s window filters out network
@@ -72,6 +84,22 @@ std::optional<BoatView> FleetModel::set_alarm_state(const std::string& boat_id,
   return it->second;
 }
 
+std::vector<std::string> FleetModel::forget(SteadyTime now, std::chrono::seconds older_than) {
+  std::vector<std::string> gone;
+  std::lock_guard lock(mutex_);
+  std::erase_if(boats_, [&](const auto& e) {
+    const bool old = e.second.samples_received > 0 && now - e.second.last_arrival > older_than;
+    if (old) gone.push_back(e.first);
+    return old;
+  });
+  std::erase_if(athletes_, [&](const auto& e) {
+    const bool old = now - e.second.last_arrival > older_than;
+    if (old) gone.push_back(e.first);
+    return old;
+  });
+  return gone;
+}
+
 std::vector<BoatView> FleetModel::boats() const {
   std::lock_guard lock(mutex_);
   std::vector<BoatView> out;
@@ -89,6 +117,8 @@ std::optional<BoatView> FleetModel::boat(const std::string& boat_id) const {
 
 AthleteView FleetModel::update(const WearableSample& sample, SteadyTime arrival) {
   std::lock_guard lock(mutex_);
+  if (athletes_.size() >= kMaxFleetEntries && !athletes_.count(sample.athlete_id))
+    evict_oldest(athletes_);
   AthleteView& a = athletes_[sample.athlete_id];
   a.last = sample;
   a.last_arrival = arrival;

@@ -94,6 +94,10 @@ struct AthleteView {
   bool stale = false;
 };
 
+/// Most boats (and, apart, most athletes) the fleet model holds: a new one beyond this evicts the
+/// one silent the longest, so a publisher inventing ids cannot grow the shore without bound.
+inline constexpr std::size_t kMaxFleetEntries = 1000;
+
 /// A boat whose clock is off by more than this is flagged (clock_suspect in the API).
 inline constexpr double kClockSuspectMs = 100.0;
 
@@ -112,6 +116,11 @@ class FleetModel {
 
   /// Sets a boat's alarm state ("normal", "warn", "alarm"); its view if the boat is known.
   std::optional<BoatView> set_alarm_state(const std::string& boat_id, const std::string& state);
+
+  /// Forgets boats and athletes silent for longer than `older_than` (a boat known only from a
+  /// stored alarm, never heard, is kept); returns their ids. The model is bounded in time by
+  /// this and in size by kMaxFleetEntries.
+  std::vector<std::string> forget(SteadyTime now, std::chrono::seconds older_than);
 
   [[nodiscard]] std::vector<BoatView> boats() const;
   [[nodiscard]] std::optional<BoatView> boat(const std::string& boat_id) const;

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "http_guard.hpp"
 #include "json_views.hpp"
 #include "openapi_json.hpp"
 #include "query.hpp"
@@ -21,8 +22,11 @@ namespace {
 
 void json_error(httplib::Response& res, int status, const std::string& message) {
   res.status = status;
-  res.set_content(json{{"error", message}}.dump(), "application/json");
+  res.set_content(to_json_text(json{{"error", message}}), "application/json");
 }
+
+/// More than this many query parameters is a client error (no route takes more than five).
+constexpr std::size_t kMaxQueryParams = 32;
 
 bool is_open_path(const std::string& path) {
   // Only the health check, the API description, login and the static dashboard are open.
@@ -42,11 +46,22 @@ Principal authenticate(const TokenStore& tokens, const std::string& authorizatio
 struct HttpApi::Impl {
   HttpConfig config;
   ShoreContext ctx;
-  httplib::Server server;
+  GuardedServer server;
   std::atomic<bool> stop_requested{false};
   std::atomic<bool> served{false};  ///< serve() has returned
 
-  Impl(HttpConfig c, ShoreContext context) : config(std::move(c)), ctx(context) {}
+  Impl(HttpConfig c, ShoreContext context)
+      : config(std::move(c)), ctx(context), server(guard_limits(config)) {}
+
+  static GuardLimits guard_limits(const HttpConfig& c) {
+    GuardLimits l;
+    // Every stream and REST worker, plus headroom that idle or slow connections may take
+    // before the guard tightens its timeouts (http_guard.hpp).
+    l.workers = c.max_stream_clients + c.rest_threads + c.spare_threads;
+    l.spare_workers = std::max<std::size_t>(4, c.spare_threads / 2);
+    l.idle_timeout = std::chrono::seconds(c.keep_alive_s);
+    return l;
+  }
 
   std::optional<Principal> principal(const httplib::Request& req) const {
     return ctx.tokens.find(
@@ -57,15 +72,42 @@ struct HttpApi::Impl {
     // Deliberate settings: the library's defaults (5 keep-alive requests per connection, no
     // TCP_NODELAY, a pool of max(8, cores-1) threads) starve under a handful of streams.
     server.set_tcp_nodelay(true);
+    // The pool, the keep-alive idle limit and the request deadlines are GuardedServer's.
     server.set_keep_alive_max_count(10000);
-    server.set_keep_alive_timeout(30);
     server.set_read_timeout(5, 0);
     server.set_write_timeout(5, 0);
     server.set_payload_max_length(config.max_body_bytes);
-    const std::size_t workers = config.max_stream_clients + config.rest_threads;
-    server.new_task_queue = [workers] { return new httplib::ThreadPool(workers); };
 
     server.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+      // Bodies: a length we accept, said up front; nothing else is read. Refused at once, and the
+      // connection closed, so an unread body is never parsed as the next request.
+      if (req.has_header("Transfer-Encoding")) {
+        GuardedServer::close_after_response();
+        json_error(res, 411,
+                   "chunked request bodies are not accepted: send a Content-Length (at most " +
+                       std::to_string(config.max_body_bytes) + " bytes)");
+        return httplib::Server::HandlerResponse::Handled;
+      }
+      if (req.has_header("Content-Length")) {
+        const auto n = parse_int(req.get_header_value("Content-Length"), 0, INT64_MAX);
+        if (!n) {
+          GuardedServer::close_after_response();
+          json_error(res, 400, "Content-Length must be a whole number of bytes");
+          return httplib::Server::HandlerResponse::Handled;
+        }
+        if (static_cast<std::uint64_t>(*n) > config.max_body_bytes) {
+          GuardedServer::close_after_response();
+          json_error(res, 413,
+                     "request body too large (at most " + std::to_string(config.max_body_bytes) +
+                         " bytes)");
+          return httplib::Server::HandlerResponse::Handled;
+        }
+      }
+      if (req.params.size() > kMaxQueryParams) {
+        json_error(res, 400,
+                   "too many query parameters (at most " + std::to_string(kMaxQueryParams) + ")");
+        return httplib::Server::HandlerResponse::Handled;
+      }
       if (is_open_path(req.path)) return httplib::Server::HandlerResponse::Unhandled;
       if (!principal(req)) {
         res.set_header("WWW-Authenticate", "Bearer");
@@ -80,6 +122,10 @@ struct HttpApi::Impl {
         json_error(res, 404, "no such resource: " + req.path);
       } else if (res.status == 413) {
         json_error(res, 413, "request body too large");
+      } else if (res.status == 414) {
+        json_error(res, 414,
+                   "request line longer than 8192 bytes (too many or too long query "
+                   "parameters)");
       } else {
         json_error(res, res.status,
                    res.status == 400 ? "malformed request (a POST or PUT needs a Content-Length)"
@@ -124,7 +170,15 @@ struct HttpApi::Impl {
         j["duplicate_boat_ids"] = duplicates;
         j["status"] = "degraded";
       }
-      res.set_content(j.dump(), "application/json");
+      j["http"] = {{"busy_connections", server.busy()},
+                   {"workers", server.workers()},
+                   {"cut_requests", server.cut_requests()},
+                   {"cut_idle", server.cut_idle()}};
+      if (ctx.ingest) {
+        j["samples_rejected"] = ctx.ingest->rejected_total();
+        j["ingest"] = ctx.ingest->to_json();
+      }
+      res.set_content(to_json_text(j), "application/json");
     });
     server.Get("/api/v1/openapi.json", [](const httplib::Request&, httplib::Response& res) {
       res.set_content(kOpenApiJson, "application/json");
@@ -140,15 +194,15 @@ struct HttpApi::Impl {
       // The dashboard's EventSource cannot send headers: the cookie carries the token.
       res.set_header("Set-Cookie", "telltale_token=" + token +
                                        "; Path=/; HttpOnly; SameSite=Strict; Max-Age=86400");
-      res.set_content(json{{"role", role_name(who->role)}}.dump(), "application/json");
+      res.set_content(to_json_text(json{{"role", role_name(who->role)}}), "application/json");
     });
     server.Get("/api/v1/me", [this](const httplib::Request& req, httplib::Response& res) {
       const Principal who = authenticate(ctx.tokens, req.get_header_value("Authorization"),
                                          req.get_header_value("Cookie"));
-      res.set_content(json{{"role", role_name(who.role)},
-                           {"boat_id", who.boat_id.empty() ? json(nullptr) : json(who.boat_id)}}
-                          .dump(),
-                      "application/json");
+      res.set_content(
+          to_json_text(json{{"role", role_name(who.role)},
+                            {"boat_id", who.boat_id.empty() ? json(nullptr) : json(who.boat_id)}}),
+          "application/json");
     });
     server.Post("/api/v1/logout", [](const httplib::Request&, httplib::Response& res) {
       res.set_header("Set-Cookie", "telltale_token=; Path=/; HttpOnly; SameSite=Strict; Max-Age=0");
@@ -165,6 +219,9 @@ struct HttpApi::Impl {
         return;
       }
       res.set_header("Cache-Control", "no-store");
+      // A dashboard that stops reading must fill its buffers in seconds, so that the write
+      // timeout frees its slot, not in the minutes a kernel-grown buffer of megabytes takes.
+      GuardedServer::cap_send_buffer(static_cast<int>(config.stream_send_buffer_bytes));
       // The current fleet first, so a new dashboard draws at once; then live updates.
       std::string snapshot = "retry: 2000\n\n";
       for (const auto& b : ctx.fleet.boats()) {

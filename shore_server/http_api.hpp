@@ -10,6 +10,7 @@
 #include "alarm_service.hpp"
 #include "auth.hpp"
 #include "fleet.hpp"
+#include "ingest.hpp"
 #include "live_hub.hpp"
 #include "store.hpp"
 
@@ -26,6 +27,14 @@ struct HttpConfig {
   std::size_t max_stream_clients = 64;
   std::size_t rest_threads = 8;  ///< workers beyond the ones the streams may hold
   std::size_t max_body_bytes = 1 << 20;
+  /// Pool threads beyond streams and REST workers: idle keep-alive and slow connections may hold
+  /// these before the server tightens its limits (http_guard.hpp).
+  std::size_t spare_threads = 32;
+  /// An idle keep-alive connection is closed after this long (sooner while threads are short).
+  int keep_alive_s = 5;
+  /// Send buffer of a live-stream connection: a client that stops reading is dropped once this
+  /// and its receive buffer are full and a write has waited 5 s.
+  std::size_t stream_send_buffer_bytes = 32 * 1024;
 };
 
 /// What the routes work on.
@@ -35,6 +44,8 @@ struct ShoreContext {
   TokenStore& tokens;
   Store& store;
   AlarmService& alarms;
+  /// The DDS door's counts (ingest.hpp), shown by /healthz; none without DDS.
+  const IngestCounters* ingest = nullptr;
 };
 
 class HttpApi {

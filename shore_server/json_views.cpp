@@ -21,6 +21,10 @@ std::string iso8601(std::uint64_t t_utc_ns) {
   return buf;
 }
 
+std::string to_json_text(const json& j) {
+  return j.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
 json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
 json boat_object(const BoatView& v) {
@@ -41,7 +45,10 @@ json boat_object(const BoatView& v) {
       {"accel_weight", finite_or_null(static_cast<double>(s.accel_weight))},
       {"quality", finite_or_null(static_cast<double>(s.quality))},
       {"leds",
-       {{"left", s.leds[0]}, {"right", s.leds[1]}, {"up", s.leds[2]}, {"down", s.leds[3]},
+       {{"left", s.leds[0]},
+        {"right", s.leds[1]},
+        {"up", s.leds[2]},
+        {"down", s.leds[3]},
         {"count", s.led_count}}},
       {"alarm_state", v.alarm_state},
       {"stale", v.stale},
@@ -58,7 +65,7 @@ json boat_object(const BoatView& v) {
   return j;
 }
 
-std::string boat_json(const BoatView& view) { return boat_object(view).dump(); }
+std::string boat_json(const BoatView& view) { return to_json_text(boat_object(view)); }
 
 json rule_object(const AlarmRule& r) {
   return {{"id", r.id},
@@ -86,7 +93,8 @@ T field(const json& j, const char* name, const T& fallback, bool required) {
     if (!std::isfinite(d)) throw HttpError(400, std::string("rule: '") + name + "' must be finite");
     return d;
   } else if constexpr (std::is_same_v<T, bool>) {
-    if (!v.is_boolean()) throw HttpError(400, std::string("rule: '") + name + "' must be true/false");
+    if (!v.is_boolean())
+      throw HttpError(400, std::string("rule: '") + name + "' must be true/false");
     return v.get<bool>();
   } else {
     if (!v.is_string()) throw HttpError(400, std::string("rule: '") + name + "' must be a string");
@@ -97,7 +105,7 @@ T field(const json& j, const char* name, const T& fallback, bool required) {
 
 AlarmRule rule_from_json(const json& j) {
   if (!j.is_object()) throw HttpError(400, "rule: expected an object");
-  static const std::set<std::string> kKnown = {"id",     "scope",          "quantity", "min_deg",
+  static const std::set<std::string> kKnown = {"id",      "scope",  "quantity",       "min_deg",
                                                "max_deg", "hold_s", "hysteresis_deg", "level",
                                                "enabled"};
   for (const auto& [key, value] : j.items())

@@ -14,6 +14,11 @@
 
 namespace telltale::shore {
 
+/// JSON text of `j` that never throws on a string that is not valid UTF-8 (such bytes become
+/// U+FFFD): a stored value from before the shore checked its input cannot fail a response.
+/// Every response and stream frame is serialised through it, never through json::dump().
+[[nodiscard]] std::string to_json_text(const nlohmann::json& j);
+
 /// ISO-8601 UTC with milliseconds for ns since 1970.
 [[nodiscard]] std::string iso8601(std::uint64_t t_utc_ns);
 /// A number, or null when it is not finite.

@@ -43,6 +43,11 @@ void LiveHub::publish_sample(const std::string& key, const std::string& data) {
   l.frame = std::move(f);
 }
 
+void LiveHub::forget(const std::string& key) {
+  std::lock_guard lock(mutex_);
+  latest_.erase(key);
+}
+
 void LiveHub::publish_event(const std::string& type, const std::string& data,
                             const std::string& key) {
   const auto f = frame(type, data);
@@ -87,8 +92,8 @@ std::string LiveHub::wait(Client& client, std::chrono::milliseconds timeout, boo
   client.next_frame_ = Clock::now() + frame_interval_;
   if (client.dropped_events_ > 0) {
     // The client was too slow to take every event: tell it, so it can refetch what it missed.
-    out += *frame("overflow",
-                  "{\"dropped_events\":" + std::to_string(client.dropped_events_) + "}");
+    out +=
+        *frame("overflow", "{\"dropped_events\":" + std::to_string(client.dropped_events_) + "}");
     client.dropped_events_ = 0;
   }
   for (const auto& e : client.events_) out += *e;

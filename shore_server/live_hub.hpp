@@ -39,6 +39,8 @@ class LiveHub {
 
   /// Replaces the latest sample of `key`. `data` is the JSON payload.
   void publish_sample(const std::string& key, const std::string& data);
+  /// Drops the latest sample of `key` (a boat the fleet model forgot).
+  void forget(const std::string& key);
   /// Queues an event of SSE type `type` about `key` for every client that may see it.
   void publish_event(const std::string& type, const std::string& data, const std::string& key);
 

@@ -40,6 +40,7 @@ struct Options {
   int commit_ms = 250;
   int session_gap_s = 60;
   int stream_interval_ms = 100;
+  int forget_after_s = 6 * 3600;
 };
 
 /// Live samples from the DDS listener to the live worker (fleet model, alarms, dashboards).
@@ -134,7 +135,7 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
   callbacks.on_wearable = [&](const WearableSample& w) {
     const AthleteView view = fleet.update(w, std::chrono::steady_clock::now());
     store.enqueue(w);
-    hub.publish_event("wearable", athlete_object(view).dump(), w.athlete_id);
+    hub.publish_event("wearable", to_json_text(athlete_object(view)), w.athlete_id);
   };
   callbacks.on_status = [&](const std::string& id, const NodeStatusInfo& st) {
     fleet.update_status(id, st);
@@ -163,9 +164,10 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
     for (const auto& v : fleet.sweep(std::chrono::steady_clock::now()))
       hub.publish_sample(v.last.boat_id, boat_json(v));
     for (const auto& a : fleet.sweep_athletes(std::chrono::steady_clock::now()))
-      hub.publish_event("wearable", athlete_object(a).dump(), a.last.athlete_id);
+      hub.publish_event("wearable", to_json_text(athlete_object(a)), a.last.athlete_id);
     const bool repeat = ++tick % 5 == 0;
-    for (const auto& a : store.acks()) {
+    const auto acks = store.acks();
+    for (const auto& a : acks) {
       auto [it, added] = receipt_sent.try_emplace({a.boat_id, a.boot_id}, a.acked_seq);
       if (!repeat && !added && it->second == a.acked_seq) continue;
       it->second = a.acked_seq;
@@ -219,6 +221,14 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(10, 5000));
   app.add_option("--stale-ms", o.stale_ms, "a boat silent this long is stale")
       ->capture_default_str();
+  app.add_option("--forget-after-s", o.forget_after_s,
+                 "a boat or athlete silent this long leaves the live fleet (its recording stays)")
+      ->capture_default_str()
+      ->check(CLI::Range(60, 30 * 86400));
+  app.add_option("--keep-alive-s", o.http.keep_alive_s,
+                 "an idle HTTP keep-alive connection is closed after this (sooner under load)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 300));
   app.add_option("--commit-ms", o.commit_ms, "store commit interval (the durability window)")
       ->capture_default_str();
   telltale::dds::add_dds_options(app, o.dds);

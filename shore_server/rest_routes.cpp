@@ -72,7 +72,8 @@ std::optional<std::size_t> max_points_of(const httplib::Request& req) {
   const std::string* m = param(req, "max_points");
   if (!m) return std::nullopt;
   const auto n = parse_int(*m, 4, kMaxPointsLimit);
-  if (!n) throw HttpError(400, "max_points must be an integer in 4.." + std::to_string(kMaxPointsLimit));
+  if (!n)
+    throw HttpError(400, "max_points must be an integer in 4.." + std::to_string(kMaxPointsLimit));
   return static_cast<std::size_t>(*n);
 }
 
@@ -91,10 +92,10 @@ std::string csv_row(const AttitudeRow& r) {
   char t[32];
   std::snprintf(t, sizeof t, "%.3f", static_cast<double>(r.t_utc_ns) * 1e-9);
   return iso8601(r.t_utc_ns) + "," + t + "," + std::to_string(r.seq) + "," +
-         csv_number(r.heel_deg) + "," + csv_number(r.pitch_deg) + "," +
-         csv_number(r.heading_deg) + "," + csv_number(r.heel_rate_deg_s) + "," +
-         csv_number(r.pitch_rate_deg_s) + "," + csv_number(r.yaw_rate_deg_s) + "," +
-         csv_number(r.accel_weight) + "," + csv_number(r.quality) + "\n";
+         csv_number(r.heel_deg) + "," + csv_number(r.pitch_deg) + "," + csv_number(r.heading_deg) +
+         "," + csv_number(r.heel_rate_deg_s) + "," + csv_number(r.pitch_rate_deg_s) + "," +
+         csv_number(r.yaw_rate_deg_s) + "," + csv_number(r.accel_weight) + "," +
+         csv_number(r.quality) + "\n";
 }
 
 json row_object(const AttitudeRow& r) {
@@ -128,14 +129,14 @@ void stream_rows(httplib::Response& res, Store& store, const std::string& boat_i
   res.set_chunked_content_provider(
       format == Format::kCsv ? "text/csv" : "application/json",
       [&store, boat_id, to_ns, format, cursor, head = std::move(head)](std::size_t,
-                                                                        httplib::DataSink& sink) {
+                                                                       httplib::DataSink& sink) {
         std::string out;
         if (!cursor->started) {
           cursor->started = true;
           if (format == Format::kCsv) {
             out = kCsvHeader;
           } else {
-            std::string h = head.dump();
+            std::string h = to_json_text(head);
             h.pop_back();  // reopen the object to append the samples array
             out = h + (head.empty() ? "" : ",") + "\"samples\":[";
           }
@@ -151,7 +152,7 @@ void stream_rows(httplib::Response& res, Store& store, const std::string& boat_i
             out += csv_row(r);
           } else {
             if (!cursor->first_row) out += ",";
-            out += row_object(r).dump();
+            out += to_json_text(row_object(r));
             cursor->first_row = false;
           }
         }
@@ -254,8 +255,14 @@ json heel_bands(Store& store, const SessionInfo& s) {
   return bands;
 }
 
+/// Export file name; a boat id stored before the shore checked ids may hold anything, so only
+/// the id contract's characters pass into the header.
 std::string safe_filename(const std::string& boat_id, std::int64_t session_id, Format f) {
-  return "telltale_" + boat_id + "_session" + std::to_string(session_id) +
+  std::string id = boat_id.substr(0, 32);
+  for (char& c : id)
+    if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-'))
+      c = '_';
+  return "telltale_" + id + "_session" + std::to_string(session_id) +
          (f == Format::kCsv ? ".csv" : ".json");
 }
 
@@ -268,22 +275,22 @@ void register_rest_routes(httplib::Server& server, ShoreContext& ctx) {
     json arr = json::array();
     for (const auto& b : ctx.fleet.boats())
       if (p.role != Role::kAthlete || b.last.boat_id == p.boat_id) arr.push_back(boat_object(b));
-    res.set_content(arr.dump(), "application/json");
+    res.set_content(to_json_text(arr), "application/json");
   });
 
-  server.Get(R"(/api/v1/boats/([^/]+))", [&ctx](const httplib::Request& req,
-                                                 httplib::Response& res) {
-    const Principal p = who(ctx, req);
-    allow_params(req, {});
-    const std::string id = path_id(req, "boat");
-    require_boat(p, id);
-    const auto view = ctx.fleet.boat(id);
-    if (!view) throw HttpError(404, "unknown boat '" + id + "'");
-    res.set_content(boat_json(*view), "application/json");
-  });
+  server.Get(R"(/api/v1/boats/([^/]+))",
+             [&ctx](const httplib::Request& req, httplib::Response& res) {
+               const Principal p = who(ctx, req);
+               allow_params(req, {});
+               const std::string id = path_id(req, "boat");
+               require_boat(p, id);
+               const auto view = ctx.fleet.boat(id);
+               if (!view) throw HttpError(404, "unknown boat '" + id + "'");
+               res.set_content(boat_json(*view), "application/json");
+             });
 
   server.Get(R"(/api/v1/boats/([^/]+)/attitude)", [&ctx](const httplib::Request& req,
-                                                          httplib::Response& res) {
+                                                         httplib::Response& res) {
     const Principal p = who(ctx, req);
     allow_params(req, {"from", "to", "max_points", "format"});
     const std::string id = path_id(req, "boat");
@@ -301,7 +308,7 @@ void register_rest_routes(httplib::Server& server, ShoreContext& ctx) {
     json j = attitude_columns(ctx.store, id, range.from_ns, range.to_ns, max_points);
     j["from"] = range.from_ns ? json(iso8601(range.from_ns)) : json(nullptr);
     j["to"] = range.to_ns != UINT64_MAX ? json(iso8601(range.to_ns)) : json(nullptr);
-    res.set_content(j.dump(), "application/json");
+    res.set_content(to_json_text(j), "application/json");
   });
 
   server.Get("/api/v1/athletes", [&ctx](const httplib::Request& req, httplib::Response& res) {
@@ -310,11 +317,11 @@ void register_rest_routes(httplib::Server& server, ShoreContext& ctx) {
     allow_params(req, {});
     json arr = json::array();
     for (const auto& a : ctx.fleet.athletes()) arr.push_back(athlete_object(a));
-    res.set_content(arr.dump(), "application/json");
+    res.set_content(to_json_text(arr), "application/json");
   });
 
   server.Get(R"(/api/v1/athletes/([^/]+)/track)", [&ctx](const httplib::Request& req,
-                                                          httplib::Response& res) {
+                                                         httplib::Response& res) {
     const Principal p = who(ctx, req);
     if (p.role == Role::kAthlete) throw HttpError(403, "an athlete sees only their own boat");
     allow_params(req, {"from", "to"});
@@ -331,8 +338,8 @@ void register_rest_routes(httplib::Server& server, ShoreContext& ctx) {
       y.push_back(finite_or_null(w.y_m));
       steps.push_back(w.steps);
     }
-    res.set_content(json{{"athlete_id", id}, {"t_s", t}, {"x_m", x}, {"y_m", y}, {"steps", steps}}
-                        .dump(),
+    res.set_content(to_json_text(json{
+                        {"athlete_id", id}, {"t_s", t}, {"x_m", x}, {"y_m", y}, {"steps", steps}}),
                     "application/json");
   });
 
@@ -352,7 +359,7 @@ void register_rest_routes(httplib::Server& server, ShoreContext& ctx) {
     json arr = json::array();
     for (const auto& s : ctx.store.sessions(boat, range.from_ns, range.to_ns))
       arr.push_back(session_object(s));
-    res.set_content(arr.dump(), "application/json");
+    res.set_content(to_json_text(arr), "application/json");
   });
 
   const auto session_or_404 = [&ctx](const httplib::Request& req, const Principal& p) {
@@ -363,33 +370,33 @@ void register_rest_routes(httplib::Server& server, ShoreContext& ctx) {
     return *s;
   };
 
-  server.Get(R"(/api/v1/sessions/([^/]+))", [&ctx, session_or_404](const httplib::Request& req,
-                                                                    httplib::Response& res) {
-    const Principal p = who(ctx, req);
-    allow_params(req, {});
-    const SessionInfo s = session_or_404(req, p);
-    json j = session_object(s);
-    j["heel_bands"] = heel_bands(ctx.store, s);
-    EventFilter f;
-    f.boat_id = s.boat_id;
-    f.from_ns = s.start_ns;
-    f.to_ns = s.end_ns;
-    f.limit = 10000;
-    json events = json::array();
-    for (const auto& e : ctx.store.events(f)) events.push_back(event_object(e));
-    j["alarm_events"] = std::move(events);
-    res.set_content(j.dump(), "application/json");
-  });
+  server.Get(R"(/api/v1/sessions/([^/]+))",
+             [&ctx, session_or_404](const httplib::Request& req, httplib::Response& res) {
+               const Principal p = who(ctx, req);
+               allow_params(req, {});
+               const SessionInfo s = session_or_404(req, p);
+               json j = session_object(s);
+               j["heel_bands"] = heel_bands(ctx.store, s);
+               EventFilter f;
+               f.boat_id = s.boat_id;
+               f.from_ns = s.start_ns;
+               f.to_ns = s.end_ns;
+               f.limit = 10000;
+               json events = json::array();
+               for (const auto& e : ctx.store.events(f)) events.push_back(event_object(e));
+               j["alarm_events"] = std::move(events);
+               res.set_content(to_json_text(j), "application/json");
+             });
 
   server.Get(R"(/api/v1/sessions/([^/]+)/attitude)",
              [&ctx, session_or_404](const httplib::Request& req, httplib::Response& res) {
                const Principal p = who(ctx, req);
                allow_params(req, {"max_points"});
                const SessionInfo s = session_or_404(req, p);
-               json j = attitude_columns(ctx.store, s.boat_id, s.start_ns, s.end_ns,
-                                         max_points_of(req));
+               json j =
+                   attitude_columns(ctx.store, s.boat_id, s.start_ns, s.end_ns, max_points_of(req));
                j["session_id"] = s.id;
-               res.set_content(j.dump(), "application/json");
+               res.set_content(to_json_text(j), "application/json");
              });
 
   server.Get(R"(/api/v1/sessions/([^/]+)/export)",
@@ -400,7 +407,8 @@ void register_rest_routes(httplib::Server& server, ShoreContext& ctx) {
                const Format format = format_of(req);
                const SessionInfo s = session_or_404(req, p);
                stream_rows(res, ctx.store, s.boat_id, s.start_ns, s.end_ns, format,
-                           {{"session", session_object(s)}}, safe_filename(s.boat_id, s.id, format));
+                           {{"session", session_object(s)}},
+                           safe_filename(s.boat_id, s.id, format));
              });
 
   server.Get("/api/v1/alarms/rules", [&ctx](const httplib::Request& req, httplib::Response& res) {
@@ -408,7 +416,7 @@ void register_rest_routes(httplib::Server& server, ShoreContext& ctx) {
     allow_params(req, {});
     json arr = json::array();
     for (const auto& r : ctx.alarms.rules()) arr.push_back(rule_object(r));
-    res.set_content(arr.dump(), "application/json");
+    res.set_content(to_json_text(arr), "application/json");
   });
 
   server.Put("/api/v1/alarms/rules", [&ctx](const httplib::Request& req, httplib::Response& res) {
@@ -420,7 +428,7 @@ void register_rest_routes(httplib::Server& server, ShoreContext& ctx) {
     ctx.alarms.put_rules(rules_from_body(req.body), utc_now_ns());
     json arr = json::array();
     for (const auto& r : ctx.alarms.rules()) arr.push_back(rule_object(r));
-    res.set_content(arr.dump(), "application/json");
+    res.set_content(to_json_text(arr), "application/json");
   });
 
   server.Get("/api/v1/alarms/events", [&ctx](const httplib::Request& req, httplib::Response& res) {
@@ -450,7 +458,7 @@ void register_rest_routes(httplib::Server& server, ShoreContext& ctx) {
     }
     json arr = json::array();
     for (const auto& e : ctx.store.events(f)) arr.push_back(event_object(e));
-    res.set_content(arr.dump(), "application/json");
+    res.set_content(to_json_text(arr), "application/json");
   });
 
   const auto event_action = [&ctx](bool acknowledge) {
@@ -466,7 +474,7 @@ void register_rest_routes(httplib::Server& server, ShoreContext& ctx) {
         if (ctx.store.event(ev_id)) throw HttpError(409, "event already cleared");
         throw HttpError(404, "unknown event " + std::to_string(ev_id));
       }
-      res.set_content(event_object(*e).dump(), "application/json");
+      res.set_content(to_json_text(event_object(*e)), "application/json");
     };
   };
   server.Post(R"(/api/v1/alarms/events/([^/]+)/ack)", event_action(true));

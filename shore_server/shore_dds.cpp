@@ -1,7 +1,8 @@
 #include "shore_dds.hpp"
 
-#include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <algorithm>
+#include <cstdio>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
 
 #include "dds_security.hpp"
 #include "shutdown.hpp"
@@ -11,85 +12,10 @@ namespace telltale::shore {
 
 namespace fdds = eprosima::fastdds::dds;
 
-namespace {
-
-AttitudeSample from_wire(const msg::BoatAttitude& m) {
-  AttitudeSample s;
-  s.boat_id = m.boat_id().to_string();
-  s.seq = m.seq();
-  s.t_utc_ns = m.t_utc_ns();
-  s.heel_deg = m.heel_deg();
-  s.pitch_deg = m.pitch_deg();
-  s.heading_deg = m.heading_deg();
-  s.heel_rate_deg_s = m.heel_rate_deg_s();
-  s.pitch_rate_deg_s = m.pitch_rate_deg_s();
-  s.yaw_rate_deg_s = m.yaw_rate_deg_s();
-  s.accel_weight = m.accel_weight();
-  s.quality = m.quality();
-  s.leds[0] = m.leds().left_leds();
-  s.leds[1] = m.leds().right_leds();
-  s.leds[2] = m.leds().up_leds();
-  s.leds[3] = m.leds().down_leds();
-  s.led_count = m.leds().led_count();
-  s.boot_id = m.boot_id();
-  return s;
-}
-
-const char* kind_name(msg::NodeKind kind) {
-  switch (kind) {
-    case msg::NODE_KIND_BOAT:
-      return "boat";
-    case msg::NODE_KIND_WEARABLE:
-      return "wearable";
-    case msg::NODE_KIND_SHORE:
-      return "shore";
-  }
-  return "unknown";
-}
-
-const char* gait_name(msg::Gait g) {
-  switch (g) {
-    case msg::GAIT_STILL:
-      return "still";
-    case msg::GAIT_SLOW_WALK:
-      return "slow_walk";
-    case msg::GAIT_WALK:
-      return "walk";
-    case msg::GAIT_FAST_WALK:
-      return "fast_walk";
-    case msg::GAIT_JOG:
-      return "jog";
-    case msg::GAIT_RUN:
-      return "run";
-    case msg::GAIT_UNKNOWN:
-      break;
-  }
-  return "unknown";
-}
-
-const char* pose_name(msg::Pose p) {
-  switch (p) {
-    case msg::POSE_HAND_HELD:
-      return "hand_held";
-    case msg::POSE_PHONE_CALL:
-      return "phone_call";
-    case msg::POSE_POCKET:
-      return "pocket";
-    case msg::POSE_ARM_SWING:
-      return "arm_swing";
-    case msg::POSE_FOOT:
-      return "foot";
-    case msg::POSE_UNKNOWN:
-      break;
-  }
-  return "unknown";
-}
-
-}  // namespace
-
 class ShoreDds::Listener : public fdds::DataReaderListener {
  public:
-  Listener(const FleetCallbacks& cb, WriterCheck* check) : cb_(cb), check_(check) {}
+  Listener(const FleetCallbacks& cb, Ingest& ingest, WriterCheck* check)
+      : cb_(cb), ingest_(ingest), check_(check) {}
 
   /// Unsecured: every sample. Secured: only a sample whose id is its writer's (writer_check.hpp).
   bool accept(const fdds::SampleInfo& info, const std::string& claimed_id) {
@@ -97,47 +23,37 @@ class ShoreDds::Listener : public fdds::DataReaderListener {
   }
 
   // Readers are told apart by topic name: a callback may arrive before the constructor below has
-  // stored the reader pointers.
+  // stored the reader pointers. Every sample goes through the door (ingest.hpp): nothing off the
+  // contract reaches the fleet model, the store or the dashboards, and nothing thrown escapes
+  // into Fast DDS's thread.
   void on_data_available(fdds::DataReader* reader) override {
+    try {
+      take_all(reader);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "shore_server: sample dropped: %s\n", e.what());
+    } catch (...) {
+      std::fprintf(stderr, "shore_server: sample dropped\n");
+    }
+  }
+
+  void take_all(fdds::DataReader* reader) {
     fdds::SampleInfo info;
     const std::string& topic = reader->get_topicdescription()->get_name();
     if (topic == dds::kTopicBoatAttitude || topic == dds::kTopicBoatBackfill) {
-      const auto& sink = topic == dds::kTopicBoatAttitude ? cb_.on_attitude : cb_.on_backfill;
+      const bool backfill = topic == dds::kTopicBoatBackfill;
       msg::BoatAttitude m;
       while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
-        if (sink && accept(info, m.boat_id().to_string())) sink(from_wire(m));
+        if (accept(info, m.boat_id().to_string())) (void)ingest_.attitude(m, backfill);
       }
     } else if (topic == dds::kTopicWearableMotion) {
       msg::WearableMotion m;
       while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
-        if (!cb_.on_wearable || !accept(info, m.athlete_id().to_string())) continue;
-        WearableSample w;
-        w.athlete_id = m.athlete_id().to_string();
-        w.seq = m.seq();
-        w.t_utc_ns = m.t_utc_ns();
-        w.steps = m.steps();
-        w.cadence_spm = m.cadence_spm();
-        w.gait = gait_name(m.gait());
-        w.pose = pose_name(m.pose());
-        w.x_m = m.x_m();
-        w.y_m = m.y_m();
-        w.heading_deg = m.heading_deg();
-        w.distance_m = m.distance_m();
-        cb_.on_wearable(w);
+        if (accept(info, m.athlete_id().to_string())) (void)ingest_.wearable(m);
       }
     } else if (topic == dds::kTopicNodeStatus) {
       msg::NodeStatus m;
       while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
-        if (!cb_.on_status || !accept(info, m.node_id().to_string())) continue;
-        NodeStatusInfo s;
-        s.kind = kind_name(m.kind());
-        s.software_version = m.software_version().to_string();
-        s.uptime_s = m.uptime_s();
-        s.sensor_health = m.sensor_health();
-        s.health_text = m.health_text().to_string();
-        s.samples_published = m.samples_published();
-        s.group = m.group().to_string();
-        cb_.on_status(m.node_id().to_string(), s);
+        if (accept(info, m.node_id().to_string())) (void)ingest_.status(m);
       }
     }
   }
@@ -149,52 +65,55 @@ class ShoreDds::Listener : public fdds::DataReaderListener {
       return;
     msg::BoatAttitude key_holder;
     if (reader->get_key_value(&key_holder, status.last_instance_handle) ==
-        ReturnCode_t::RETCODE_OK)
+            ReturnCode_t::RETCODE_OK &&
+        contract_id(key_holder.boat_id().to_string()))
       cb_.on_deadline_missed(key_holder.boat_id().to_string());
   }
 
  private:
   using ReturnCode_t = eprosima::fastrtps::types::ReturnCode_t;
   const FleetCallbacks& cb_;
+  Ingest& ingest_;
   WriterCheck* check_;
 };
 
 ShoreDds::ShoreDds(const dds::DdsOptions& options, FleetCallbacks callbacks)
-    : callbacks_(std::move(callbacks)) {
+    : callbacks_(std::move(callbacks)),
+      ingest_(std::make_unique<Ingest>(IngestSinks{callbacks_.on_attitude, callbacks_.on_backfill,
+                                                   callbacks_.on_status, callbacks_.on_wearable})) {
   dds::DdsOptions opts = options;
   if (!opts.security_dir.empty()) {
     writer_check_ = std::make_unique<WriterCheck>(opts.security_dir);
     opts.listener = writer_check_.get();
     dds::use_shore_partitions(opts);
   }
-  listener_ = std::make_unique<Listener>(callbacks_, writer_check_.get());
+  listener_ = std::make_unique<Listener>(callbacks_, *ingest_, writer_check_.get());
   participant_ = std::make_unique<dds::Participant>(opts, "shore_server");
   participant_->reader(
-      participant_->topic(dds::kTopicBoatAttitude,
-                          fdds::TypeSupport(new msg::BoatAttitudePubSubType())),
+      participant_->topic(dds::kTopicBoatAttitude, fdds::TypeSupport(new StrictBoatAttitudeType())),
       "attitude_reader", listener_.get());
-  participant_->reader(participant_->topic(dds::kTopicBoatBackfill,
-                                           fdds::TypeSupport(new msg::BoatAttitudePubSubType())),
-                       "backfill_reader", listener_.get());
+  participant_->reader(
+      participant_->topic(dds::kTopicBoatBackfill, fdds::TypeSupport(new StrictBoatAttitudeType())),
+      "backfill_reader", listener_.get());
   participant_->reader(participant_->topic(dds::kTopicWearableMotion,
-                                           fdds::TypeSupport(new msg::WearableMotionPubSubType())),
+                                           fdds::TypeSupport(new StrictWearableMotionType())),
                        "wearable_reader", listener_.get());
   participant_->reader(
-      participant_->topic(dds::kTopicNodeStatus, fdds::TypeSupport(new msg::NodeStatusPubSubType())),
+      participant_->topic(dds::kTopicNodeStatus, fdds::TypeSupport(new StrictNodeStatusType())),
       "status_reader", listener_.get());
   rule_writer_ = participant_->writer(
       participant_->topic(dds::kTopicAlarmRules, fdds::TypeSupport(new msg::AlarmRulePubSubType())),
       "alarm_writer");
-  event_writer_ = participant_->writer(
-      participant_->topic(dds::kTopicAlarmEvents,
-                          fdds::TypeSupport(new msg::AlarmEventPubSubType())),
-      "alarm_writer");
+  event_writer_ =
+      participant_->writer(participant_->topic(dds::kTopicAlarmEvents,
+                                               fdds::TypeSupport(new msg::AlarmEventPubSubType())),
+                           "alarm_writer");
   ack_writer_ = participant_->writer(
       participant_->topic(dds::kTopicShoreAck, fdds::TypeSupport(new msg::ShoreAckPubSubType())),
       "ack_writer");
 }
 
-void ShoreDds::publish_ack(const std::string& boat_id, std::uint64_t boot_id,
+bool ShoreDds::publish_ack(const std::string& boat_id, std::uint64_t boot_id,
                            std::uint64_t acked_seq) {
   msg::ShoreAck m;
   m.boat_id(boat_id);
@@ -202,7 +121,29 @@ void ShoreDds::publish_ack(const std::string& boat_id, std::uint64_t boot_id,
   m.acked_seq(acked_seq);
   m.t_utc_ns(utc_now_ns());
   std::lock_guard lock(write_mutex_);
-  ack_writer_->write(&m);
+  const auto now = std::chrono::steady_clock::now();
+  const auto key = std::make_pair(boat_id, boot_id);
+  if (!ack_instances_.count(key)) {
+    // Make room first: the least recently written receipt instance goes (its run is long
+    // delivered or its boat gone; a receipt asked for again is registered anew).
+    while (ack_instances_.size() >= kMaxAckInstances) {
+      auto oldest = ack_instances_.begin();
+      for (auto it = ack_instances_.begin(); it != ack_instances_.end(); ++it)
+        if (it->second < oldest->second) oldest = it;
+      msg::ShoreAck old;
+      old.boat_id(oldest->first.first);
+      old.boot_id(oldest->first.second);
+      (void)ack_writer_->unregister_instance(&old, ack_writer_->lookup_instance(&old));
+      ack_instances_.erase(oldest);
+    }
+  }
+  ack_instances_[key] = now;
+  return ack_writer_->write(&m);
+}
+
+std::size_t ShoreDds::ack_instances() const {
+  std::lock_guard lock(write_mutex_);
+  return ack_instances_.size();
 }
 
 // The participant (and its readers) go first, so no callback runs on a dead listener.

@@ -1,19 +1,23 @@
 #pragma once
 /// \file
 /// The shore's DDS role: subscribes to the whole fleet (attitude, node status) and hands every
-/// sample to the callbacks, on Fast DDS's listener thread (callbacks must be quick and must not
-/// throw: they update the fleet model, the live hub and the store queue); publishes the alarm
-/// rules and events to the boats (reliable, transient local: a boat that joins late gets them).
+/// sample that passes the contract's checks (ingest.hpp) to the callbacks, on Fast DDS's listener
+/// thread (callbacks must be quick and must not throw: they update the fleet model, the live hub
+/// and the store queue); publishes the alarm rules and events to the boats (reliable, transient
+/// local: a boat that joins late gets them).
 
+#include <chrono>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
-#include <vector>
 #include <string>
+#include <vector>
 
 #include "dds_participant.hpp"
-#include "telltale/fusion/alarm_engine.hpp"
 #include "fleet.hpp"
+#include "ingest.hpp"
+#include "telltale/fusion/alarm_engine.hpp"
 #include "writer_check.hpp"
 
 namespace telltale::shore {
@@ -30,6 +34,9 @@ struct FleetCallbacks {
   std::function<void(const std::string& boat_id)> on_deadline_missed;
 };
 
+/// Receipt instances the shore's ack writer keeps registered at most (its profile allows 2000).
+inline constexpr std::size_t kMaxAckInstances = 1000;
+
 class ShoreDds {
  public:
   /// Creates the participant, readers and writers (throws dds::DdsError).
@@ -43,21 +50,32 @@ class ShoreDds {
   /// Publishes one event's current phase. Thread-safe.
   void publish_event(const AlarmEvent& event);
   /// Tells a boat that every sample of run `boot_id` up to `acked_seq` is stored. Thread-safe.
-  void publish_ack(const std::string& boat_id, std::uint64_t boot_id, std::uint64_t acked_seq);
+  /// False when the writer refused it (it never should: see kMaxAckInstances).
+  bool publish_ack(const std::string& boat_id, std::uint64_t boot_id, std::uint64_t acked_seq);
+  /// Receipt instances registered now (at most kMaxAckInstances).
+  [[nodiscard]] std::size_t ack_instances() const;
   [[nodiscard]] int domain() const { return participant_->domain(); }
   [[nodiscard]] bool secured() const { return participant_->secured(); }
+  /// What the door (ingest.hpp) let in and kept out.
+  [[nodiscard]] const IngestCounters& ingest_counters() const { return ingest_->counters(); }
 
  private:
   class Listener;
   FleetCallbacks callbacks_;
+  std::unique_ptr<Ingest> ingest_;
   std::unique_ptr<WriterCheck> writer_check_;  ///< secured mode only
   std::unique_ptr<Listener> listener_;
   std::unique_ptr<dds::Participant> participant_;
   eprosima::fastdds::dds::DataWriter* rule_writer_ = nullptr;
   eprosima::fastdds::dds::DataWriter* event_writer_ = nullptr;
   eprosima::fastdds::dds::DataWriter* ack_writer_ = nullptr;
-  std::mutex write_mutex_;
+  mutable std::mutex write_mutex_;
   std::vector<std::string> published_rule_ids_;
+  /// Receipt instances the ack writer holds, (boat, run) -> last written: at most
+  /// kMaxAckInstances, the least recently written unregistered first (the writer's resource limit
+  /// is 2000 instances; without this the 2001st run never got a receipt).
+  std::map<std::pair<std::string, std::uint64_t>, std::chrono::steady_clock::time_point>
+      ack_instances_;
   std::uint64_t rule_revision_ = 0;
 };
 

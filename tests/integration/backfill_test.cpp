@@ -89,6 +89,31 @@ TEST_F(BackfillTest, ReadOnlyLogDirectoryRefusesToStart) {
   EXPECT_EQ(boat.stop(SIGINT, 5s), 1) << boat.output();
 }
 
+// Given a boat whose log disk is full (an 8 KB tmpfs), the node's status says so first, where the
+// dashboard and the boats API show it (it said "ok" while the log lost every record).
+TEST_F(BackfillTest, FullLogDiskIsReportedInTheNodeStatus) {
+  if (::geteuid() != 0 || !std::filesystem::exists("/usr/bin/unshare"))
+    GTEST_SKIP() << "needs root and unshare for a private tmpfs";
+  const std::string full = dir_ + "/fulllog";
+  std::filesystem::create_directories(full);
+  Process boat({"/usr/bin/unshare", "-m", "--propagation", "private", "sh", "-c",
+                "mount -t tmpfs -o size=8k tmpfs '" + full + "' && exec '" + bin_dir() +
+                    "/boat_node' --domain " + std::to_string(domain_) +
+                    " --boat-id fl1 --log-dir '" + full + "'"});
+  ASSERT_TRUE(boat.wait_for_line("boat_node ready: ", 20s)) << boat.output();
+  std::string text;
+  EXPECT_TRUE(eventually(
+      [&] {
+        const auto boats = boats_by_id();
+        if (!boats.count("fl1") || !boats.at("fl1").contains("status")) return false;
+        text = boats.at("fl1")["status"]["health_text"].get<std::string>();
+        return text.rfind("SESSION LOG FAILING (No space left on device)", 0) == 0;
+      },
+      20s))
+      << text;
+  boat.stop(SIGINT, 15s);
+}
+
 // Given a boat sailing, when its shore is replaced by one on an empty database (a fresh or
 // replaced disk), then the boat follows the new shore's lower receipt: it sends the run from its
 // start, in order, once (not the whole tail every 5 s), and the new database holds all of it.

@@ -115,6 +115,11 @@ std::string make_temp_dir() {
   return tmpl;
 }
 
-std::string bin_dir() { return TELLTALE_BIN_DIR; }
+// TELLTALE_TEST_BIN_DIR runs the tests against other binaries (an older build, to see a test
+// fail before its fix).
+std::string bin_dir() {
+  const char* other = std::getenv("TELLTALE_TEST_BIN_DIR");
+  return other && *other ? other : TELLTALE_BIN_DIR;
+}
 
 }  // namespace telltale::testing

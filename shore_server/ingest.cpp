@@ -1,0 +1,354 @@
+#include "ingest.hpp"
+
+#include <fastcdr/Cdr.h>
+#include <fastcdr/FastBuffer.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "shutdown.hpp"
+
+namespace telltale::shore {
+
+namespace {
+
+constexpr std::array<const char*, kRejectKinds> kRejectNames = {"none", "id", "time", "value",
+                                                                "text"};
+constexpr std::array<const char*, kTopics> kTopicNames = {"attitude", "backfill", "status",
+                                                          "wearable"};
+
+bool finite_in(double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; }
+/// NaN ("no value") or within [lo, hi].
+bool nan_or_in(double v, double lo, double hi) { return std::isnan(v) || (v >= lo && v <= hi); }
+
+const char* kind_name(msg::NodeKind kind) {
+  switch (kind) {
+    case msg::NODE_KIND_BOAT:
+      return "boat";
+    case msg::NODE_KIND_WEARABLE:
+      return "wearable";
+    case msg::NODE_KIND_SHORE:
+      return "shore";
+  }
+  return "unknown";
+}
+
+const char* gait_name(msg::Gait g) {
+  switch (g) {
+    case msg::GAIT_STILL:
+      return "still";
+    case msg::GAIT_SLOW_WALK:
+      return "slow_walk";
+    case msg::GAIT_WALK:
+      return "walk";
+    case msg::GAIT_FAST_WALK:
+      return "fast_walk";
+    case msg::GAIT_JOG:
+      return "jog";
+    case msg::GAIT_RUN:
+      return "run";
+    case msg::GAIT_UNKNOWN:
+      break;
+  }
+  return "unknown";
+}
+
+const char* pose_name(msg::Pose p) {
+  switch (p) {
+    case msg::POSE_HAND_HELD:
+      return "hand_held";
+    case msg::POSE_PHONE_CALL:
+      return "phone_call";
+    case msg::POSE_POCKET:
+      return "pocket";
+    case msg::POSE_ARM_SWING:
+      return "arm_swing";
+    case msg::POSE_FOOT:
+      return "foot";
+    case msg::POSE_UNKNOWN:
+      break;
+  }
+  return "unknown";
+}
+
+/// The first member of every keyed type the shore reads is its string id: after the 4-byte
+/// encapsulation header comes its CDR length (terminating NUL included). True when that length
+/// is the length the bounded string kept plus one, i.e. nothing was cut and no NUL was inside.
+bool key_string_intact(const eprosima::fastrtps::rtps::SerializedPayload_t* payload,
+                       std::size_t kept_chars) {
+  if (payload == nullptr || payload->data == nullptr || payload->length < 8) return false;
+  const auto* d = payload->data;
+  const bool little = (d[1] & 1) != 0;  // CDR_LE 0x0001, PL_CDR_LE 0x0003
+  std::uint32_t n = 0;
+  for (int i = 0; i < 4; ++i) {
+    const std::uint32_t byte = d[4 + (little ? 3 - i : i)];
+    n = (n << 8) | byte;
+  }
+  return n >= 1 && n - 1 == kept_chars;
+}
+
+}  // namespace
+
+const char* reject_name(Reject r) { return kRejectNames[static_cast<std::size_t>(r)]; }
+const char* topic_name(Topic t) { return kTopicNames[static_cast<std::size_t>(t)]; }
+
+bool valid_utf8(std::string_view text) {
+  std::size_t i = 0;
+  const std::size_t n = text.size();
+  while (i < n) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c < 0x80) {
+      ++i;
+      continue;
+    }
+    std::size_t len = 0;
+    std::uint32_t cp = 0;
+    if (c >= 0xC2 && c <= 0xDF) {
+      len = 2;
+      cp = c & 0x1F;
+    } else if (c >= 0xE0 && c <= 0xEF) {
+      len = 3;
+      cp = c & 0x0F;
+    } else if (c >= 0xF0 && c <= 0xF4) {
+      len = 4;
+      cp = c & 0x07;
+    } else {
+      return false;  // continuation byte first, overlong 0xC0/0xC1, or 0xF5..0xFF
+    }
+    if (n - i < len) return false;
+    for (std::size_t k = 1; k < len; ++k) {
+      const auto cc = static_cast<unsigned char>(text[i + k]);
+      if ((cc & 0xC0) != 0x80) return false;
+      cp = (cp << 6) | (cc & 0x3F);
+    }
+    if ((len == 3 && cp < 0x800) || (len == 4 && cp < 0x10000) || cp > 0x10FFFF ||
+        (cp >= 0xD800 && cp <= 0xDFFF))
+      return false;
+    i += len;
+  }
+  return true;
+}
+
+bool clean_text(std::string_view text) {
+  if (!valid_utf8(text)) return false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c < 0x20 || c == 0x7F) return false;
+    // C1 controls U+0080..U+009F are 0xC2 0x80..0x9F in UTF-8.
+    if (c == 0xC2 && i + 1 < text.size() && static_cast<unsigned char>(text[i + 1]) <= 0x9F)
+      return false;
+  }
+  return true;
+}
+
+bool contract_id(std::string_view id) {
+  if (id.empty() || id.size() > 32) return false;
+  for (char c : id) {
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                    c == '_' || c == '-';
+    if (!ok) return false;
+  }
+  return true;
+}
+
+bool contract_time(std::uint64_t t_utc_ns, std::uint64_t shore_now_ns) {
+  return t_utc_ns >= kEarliestSampleNs && t_utc_ns <= shore_now_ns + kMaxAheadNs;
+}
+
+Reject check(const AttitudeSample& s, std::uint64_t shore_now_ns) {
+  if (!contract_id(s.boat_id)) return Reject::kId;
+  if (!contract_time(s.t_utc_ns, shore_now_ns)) return Reject::kTime;
+  // Heel and pitch are the sample: without them it is nothing to store (the schema says NOT
+  // NULL), so a NaN is refused and counted here rather than dropped by SQLite and acknowledged.
+  if (!finite_in(s.heel_deg, -180.0, 180.0) || !finite_in(s.pitch_deg, -90.0, 90.0) ||
+      !nan_or_in(s.heading_deg, 0.0, 360.0) || !std::isfinite(s.heel_rate_deg_s) ||
+      !std::isfinite(s.pitch_rate_deg_s) || !std::isfinite(s.yaw_rate_deg_s) ||
+      !std::isfinite(s.accel_weight) || !std::isfinite(s.quality))
+    return Reject::kValue;
+  return Reject::kNone;
+}
+
+Reject check(const WearableSample& s, std::uint64_t shore_now_ns) {
+  if (!contract_id(s.athlete_id)) return Reject::kId;
+  if (!contract_time(s.t_utc_ns, shore_now_ns)) return Reject::kTime;
+  // NaN is "no value" (no position before the first step); infinities are broken.
+  for (double v : {s.cadence_spm, s.x_m, s.y_m, s.distance_m})
+    if (std::isinf(v)) return Reject::kValue;
+  if (!nan_or_in(s.heading_deg, 0.0, 360.0)) return Reject::kValue;
+  return Reject::kNone;
+}
+
+Reject check(const std::string& node_id, const NodeStatusInfo& s, std::uint64_t t_utc_ns,
+             std::uint64_t shore_now_ns) {
+  if (!contract_id(node_id)) return Reject::kId;
+  if (!contract_time(t_utc_ns, shore_now_ns)) return Reject::kTime;
+  if (!std::isfinite(s.uptime_s) || s.uptime_s < 0.0) return Reject::kValue;
+  if (!clean_text(s.software_version) || !clean_text(s.health_text) || !clean_text(s.group))
+    return Reject::kText;
+  return Reject::kNone;
+}
+
+void IngestCounters::count(Topic topic, Reject reason) {
+  const auto t = static_cast<std::size_t>(topic);
+  if (reason == Reject::kNone) {
+    accepted_[t].fetch_add(1, std::memory_order_relaxed);
+    return;
+  }
+  rejected_[t][static_cast<std::size_t>(reason)].fetch_add(1, std::memory_order_relaxed);
+  std::lock_guard lock(last_mutex_);
+  last_rejected_ = std::string(topic_name(topic)) + ": " + reject_name(reason);
+}
+
+std::uint64_t IngestCounters::accepted(Topic topic) const {
+  return accepted_[static_cast<std::size_t>(topic)].load();
+}
+
+std::uint64_t IngestCounters::rejected(Topic topic, Reject reason) const {
+  return rejected_[static_cast<std::size_t>(topic)][static_cast<std::size_t>(reason)].load();
+}
+
+std::uint64_t IngestCounters::rejected_total() const {
+  std::uint64_t n = 0;
+  for (const auto& per_topic : rejected_)
+    for (const auto& c : per_topic) n += c.load();
+  return n;
+}
+
+nlohmann::json IngestCounters::to_json() const {
+  nlohmann::json accepted = nlohmann::json::object();
+  nlohmann::json rejected = nlohmann::json::object();
+  for (std::size_t t = 0; t < kTopics; ++t) {
+    accepted[kTopicNames[t]] = accepted_[t].load();
+    nlohmann::json per = nlohmann::json::object();
+    for (std::size_t r = 1; r < kRejectKinds; ++r) per[kRejectNames[r]] = rejected_[t][r].load();
+    rejected[kTopicNames[t]] = std::move(per);
+  }
+  nlohmann::json j = {{"accepted", std::move(accepted)},
+                      {"rejected", std::move(rejected)},
+                      {"rejected_total", rejected_total()}};
+  std::lock_guard lock(last_mutex_);
+  j["last_rejected"] =
+      last_rejected_.empty() ? nlohmann::json(nullptr) : nlohmann::json(last_rejected_);
+  return j;
+}
+
+AttitudeSample from_wire(const msg::BoatAttitude& m) {
+  AttitudeSample s;
+  s.boat_id = m.boat_id().to_string();
+  s.seq = m.seq();
+  s.t_utc_ns = m.t_utc_ns();
+  s.heel_deg = m.heel_deg();
+  s.pitch_deg = m.pitch_deg();
+  s.heading_deg = m.heading_deg();
+  s.heel_rate_deg_s = m.heel_rate_deg_s();
+  s.pitch_rate_deg_s = m.pitch_rate_deg_s();
+  s.yaw_rate_deg_s = m.yaw_rate_deg_s();
+  s.accel_weight = m.accel_weight();
+  s.quality = m.quality();
+  s.leds[0] = m.leds().left_leds();
+  s.leds[1] = m.leds().right_leds();
+  s.leds[2] = m.leds().up_leds();
+  s.leds[3] = m.leds().down_leds();
+  s.led_count = m.leds().led_count();
+  s.boot_id = m.boot_id();
+  return s;
+}
+
+WearableSample from_wire(const msg::WearableMotion& m) {
+  WearableSample w;
+  w.athlete_id = m.athlete_id().to_string();
+  w.seq = m.seq();
+  w.t_utc_ns = m.t_utc_ns();
+  w.steps = m.steps();
+  w.cadence_spm = m.cadence_spm();
+  w.gait = gait_name(m.gait());
+  w.pose = pose_name(m.pose());
+  w.x_m = m.x_m();
+  w.y_m = m.y_m();
+  w.heading_deg = m.heading_deg();
+  w.distance_m = m.distance_m();
+  return w;
+}
+
+NodeStatusInfo from_wire(const msg::NodeStatus& m) {
+  NodeStatusInfo s;
+  s.kind = kind_name(m.kind());
+  s.software_version = m.software_version().to_string();
+  s.uptime_s = m.uptime_s();
+  s.sensor_health = m.sensor_health();
+  s.health_text = m.health_text().to_string();
+  s.samples_published = m.samples_published();
+  s.group = m.group().to_string();
+  return s;
+}
+
+Ingest::Ingest(IngestSinks sinks, std::function<std::uint64_t()> clock)
+    : sinks_(std::move(sinks)), clock_(std::move(clock)) {}
+
+std::uint64_t Ingest::now() const { return clock_ ? clock_() : utc_now_ns(); }
+
+Reject Ingest::attitude(const msg::BoatAttitude& m, bool backfill) {
+  const Topic topic = backfill ? Topic::kBackfill : Topic::kAttitude;
+  const AttitudeSample s = from_wire(m);
+  const Reject r = check(s, now());
+  counters_.count(topic, r);
+  if (r != Reject::kNone) return r;
+  const auto& sink = backfill ? sinks_.on_backfill : sinks_.on_attitude;
+  if (sink) sink(s);
+  return r;
+}
+
+Reject Ingest::status(const msg::NodeStatus& m) {
+  const std::string id = m.node_id().to_string();
+  const NodeStatusInfo s = from_wire(m);
+  const Reject r = check(id, s, m.t_utc_ns(), now());
+  counters_.count(Topic::kStatus, r);
+  if (r == Reject::kNone && sinks_.on_status) sinks_.on_status(id, s);
+  return r;
+}
+
+Reject Ingest::wearable(const msg::WearableMotion& m) {
+  const WearableSample w = from_wire(m);
+  const Reject r = check(w, now());
+  counters_.count(Topic::kWearable, r);
+  if (r == Reject::kNone && sinks_.on_wearable) sinks_.on_wearable(w);
+  return r;
+}
+
+bool StrictBoatAttitudeType::deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload,
+                                         void* data) {
+  try {
+    if (!msg::BoatAttitudePubSubType::deserialize(payload, data)) return false;
+  } catch (...) {
+    return false;  // any Fast CDR exception: a malformed payload, not a sample
+  }
+  auto* m = static_cast<msg::BoatAttitude*>(data);
+  if (!key_string_intact(payload, m->boat_id().size())) m->boat_id("");
+  return true;
+}
+
+bool StrictNodeStatusType::deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload,
+                                       void* data) {
+  try {
+    if (!msg::NodeStatusPubSubType::deserialize(payload, data)) return false;
+  } catch (...) {
+    return false;  // any Fast CDR exception: a malformed payload, not a sample
+  }
+  auto* m = static_cast<msg::NodeStatus*>(data);
+  if (!key_string_intact(payload, m->node_id().size())) m->node_id("");
+  return true;
+}
+
+bool StrictWearableMotionType::deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload,
+                                           void* data) {
+  try {
+    if (!msg::WearableMotionPubSubType::deserialize(payload, data)) return false;
+  } catch (...) {
+    return false;  // any Fast CDR exception: a malformed payload, not a sample
+  }
+  auto* m = static_cast<msg::WearableMotion*>(data);
+  if (!key_string_intact(payload, m->athlete_id().size())) m->athlete_id("");
+  return true;
+}
+
+}  // namespace telltale::shore
