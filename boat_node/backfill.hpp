@@ -73,8 +73,8 @@ class Backfiller {
   std::atomic<std::uint64_t> acked_{0};
   std::atomic<std::uint64_t> resent_{0};
   std::atomic<std::uint64_t> send_failures_{0};
-  std::atomic<std::int64_t> last_ack_ns_{0};  ///< steady clock of the latest receipt
-  std::atomic<std::int64_t> progress_ns_{0};  ///< steady clock of the latest move of acked_
+  std::atomic<std::int64_t> last_ack_ns_{0};       ///< steady clock of the latest receipt
+  std::atomic<std::int64_t> progress_ns_{0};       ///< steady clock of the latest move of acked_
   std::atomic<std::int64_t> followed_down_ns_{0};  ///< steady clock of the latest lower receipt
   std::atomic<bool> shore_seen_{false};
   std::atomic<bool> draining_{false};

@@ -94,7 +94,7 @@ class SessionLog {
   int fd_ = -1;
   std::filesystem::path current_;
   std::uint64_t file_first_seq_ = 0;
-  std::uint64_t in_file_ = 0;  ///< whole records on disk in the current file
+  std::uint64_t in_file_ = 0;           ///< whole records on disk in the current file
   std::vector<unsigned char> pending_;  ///< encoded records not on disk yet, contiguous seqs
   std::uint64_t pending_first_seq_ = 0;
   std::uint64_t dropped_ = 0;
