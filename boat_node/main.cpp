@@ -390,8 +390,8 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       const auto log_health = log.health();
       std::string text;
       if (log_health.pending_records > 0 || log_health.dropped_records > 0) {
-        text = "SESSION LOG FAILING (" + log_health.last_error + "): " +
-               std::to_string(log_health.pending_records) + " held in memory";
+        text = "SESSION LOG FAILING (" + log_health.last_error +
+               "): " + std::to_string(log_health.pending_records) + " held in memory";
         if (log_health.dropped_records > 0)
           text += ", " + std::to_string(log_health.dropped_records) + " not logged";
         text += "; ";
