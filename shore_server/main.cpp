@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <map>
 #include <mutex>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -147,7 +148,7 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
   alarms.start({[&](const std::vector<AlarmRule>& rules) { dds.publish_rules(rules); },
                 [&](const AlarmEvent& e) { dds.publish_event(e); }});
 
-  HttpApi api(o.http, {fleet, hub, tokens, store, alarms});
+  HttpApi api(o.http, {fleet, hub, tokens, store, alarms, &dds.ingest_counters()});
   const int port = api.bind();
   std::thread http_thread([&] { api.serve(); });
   std::printf("shore_server ready: http://%s:%d/ domain=%d db=%s dds_security=%s\n",
@@ -172,6 +173,18 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
       if (!repeat && !added && it->second == a.acked_seq) continue;
       it->second = a.acked_seq;
       dds.publish_ack(a.boat_id, a.boot_id, a.acked_seq);
+    }
+    if (repeat) {
+      // Runs the store no longer tracks need no receipt: forget them, so this map is bounded by
+      // the store's receipts, not by every run seen since start.
+      std::set<std::pair<std::string, std::uint64_t>> live_runs;
+      for (const auto& a : acks) live_runs.emplace(a.boat_id, a.boot_id);
+      std::erase_if(receipt_sent, [&](const auto& e) { return !live_runs.count(e.first); });
+    }
+    if (tick % 300 == 0) {  // every minute: boats and athletes silent for long leave the model
+      for (const auto& id :
+           fleet.forget(std::chrono::steady_clock::now(), std::chrono::seconds(o.forget_after_s)))
+        hub.forget(id);
     }
   }
   hub.close();
