@@ -11,7 +11,7 @@ build="$root/build-fuzz"
 seconds=${1:-45}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(fuzz_csv fuzz_nmea fuzz_witmotion fuzz_session_log fuzz_rest)
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_csv fuzz_nmea fuzz_witmotion fuzz_session_log fuzz_rest fuzz_ingest)
 "$root/deploy/bootstrap.sh"
 
 start=$(date +%s)
