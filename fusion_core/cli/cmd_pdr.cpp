@@ -27,7 +27,8 @@ void run_pdr(const PdrOptions& o) {
   if (o.mount != "phone" && o.mount != "body" && o.mount != "foot")
     throw UsageError("unknown mount '" + o.mount + "' (phone, body, foot)");
   bool has_gyro = false, has_mag = false;
-  const auto records = read_imu_csv(o.in, false, &has_gyro, &has_mag);
+  std::size_t repeated = 0;
+  const auto records = read_imu_csv(o.in, false, &has_gyro, &has_mag, &repeated);
   fusion::PdrParams params;
   params.height_m = o.height_m;
   params.step_scale.fill(o.step_scale);
@@ -56,10 +57,10 @@ void run_pdr(const PdrOptions& o) {
       "{\"samples\": %zu, \"steps\": %zu, \"distance_m\": %.3f, \"end_x_m\": %.3f, "
       "\"end_y_m\": %.3f, \"heading_deg\": %.2f, \"pose\": %d, \"cadence_spm\": %.1f, "
       "\"pose_switches\": %u, \"pose_changes\": %u, \"replaced_headings\": %u, \"gyro\": %s, "
-      "\"mag\": %s, \"ns_per_sample\": %.1f}\n",
+      "\"mag\": %s, \"repeated_stamps\": %zu, \"ns_per_sample\": %.1f}\n",
       records.size(), f.steps, f.distance_m, f.x_m, f.y_m, f.heading_deg, static_cast<int>(f.pose),
       f.cadence_spm, d.switches, d.pose_changes, d.replaced_headings, has_gyro ? "true" : "false",
-      has_mag ? "true" : "false",
+      has_mag ? "true" : "false", repeated,
       static_cast<double>(spent.count()) / static_cast<double>(records.size()));
 }
 

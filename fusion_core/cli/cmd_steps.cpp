@@ -23,11 +23,17 @@ fusion::StepMount parse_mount(const std::string& m) {
 
 void run_steps(const StepsOptions& o) {
   const auto mount = parse_mount(o.mount);
-  const std::string method =
-      o.method.empty() ? std::string(fusion::default_step_detector(mount)) : o.method;
+  // A belt or lower-back sensor (--mount body) is rigid to the trunk, whose vertical oscillation
+  // gait-phase counts from the first step to the last; a phone (--mount phone) may be in a hand,
+  // a bag or a swinging arm, where peak-valley holds (Oxford traces).
+  const std::string method = !o.method.empty() ? o.method
+                             : o.mount == "body"
+                                 ? std::string("gait-phase")
+                                 : std::string(fusion::default_step_detector(mount));
   auto detector = fusion::make_step_detector(method, mount);
   if (!detector) throw UsageError("unknown step method '" + method + "'");
-  const auto records = read_imu_csv(o.in, false);
+  std::size_t repeated = 0;
+  const auto records = read_imu_csv(o.in, false, nullptr, nullptr, &repeated);
   std::string times;
   std::size_t steps = 0;
   fusion::StepEvent ev;
@@ -38,8 +44,12 @@ void run_steps(const StepsOptions& o) {
     times += buf;
     ++steps;
   }
-  std::printf("{\"steps\": %zu, \"step_times_s\": [%s], \"method\": \"%s\", \"mount\": \"%s\"}\n",
-              steps, times.c_str(), method.c_str(), o.mount.c_str());
+  // repeated_stamps: rows whose time stamp repeated the previous row's, merged into it (their
+  // mean: see read_imu_csv); samples: the records after merging.
+  std::printf(
+      "{\"steps\": %zu, \"step_times_s\": [%s], \"method\": \"%s\", \"mount\": \"%s\", "
+      "\"samples\": %zu, \"repeated_stamps\": %zu}\n",
+      steps, times.c_str(), method.c_str(), o.mount.c_str(), records.size(), repeated);
 }
 
 }  // namespace
@@ -53,8 +63,9 @@ void register_steps(CLI::App& app) {
   cmd->add_option("--in", opts->in,
                   "IMU CSV: t_s,ax_m_s2,ay_m_s2,az_m_s2[,gx_rad_s,gy_rad_s,gz_rad_s]")
       ->required();
-  cmd->add_option("--method", opts->method,
-                  "detector: " + names + " (default: adaptive for foot, peak-valley otherwise)");
+  cmd->add_option(
+      "--method", opts->method,
+      "detector: " + names + " (default: gait-phase for foot and body, peak-valley for phone)");
   cmd->add_option("--mount", opts->mount, "foot (counts that foot's steps) | body | phone")
       ->capture_default_str();
   cmd->callback([opts] { run_steps(*opts); });

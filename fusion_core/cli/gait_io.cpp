@@ -5,7 +5,7 @@
 namespace telltale::cli {
 
 std::vector<ImuRecord> read_imu_csv(const std::string& path, bool require_gyro, bool* has_gyro,
-                                    bool* has_mag) {
+                                    bool* has_mag, std::size_t* repeated_stamps) {
   io::CsvReader reader(path,
                        {{"t_s"},
                         {"ax_m_s2"},
@@ -17,7 +17,7 @@ std::vector<ImuRecord> read_imu_csv(const std::string& path, bool require_gyro, 
                         {"mx_uT", false, true},
                         {"my_uT", false, true},
                         {"mz_uT", false, true}},
-                       "t_s");
+                       "t_s", io::TimeOrder::kNonDecreasing);
   const bool gyro = reader.has_column("gx_rad_s") && reader.has_column("gy_rad_s") &&
                     reader.has_column("gz_rad_s");
   const bool mag =
@@ -26,6 +26,7 @@ std::vector<ImuRecord> read_imu_csv(const std::string& path, bool require_gyro, 
   if (has_mag) *has_mag = mag;
   std::vector<ImuRecord> out;
   std::vector<double> row;
+  std::size_t merged = 1;  // rows averaged into out.back()
   while (reader.next(row)) {
     ImuRecord r;
     r.imu.t_s = row[0];
@@ -33,8 +34,20 @@ std::vector<ImuRecord> read_imu_csv(const std::string& path, bool require_gyro, 
     r.imu.gyro_body_rad_s =
         gyro ? Eigen::Vector3d(row[4], row[5], row[6]) : Eigen::Vector3d::Constant(std::nan(""));
     if (mag) r.mag_uT = {row[7], row[8], row[9]};
+    if (!out.empty() && r.imu.t_s == out.back().imu.t_s) {
+      // A repeated stamp: running mean of the rows that share it (NaN stays NaN: missing).
+      ++merged;
+      const double k = 1.0 / static_cast<double>(merged);
+      auto& m = out.back();
+      m.imu.acc_body_m_s2 += k * (r.imu.acc_body_m_s2 - m.imu.acc_body_m_s2);
+      m.imu.gyro_body_rad_s += k * (r.imu.gyro_body_rad_s - m.imu.gyro_body_rad_s);
+      m.mag_uT += k * (r.mag_uT - m.mag_uT);
+      continue;
+    }
+    merged = 1;
     out.push_back(r);
   }
+  if (repeated_stamps) *repeated_stamps = reader.repeated_times();
   if (out.empty()) throw io::CsvError(path + ":2:0: no data rows");
   return out;
 }

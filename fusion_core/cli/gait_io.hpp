@@ -23,9 +23,17 @@ struct ImuRecord {
 
 /// Reads `t_s,ax_m_s2,ay_m_s2,az_m_s2` (required), `gx_rad_s,gy_rad_s,gz_rad_s` (required when
 /// `require_gyro`), `mx_uT,my_uT,mz_uT` (optional). Throws io::CsvError on bad input.
+///
+/// Repeated time stamps (real phones write them: the OS stamps a batch of sensor events with
+/// one delivery time) are accepted: the rows sharing a stamp are merged into one record, the
+/// mean of their values (the file says they were measured at the same instant; inventing times
+/// between them would be a guess, and averaging two readings of one instant only lowers their
+/// noise -- steps are below 4 Hz, far under any rate that repeats stamps). `repeated_stamps`
+/// receives how many rows were merged into the row before them. Time going backwards stays an
+/// error naming the file, line and column.
 [[nodiscard]] std::vector<ImuRecord> read_imu_csv(const std::string& path, bool require_gyro,
-                                                  bool* has_gyro = nullptr,
-                                                  bool* has_mag = nullptr);
+                                                  bool* has_gyro = nullptr, bool* has_mag = nullptr,
+                                                  std::size_t* repeated_stamps = nullptr);
 
 /// Writes the IMU CSV (t_s, gyro, acc, mag) and, if `truth_path` is not empty, the truth CSV:
 /// t_s,x_m,y_m,heading_deg,distance_m,gait,pose,switching,steps,foot_steps,step_hz,step_length_m

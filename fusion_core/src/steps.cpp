@@ -374,15 +374,141 @@ bool PeakValleyStepDetector::update(const ImuSample& s, StepEvent& event) {
 }
 
 // ---------------------------------------------------------------------------------------------
+GaitPhaseStepDetector::GaitPhaseStepDetector(Params params)
+    : params_(params), rate_lp_(params.rate_cutoff_hz), vertical_lp_(params.vertical_cutoff_hz) {}
+
+void GaitPhaseStepDetector::reset() { *this = GaitPhaseStepDetector(params_); }
+
+bool GaitPhaseStepDetector::update(const ImuSample& s, StepEvent& event) {
+  const double dt = gate(s, have_t_, last_t_s_, diag_);
+  if (dt < 0.0) return false;
+  if (params_.mount == StepMount::kFoot && s.gyro_body_rad_s.allFinite()) {
+    diag_.gyro_used = true;
+    return update_foot(s, dt, event);
+  }
+  // No gyro on a foot: the trunk rule on the foot's vertical force still sees one rise and fall
+  // per swing (lift, impact) -- a fallback, not the detector's purpose.
+  diag_.gyro_used = false;
+  return update_body(s, dt, event);
+}
+
+bool GaitPhaseStepDetector::emit(double t_s, StepEvent& event) {
+  event.t_s = t_s;
+  event.interval_s = have_step_ ? t_s - last_step_t_s_ : 0.0;
+  last_step_t_s_ = t_s;
+  have_step_ = true;
+  return true;
+}
+
+bool GaitPhaseStepDetector::update_foot(const ImuSample& s, double dt, StepEvent& event) {
+  // |w| whatever the mounting; smoothed at 5 Hz so the zero crossing of the medio-lateral rate
+  // between toe-off and swing (the other axes keep |w| up there) and the impact's ringing do
+  // not split a swing, while a stance of 0.1 s still shows.
+  const double w_raw = s.gyro_body_rad_s.norm();
+  const double w = rate_lp_.step(w_raw, dt);
+  const double acc = std::abs(s.acc_body_m_s2.norm() - kG);
+  if (!in_swing_) {
+    if (w <= params_.swing_enter_rad_s) return false;
+    in_swing_ = true;
+    swing_peak_rad_s_ = w;
+    swing_angle_rad_ = 0.0;
+    swing_acc_m_s2_ = 0.0;
+    landing_t_s_ = s.t_s;
+  }
+  swing_angle_rad_ += w * dt;
+  swing_peak_rad_s_ = std::max(swing_peak_rad_s_, w);
+  if (w >= params_.landing_fraction * swing_peak_rad_s_) landing_t_s_ = s.t_s;
+  // Stance: relative to this swing's own peak, because a brisk walker's stance still rolls at
+  // 1-2 rad/s (10-20 % of a 10 rad/s swing), while the slowest first step peaks near 2 rad/s.
+  const double stance =
+      std::max(params_.stance_abs_rad_s, params_.stance_fraction * swing_peak_rad_s_);
+  // The force counts only while the foot turns: a foot rolling over its toes (heel-off) turns
+  // at |f| = g, and the smoothed rate lags into the push-off that follows; a swing both turns
+  // and accelerates.
+  if (w_raw >= stance) swing_acc_m_s2_ = std::max(swing_acc_m_s2_, acc);
+  if (w >= stance) return false;
+  in_swing_ = false;
+  const bool turned = swing_angle_rad_ >= params_.min_swing_deg * M_PI / 180.0 &&
+                      swing_peak_rad_s_ >= params_.min_peak_rad_s;
+  if (!turned || swing_acc_m_s2_ < params_.min_acc_m_s2) {
+    ++diag_.rejected_amplitude;
+    return false;
+  }
+  // One foot steps once per gait cycle: a second swing sooner than `interval_fraction` of the
+  // recent cycle is the same step in two motions (heel-off then swing, or a landing that
+  // settles); the cycle is forgotten after a pause, so a new walk at any pace starts afresh.
+  const double since = landing_t_s_ - last_step_t_s_;
+  if (since > params_.pause_s) cycle_s_ = 0.0;
+  if (have_step_ &&
+      since < std::max(params_.min_step_interval_s, params_.interval_fraction * cycle_s_)) {
+    ++diag_.rejected_timing;
+    return false;
+  }
+  if (have_step_ && since <= params_.pause_s)
+    cycle_s_ = cycle_s_ > 0.0 ? cycle_s_ + 0.3 * (since - cycle_s_) : since;
+  return emit(landing_t_s_, event);
+}
+
+bool GaitPhaseStepDetector::update_body(const ImuSample& s, double dt, StepEvent& event) {
+  // Gravity in the sensor frame: the specific force averaged over ~1 s (several steps, whose
+  // accelerations average out); vertical acceleration = the force along it minus its size.
+  if (!have_gravity_) {
+    gravity_m_s2_ = s.acc_body_m_s2;
+    have_gravity_ = true;
+  }
+  const double k = dt > 0.0 ? dt / (params_.gravity_tau_s + dt) : 1.0;
+  gravity_m_s2_ += k * (s.acc_body_m_s2 - gravity_m_s2_);
+  const double g = gravity_m_s2_.norm();
+  if (!(g > 1e-6)) return false;
+  const double v = vertical_lp_.step(s.acc_body_m_s2.dot(gravity_m_s2_) / g - g, dt);
+
+  // The hysteresis follows the walk (a ripple between two steps is under a fifth of a step's
+  // swing) but not so closely that the closing step of a walk, whose trunk swings a third of
+  // the walk's as it stops, is taken for a ripple; after a pause only the floor applies.
+  if (s.t_s - last_step_t_s_ > params_.pause_s) amplitude_m_s2_ = 0.0;
+  const double h =
+      std::max(params_.hysteresis_abs_m_s2, params_.hysteresis_fraction * amplitude_m_s2_);
+  if (!rising_) {
+    valley_m_s2_ = std::min(valley_m_s2_, v);
+    if (v > valley_m_s2_ + h) {
+      rising_ = true;
+      peak_m_s2_ = v;
+      peak_t_s_ = s.t_s;
+    }
+    return false;
+  }
+  if (v > peak_m_s2_) {
+    peak_m_s2_ = v;
+    peak_t_s_ = s.t_s;
+  }
+  if (v >= peak_m_s2_ - h) return false;
+  // A rise and a fall of h each: one step, at its peak.
+  const double swing = peak_m_s2_ - valley_m_s2_;
+  rising_ = false;
+  valley_m_s2_ = v;
+  if (have_step_ && peak_t_s_ - last_step_t_s_ < params_.min_body_interval_s) {
+    ++diag_.rejected_timing;
+    return false;
+  }
+  amplitude_m_s2_ =
+      amplitude_m_s2_ > 0.0 ? amplitude_m_s2_ + 0.3 * (swing - amplitude_m_s2_) : swing;
+  return emit(peak_t_s_, event);
+}
+
+// ---------------------------------------------------------------------------------------------
 namespace {
-constexpr std::array<std::string_view, 4> kNames = {"adaptive", "peak", "fixed-threshold",
-                                                    "peak-valley"};
+constexpr std::array<std::string_view, 5> kNames = {"adaptive", "peak", "fixed-threshold",
+                                                    "peak-valley", "gait-phase"};
 }
 
 std::span<const std::string_view> step_detector_names() { return kNames; }
 
 std::string_view default_step_detector(StepMount mount) {
-  return mount == StepMount::kFoot ? "adaptive" : "peak-valley";
+  // Foot: gait phases count the first step from standing and the closing step that the adaptive
+  // thresholds miss (IPOL foot sensors). Body: peak-valley, which copes with a phone anywhere
+  // (hand, bag, swinging arm: Oxford traces); a sensor rigid to the trunk (belt, lower back)
+  // does better with gait-phase (see fusion_cli steps --mount body).
+  return mount == StepMount::kFoot ? "gait-phase" : "peak-valley";
 }
 
 std::unique_ptr<StepDetector> make_step_detector(std::string_view name, StepMount mount) {
@@ -426,6 +552,11 @@ std::unique_ptr<StepDetector> make_step_detector(std::string_view name, StepMoun
       p.min_swing_m_s2 = 2.0;
     }
     return std::make_unique<PeakValleyStepDetector>(p);
+  }
+  if (name == "gait-phase") {
+    GaitPhaseStepParams p;
+    p.mount = mount;
+    return std::make_unique<GaitPhaseStepDetector>(p);
   }
   return nullptr;
 }

@@ -81,7 +81,7 @@ TEST(StepRegistry, EveryNameBuildsForEveryMountAndUnknownIsNull) {
       EXPECT_EQ(d->name(), name);
     }
   EXPECT_EQ(make_step_detector("nope", StepMount::kFoot), nullptr);
-  EXPECT_EQ(default_step_detector(StepMount::kFoot), "adaptive");
+  EXPECT_EQ(default_step_detector(StepMount::kFoot), "gait-phase");
   EXPECT_EQ(default_step_detector(StepMount::kBody), "peak-valley");
 }
 
@@ -261,6 +261,100 @@ TEST(SwingStepDetector, IgnoresNaNAndTimeThatDoesNotAdvance) {
   }
   EXPECT_TRUE(d.swinging(9.99));
   EXPECT_NEAR(static_cast<double>(n), 17.0, 1.0);  // 18 turns, the first half swing from rest
+}
+
+// --- a real walk's first and last steps (issue 19) ---------------------------------------------
+// Given a person standing still, then walking, then stopping, as on the IPOL recordings: the
+// first step from standing is short and slow (the foot turns ~15 deg, not 45), and so is the
+// step that closes the walk beside the other foot. When a detector runs on it at 50, 100 and
+// 200 Hz, then every step is counted, the small ones included, and nothing while standing.
+// (The adaptive detector, whose thresholds come from the steps before, missed exactly these.)
+
+/// A foot-mounted IMU (medio-lateral axis y): `standing_s` still, then `normal` swings between
+/// a small first and a small last one, each followed by a 0.6 s stance; then standing again.
+/// A swing of duration T and rate amplitude A turns the foot -A T/pi then +A T/pi (toe-off,
+/// swing), while its specific force leaves g by +-B (push-off, swing, impact).
+std::vector<ImuSample> foot_walk(double rate_hz, int normal) {
+  struct Swing {
+    double t_s, a_rad_s, b_m_s2;
+  };
+  std::vector<Swing> swings;
+  double t = 2.0;
+  const auto add = [&](double dur, double a, double b) {
+    swings.push_back({dur, a, b});
+    t += dur + 0.6;
+  };
+  add(0.35, 2.0, 3.0);  // first step from standing: small
+  for (int i = 0; i < normal; ++i) add(0.4, 6.0, 8.0);
+  add(0.3, 2.0, 3.0);  // closing step
+  std::vector<ImuSample> out;
+  const double end = t + 2.0;
+  std::size_t k = 0;
+  double start = 2.0;
+  for (int n = 0; n * (1.0 / rate_hz) < end; ++n) {
+    const double ts = n / rate_hz;
+    ImuSample s{ts, Eigen::Vector3d::Zero(), Eigen::Vector3d(0.0, 0.0, kG)};
+    // A standing foot's noise: 0.01 rad/s, 0.03 m/s^2 (deterministic).
+    s.gyro_body_rad_s += Eigen::Vector3d(0.01 * std::sin(37.0 * ts), 0.01 * std::cos(53.0 * ts), 0);
+    s.acc_body_m_s2 += Eigen::Vector3d(0.03 * std::sin(41.0 * ts), 0.0, 0.03 * std::cos(29.0 * ts));
+    while (k < swings.size() && ts > start + swings[k].t_s + 0.6) {
+      start += swings[k].t_s + 0.6;
+      ++k;
+    }
+    if (k < swings.size() && ts >= start && ts < start + swings[k].t_s) {
+      const double tau = (ts - start) / swings[k].t_s;
+      s.gyro_body_rad_s.y() += -swings[k].a_rad_s * std::sin(2.0 * M_PI * tau);
+      s.acc_body_m_s2.x() += swings[k].b_m_s2 * std::sin(2.0 * M_PI * tau);
+      s.acc_body_m_s2.z() += swings[k].b_m_s2 * std::sin(M_PI * tau);
+    }
+    out.push_back(s);
+  }
+  return out;
+}
+
+/// A lower-back IMU: standing, then `normal` steps at 1.8 Hz whose vertical acceleration swings
+/// +-1.5 m/s^2 between a first and a last step of +-0.5 m/s^2 (starting and stopping), standing.
+std::vector<ImuSample> trunk_walk(double rate_hz, int normal) {
+  const int steps = normal + 2;
+  const double f_hz = 1.8, t0 = 2.0, t1 = t0 + steps / f_hz;
+  std::vector<ImuSample> out;
+  for (int n = 0; n * (1.0 / rate_hz) < t1 + 2.0; ++n) {
+    const double ts = n / rate_hz;
+    // Tilted 20 deg: the vertical is not a sensor axis.
+    const Eigen::Vector3d up(std::sin(0.35), 0.0, std::cos(0.35));
+    double a = 0.03 * std::sin(31.0 * ts);
+    if (ts >= t0 && ts < t1) {
+      const int i = static_cast<int>((ts - t0) * f_hz);
+      const double amp = (i == 0 || i == steps - 1) ? 0.5 : 1.5;
+      a += -amp * std::cos(2.0 * M_PI * f_hz * (ts - t0));
+    }
+    ImuSample s{ts, Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()),
+                (kG + a) * up + Eigen::Vector3d(0.0, 0.2 * a, 0.0)};
+    out.push_back(s);
+  }
+  return out;
+}
+
+std::size_t count_samples(StepDetector& d, const std::vector<ImuSample>& samples) {
+  d.reset();
+  std::size_t n = 0;
+  StepEvent ev;
+  for (const auto& s : samples) n += d.update(s, ev) ? 1u : 0u;
+  return n;
+}
+
+TEST(GaitPhaseStepDetector, FootCountsTheFirstStepFromStandingAndTheClosingStep) {
+  for (double rate : {50.0, 100.0, 200.0}) {
+    auto d = make_step_detector("gait-phase", StepMount::kFoot);
+    EXPECT_EQ(count_samples(*d, foot_walk(rate, 8)), 10u) << rate << " Hz";
+  }
+}
+
+TEST(GaitPhaseStepDetector, TrunkCountsTheFirstAndLastStepOfAWalk) {
+  for (double rate : {50.0, 100.0, 200.0}) {
+    auto d = make_step_detector("gait-phase", StepMount::kBody);
+    EXPECT_EQ(count_samples(*d, trunk_walk(rate, 10)), 12u) << rate << " Hz";
+  }
 }
 
 // --- real phone traces --------------------------------------------------------------------------

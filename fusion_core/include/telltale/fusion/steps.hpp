@@ -240,6 +240,101 @@ class PeakValleyStepDetector final : public StepDetector {
   int n_ = 0;
 };
 
+/// Gait phases, for real walks that start and stop (issue 19). The adaptive and peak-valley
+/// detectors need a few steps of history before their thresholds describe the walk, so on real
+/// recordings (stand, walk 10 m, turn, walk back, stop) they lost the first steps after standing
+/// and the last before stopping, 2-4 a walk. This detector needs no history: every rule is a
+/// property of one step, fixed by the physics of gait.
+///
+/// Foot (`StepMount::kFoot`, counts that foot's steps): a step is one swing of the foot between
+/// two stances. In stance the foot is flat on the ground and barely turns (|w| a few 0.01 rad/s
+/// standing, below ~0.25 x the swing's peak rate in a brisk walk, whose stance still rolls
+/// heel-to-toe); in swing it turns about the medio-lateral axis by 30-100 deg (toe-off, swing,
+/// heel strike) and its specific force leaves 1 g (push-off, swing, impact). So: a swing starts
+/// when the smoothed |w| exceeds `swing_enter_rad_s`, ends when it falls below the stance level
+/// (`stance_abs_rad_s`, or `stance_fraction` x this swing's peak), and is a step when it turned
+/// through `min_swing_deg`, peaked at `min_peak_rad_s` and |f| left g by `min_acc_m_s2` -- small
+/// enough for the short first step from standing and the closing step, well above a weight shift
+/// while standing (< 0.3 rad/s, < 0.5 m/s^2 on the IPOL recordings). The event time is the
+/// landing: the last moment the rate was above half the swing's peak (heel strike to foot flat).
+/// A foot cannot start a new step less than `min_step_interval_s` after its last one (the other
+/// foot swings in between: 2.5 cycles/s is beyond a sprint), nor sooner than
+/// `interval_fraction` of its recent cycle: that merges a landing that settles in two motions.
+/// The force excursion counts only while the foot turns (a heel rising over the toes turns at
+/// |f| = g).
+///
+/// Body (`StepMount::kBody`, every step): the trunk rises and falls once per step (the centre of
+/// mass vaults over the stance leg, then is caught by the next heel strike), so its vertical
+/// acceleration oscillates at the step frequency, 1-3 m/s^2 in a walk. Vertical = along the
+/// slowly low-passed specific force (gravity in the sensor frame, any mounting). Each rise of
+/// `hysteresis_abs_m_s2` (or `hysteresis_fraction` x the recent peak-to-valley) after a valley,
+/// followed by a fall of as much, is one step, reported at its peak (the loading after the heel
+/// strike). The first step after standing has no history to compare with, so only the physical
+/// floor applies (standing sway: < 0.1 m/s^2).
+///
+/// Both hold from 50 to 200 Hz: every filter and duration is in seconds, none in samples.
+struct GaitPhaseStepParams {
+  StepMount mount = StepMount::kFoot;
+  // Foot.
+  double rate_cutoff_hz = 5.0;       ///< low-pass on |w| (a swing lasts 0.3-0.5 s), Hz
+  double swing_enter_rad_s = 1.0;    ///< smoothed |w| that starts a swing, rad/s
+  double stance_abs_rad_s = 0.5;     ///< smoothed |w| below this is stance, rad/s
+  double stance_fraction = 0.25;     ///< ...or below this x the swing's peak |w|
+  double min_swing_deg = 11.5;       ///< smallest rotation of a step's swing, deg
+  double min_peak_rad_s = 1.0;       ///< smallest peak smoothed |w| of a swing, rad/s
+  double min_acc_m_s2 = 2.0;         ///< smallest ||f| - g| during a swing, m/s^2
+  double landing_fraction = 0.5;     ///< landing = last time |w| was above this x peak
+  double min_step_interval_s = 0.4;  ///< same foot, between step events, s
+  double interval_fraction = 0.6;    ///< ...and at least this x the recent gait cycle
+  // Body.
+  double gravity_tau_s = 1.0;         ///< time constant of the gravity direction, s
+  double vertical_cutoff_hz = 3.0;    ///< low-pass on the vertical acceleration, Hz
+  double hysteresis_abs_m_s2 = 0.4;   ///< smallest rise/fall that is a step, m/s^2
+  double hysteresis_fraction = 0.2;   ///< ...or this x the recent peak-to-valley
+  double min_body_interval_s = 0.25;  ///< between steps (4 steps/s), s
+  double pause_s = 2.0;  ///< longer without a step: amplitude and cycle memories are reset
+};
+class GaitPhaseStepDetector final : public StepDetector {
+ public:
+  using Params = GaitPhaseStepParams;
+  explicit GaitPhaseStepDetector(Params params = {});
+  /// `event.t_s` is the time the step happened (foot: landing; body: the trunk's loading peak),
+  /// up to ~0.3 s before the sample that confirmed it.
+  bool update(const ImuSample& sample, StepEvent& event) override;
+  void reset() override;
+  [[nodiscard]] std::string_view name() const override { return "gait-phase"; }
+  [[nodiscard]] const StepDiagnostics& diagnostics() const override { return diag_; }
+
+ private:
+  bool update_foot(const ImuSample& s, double dt, StepEvent& event);
+  bool update_body(const ImuSample& s, double dt, StepEvent& event);
+  bool emit(double t_s, StepEvent& event);
+
+  Params params_;
+  StepDiagnostics diag_;
+  LowPass2 rate_lp_;
+  LowPass2 vertical_lp_;
+  bool have_t_ = false;
+  double last_t_s_ = 0.0;
+  double last_step_t_s_ = -1e9;
+  bool have_step_ = false;
+  // Foot: the swing in progress.
+  bool in_swing_ = false;
+  double swing_peak_rad_s_ = 0.0;
+  double swing_angle_rad_ = 0.0;
+  double swing_acc_m_s2_ = 0.0;
+  double landing_t_s_ = 0.0;
+  double cycle_s_ = 0.0;  ///< recent interval between this foot's steps (0: none since a pause)
+  // Body: gravity in the sensor frame and the oscillation's extremes.
+  Eigen::Vector3d gravity_m_s2_ = Eigen::Vector3d::Zero();
+  bool have_gravity_ = false;
+  bool rising_ = false;  ///< after a valley, seeking the peak
+  double valley_m_s2_ = 1e9;
+  double peak_m_s2_ = -1e9;
+  double peak_t_s_ = 0.0;
+  double amplitude_m_s2_ = 0.0;  ///< recent peak-to-valley (0: none since the last pause)
+};
+
 /// Steps from a swinging arm (a phone carried in the hand, arm swinging): the arm turns forward
 /// and back once per stride, so its rate about the swing axis changes sign at each end of the
 /// swing, once per step. The body's acceleration magnitude is no help there: the hand's pendulum
@@ -298,9 +393,11 @@ class SwingStepDetector {
   bool have_t_ = false;
 };
 
-/// Names accepted by make_step_detector: "adaptive", "peak", "fixed-threshold", "peak-valley".
+/// Names accepted by make_step_detector: "adaptive", "peak", "fixed-threshold", "peak-valley",
+/// "gait-phase".
 [[nodiscard]] std::span<const std::string_view> step_detector_names();
-/// The default detector for a mount: foot -> "adaptive", body -> "peak-valley".
+/// The default detector for a mount: foot -> "gait-phase", body -> "peak-valley" (a phone: any
+/// pose; for a sensor rigid to the trunk, "gait-phase" counts better).
 [[nodiscard]] std::string_view default_step_detector(StepMount mount);
 /// Builds a detector with defaults suited to the mount; nullptr for an unknown name.
 [[nodiscard]] std::unique_ptr<StepDetector> make_step_detector(std::string_view name,
