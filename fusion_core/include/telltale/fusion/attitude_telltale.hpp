@@ -93,7 +93,9 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
     double tau_scale = 1.0;     ///< tau_acc_s / the time constant in use (>= 1, see update)
     double lp_elapsed_s = 0.0;  ///< time since the low-pass (re)started
     bool lp_running = false;    ///< false: still the growing mean of the fast start
-    Eigen::Vector3d up_i = Eigen::Vector3d::UnitZ();  ///< the vertical in I (unit)
+    Eigen::Vector3d up_i = Eigen::Vector3d::UnitZ();       ///< the vertical in I (unit)
+    Eigen::Vector3d bias_up_i = Eigen::Vector3d::UnitZ();  ///< up_i at the last motion update
+    double bias_elapsed_s = 0.0;                           ///< time since then
     Eigen::Vector3d gyro_rest_lp_rad_s = Eigen::Vector3d::Zero();
     Eigen::Vector3d acc_rest_lp_m_s2 = Eigen::Vector3d::Zero();
     double rest_time_s = 0.0;
