@@ -118,7 +118,9 @@ struct HttpApi::Impl {
     });
     server.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
       if (!res.body.empty()) return;
-      if (res.status == 404) {
+      if (res.status == 400 && GuardedServer::request_too_large()) {
+        json_error(res, 431, "request line and headers too large");
+      } else if (res.status == 404) {
         json_error(res, 404, "no such resource: " + req.path);
       } else if (res.status == 413) {
         json_error(res, 413, "request body too large");

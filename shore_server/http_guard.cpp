@@ -21,6 +21,7 @@ using std::chrono::milliseconds;
 struct Connection {
   int fd = -1;
   bool close_after = false;
+  int cut = 0;  ///< the current request: 1 too slow, 2 too large
 };
 thread_local Connection* tl_connection = nullptr;
 
@@ -52,7 +53,8 @@ void ip_and_port(const sockaddr_storage& addr, std::string& ip, int& port) {
 /// with the head and body deadlines and the head's size limits.
 class GuardedStream final : public httplib::Stream {
  public:
-  GuardedStream(int fd, GuardedServer& server) : fd_(fd), server_(server) {}
+  GuardedStream(int fd, GuardedServer& server, Connection& conn)
+      : fd_(fd), server_(server), conn_(conn) {}
 
   enum class Cut { kNone, kSlow, kLarge };
 
@@ -80,6 +82,7 @@ class GuardedStream final : public httplib::Stream {
     head_lines_ = 0;
     line_chars_ = 0;
     cut_ = Cut::kNone;
+    conn_.cut = 0;
     wrote_ = false;
     request_start_ = Clock::now();
   }
@@ -140,6 +143,7 @@ class GuardedStream final : public httplib::Stream {
       const auto now = Clock::now();
       if (now >= deadline) {
         cut_ = Cut::kSlow;
+        conn_.cut = 1;
         server_.count_cut_request();
         return false;
       }
@@ -168,12 +172,14 @@ class GuardedStream final : public httplib::Stream {
       const char c = buf_[pos_ + i++];
       if (++head_bytes_ > l.head_max_bytes) {
         cut_ = Cut::kLarge;
+        conn_.cut = 2;
         server_.count_cut_request();
         return i;
       }
       if (c == '\n') {
         if (++head_lines_ > l.head_max_lines) {
           cut_ = Cut::kLarge;
+          conn_.cut = 2;
           server_.count_cut_request();
           return i;
         }
@@ -191,6 +197,7 @@ class GuardedStream final : public httplib::Stream {
 
   int fd_;
   GuardedServer& server_;
+  Connection& conn_;
   char buf_[4096];
   std::size_t pos_ = 0;
   std::size_t len_ = 0;
@@ -227,6 +234,8 @@ void GuardedServer::close_after_response() {
   if (tl_connection) tl_connection->close_after = true;
 }
 
+bool GuardedServer::request_too_large() { return tl_connection && tl_connection->cut == 2; }
+
 void GuardedServer::cap_send_buffer(int bytes) {
   if (tl_connection)
     (void)::setsockopt(tl_connection->fd, SOL_SOCKET, SO_SNDBUF, &bytes, sizeof bytes);
@@ -236,14 +245,14 @@ bool GuardedServer::process_and_close_socket(socket_t sock) {
   busy_.fetch_add(1);
   Connection conn{sock, false};
   tl_connection = &conn;
-  GuardedStream strm(sock, *this);
+  GuardedStream strm(sock, *this, conn);
   bool ret = false;
   // Same keep-alive contract as the library's loop, with our idle limit and stream.
   std::size_t count = keep_alive_max_count_;
   while (count > 0 && strm.wait_request(svr_sock_)) {
     strm.begin_request();
     bool closed = false;
-    ret = process_request(strm, count == 1, closed, {});
+    ret = process_request(strm, count == 1, closed, [](httplib::Request&) {});
     if (strm.cut() != GuardedStream::Cut::kNone && !strm.wrote()) {
       if (strm.cut() == GuardedStream::Cut::kLarge) {
         write_error(sock, 431, "Request Header Fields Too Large",

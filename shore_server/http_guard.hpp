@@ -53,6 +53,9 @@ class GuardedServer : public httplib::Server {
   /// so a client that stops reading fills it within seconds and the write timeout drops it,
   /// instead of the kernel growing the buffer to megabytes while it holds a stream slot.
   static void cap_send_buffer(int bytes);
+  /// From the error handler: the request being answered had its line and headers cut for size
+  /// (the library then answers 400; this makes it the 431 it is).
+  [[nodiscard]] static bool request_too_large();
 
   /// Connections being served now (each holds a pool thread).
   [[nodiscard]] std::size_t busy() const { return busy_.load(); }
