@@ -1,6 +1,7 @@
 // The production filter on six real recordings with optical ground truth (BROAD, CC BY 4.0,
-// tests/data/broad/README.md): mean inclination RMSE <= 0.55 deg (best published ~0.53 deg on
-// these six, Madgwick's ~2.6 deg).
+// tests/data/broad/README.md): mean inclination RMSE <= 0.45 deg, every trial < 0.6 (issue 18:
+// 0.39 mean, worst 0.49; VQF 6D and the filter before issue 18 ~0.53 on these six, Madgwick's
+// ~2.6 deg). Seen failing: the filter before issue 18 gives a mean of ~0.54 here.
 #include <gtest/gtest.h>
 #include <zlib.h>
 
@@ -50,10 +51,10 @@ TEST(Broad, ProductionFilterMeanInclinationRmseWithinTarget) {
     const double e = inclination_rmse_deg(filter, data);
     RecordProperty(trial, std::to_string(e));
     std::printf("  %s: %.3f deg\n", trial, e);
-    EXPECT_LT(e, 1.2) << trial;
+    EXPECT_LT(e, 0.6) << trial;
     sum += e;
   }
-  EXPECT_LE(sum / 6.0, 0.55);
+  EXPECT_LE(sum / 6.0, 0.45);
 }
 
 }  // namespace
