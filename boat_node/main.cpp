@@ -447,7 +447,7 @@ int main(int argc, char** argv) {
       "Telltale boat node: IMU (+ heading sensors) -> fusion core -> DDS, with a session "
       "log and backfill"};
   app.set_config("--config", "", "read options from this file (INI/TOML: key = value)");
-  app.add_option("--domain", domain, "DDS domain id (default: $TELLTALE_DOMAIN)");
+  app.add_option("--domain", domain, "DDS domain id (default: $TELLTALE_DOMAIN, else 0)");
   app.add_option("--boat-id", o.boat_id, "fleet-unique boat id, 1-32 of [A-Za-z0-9_-]")->required();
   app.add_option("--group", o.group, "fleet group or class (alarm rules can target it)");
   app.add_option("--source", o.source, "IMU: sim | replay:FILE.csv | witmotion:DEVICE[@BAUD]")

@@ -272,7 +272,7 @@ int main(int argc, char** argv) {
   int domain = -1;
   CLI::App app{"Telltale wearable node: phone/foot IMU -> steps and dead reckoning -> DDS"};
   app.set_config("--config", "", "read options from this file (INI/TOML: key = value)");
-  app.add_option("--domain", domain, "DDS domain id (default: $TELLTALE_DOMAIN)");
+  app.add_option("--domain", domain, "DDS domain id (default: $TELLTALE_DOMAIN, else 0)");
   app.add_option("--athlete-id", o.athlete_id, "athlete id, 1-32 of [A-Za-z0-9_-]")->required();
   app.add_option("--source", o.source,
                  "sim | sim:SCENARIO | replay:FILE.csv | witmotion:DEVICE[@BAUD]")

@@ -5,6 +5,7 @@
 #include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <set>
@@ -81,6 +82,26 @@ class LiveQueue {
   bool closed_ = false;
 };
 
+/// Stops a worker thread (the `stop` callback makes it return) and joins it when the scope ends.
+class JoinOnExit {
+ public:
+  JoinOnExit(std::thread& thread, std::function<void()> stop)
+      : thread_(thread), stop_(std::move(stop)) {}
+  ~JoinOnExit() { finish(); }
+  /// Stops and joins now (once; later calls and the destructor do nothing).
+  void finish() {
+    if (!thread_.joinable()) return;
+    stop_();
+    thread_.join();
+  }
+  JoinOnExit(const JoinOnExit&) = delete;
+  JoinOnExit& operator=(const JoinOnExit&) = delete;
+
+ private:
+  std::thread& thread_;
+  std::function<void()> stop_;
+};
+
 void add_tokens(const Options& o, TokenStore& tokens) {
   tokens.add(o.coach_token, {Role::kCoach, ""});
   for (const auto& t : o.analyst_tokens) tokens.add(t, {Role::kAnalyst, ""});
@@ -114,7 +135,12 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
   // for the fleet model, the alarms or the dashboards. The recording is queued first; the live
   // path runs on a worker of its own and, if it ever falls 5 s behind, skips to the newest.
   LiveQueue live;
-  std::thread live_worker([&] {
+  // Joined on every way out of run(), the exceptions of the setup below included (a DDS domain
+  // that cannot be joined, a port in use): a joinable std::thread destroyed by the unwinding
+  // would end the process in std::terminate instead of the one error line main prints.
+  std::thread live_worker;
+  JoinOnExit live_join{live_worker, [&] { live.close(); }};
+  live_worker = std::thread([&] {
     std::vector<std::pair<AttitudeSample, std::uint64_t>> batch;
     while (live.take(batch)) {
       for (const auto& [s, arrival_utc] : batch) {
@@ -150,7 +176,12 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
 
   HttpApi api(o.http, {fleet, hub, tokens, store, alarms, &dds.ingest_counters()});
   const int port = api.bind();
-  std::thread http_thread([&] { api.serve(); });
+  std::thread http_thread;
+  JoinOnExit http_join{http_thread, [&] {
+                         hub.close();
+                         api.stop();
+                       }};
+  http_thread = std::thread([&] { api.serve(); });
   std::printf("shore_server ready: http://%s:%d/ domain=%d db=%s dds_security=%s\n",
               o.http.bind_address.c_str(), port, dds.domain(), o.store.path.c_str(),
               dds.secured() ? "on" : "off");
@@ -187,11 +218,8 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
         hub.forget(id);
     }
   }
-  hub.close();
-  api.stop();
-  http_thread.join();
-  live.close();
-  live_worker.join();
+  http_join.finish();
+  live_join.finish();
   std::printf("shore_server stopped: %llu samples committed\n",
               static_cast<unsigned long long>(store.committed()));
 }
@@ -204,7 +232,7 @@ int main(int argc, char** argv) {
   int domain = -1;
   CLI::App app{"Telltale shore server: fleet over DDS -> SQLite, REST API, live stream, dashboard"};
   app.set_config("--config", "", "read options from this file (INI/TOML: key = value)");
-  app.add_option("--domain", domain, "DDS domain id (default: $TELLTALE_DOMAIN)");
+  app.add_option("--domain", domain, "DDS domain id (default: $TELLTALE_DOMAIN, else 0)");
   app.add_option("--http-port", o.http.port, "HTTP port; 0 picks a free one and prints it")
       ->capture_default_str();
   app.add_option("--bind", o.http.bind_address, "HTTP listen address (localhost by default)")

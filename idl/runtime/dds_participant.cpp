@@ -1,10 +1,11 @@
 #include "dds_participant.hpp"
 
+#include <fastdds/rtps/common/Locator.h>
+#include <fastrtps/types/TypesBase.h>
+#include <fastrtps/utils/IPLocator.h>
+
 #include <cstdlib>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
-#include <fastdds/rtps/common/Locator.h>
-#include <fastrtps/utils/IPLocator.h>
-#include <fastrtps/types/TypesBase.h>
 #include <filesystem>
 #include <mutex>
 
@@ -17,16 +18,18 @@ using eprosima::fastrtps::types::ReturnCode_t;
 namespace fdds = eprosima::fastdds::dds;
 
 int resolve_domain(const std::optional<int>& flag) {
-  int domain = 0;
+  // With neither flag nor variable every binary lands on one shared default, so a shore and a
+  // boat started with no options find each other; tests and the demo always pass their own.
+  int domain = kDefaultDomain;
   if (flag) {
     domain = *flag;
   } else if (const char* env = std::getenv("TELLTALE_DOMAIN"); env && *env) {
     char* end = nullptr;
     const long v = std::strtol(env, &end, 10);
     if (*end != '\0') throw DdsError(std::string("TELLTALE_DOMAIN is not a number: ") + env);
+    if (end == env || v < 0 || v > 232)
+      throw DdsError(std::string("TELLTALE_DOMAIN must be a DDS domain 0..232, got '") + env + "'");
     domain = static_cast<int>(v);
-  } else {
-    throw DdsError("no DDS domain: pass --domain N or set TELLTALE_DOMAIN");
   }
   if (domain < 0 || domain > 232) throw DdsError("DDS domain must be 0..232");
   return domain;
@@ -140,8 +143,8 @@ fdds::DataWriter* Participant::writer(fdds::Topic* t, const std::string& profile
 
 fdds::DataReader* Participant::reader(fdds::Topic* t, const std::string& profile,
                                       fdds::DataReaderListener* listener) {
-  auto* r = subscriber_->create_datareader_with_profile(t, profile, listener,
-                                                        fdds::StatusMask::all());
+  auto* r =
+      subscriber_->create_datareader_with_profile(t, profile, listener, fdds::StatusMask::all());
   if (!r)
     throw DdsError("cannot create reader on " + t->get_name() + " with profile " + profile +
                    (secured_ ? " (DDS Security: this node's permissions do not allow it)" : ""));

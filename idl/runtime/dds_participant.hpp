@@ -40,8 +40,8 @@ class DdsError : public std::runtime_error {
 
 /// Where to find the domain and the profiles. Filled from flags, with environment fallbacks.
 struct DdsOptions {
-  std::optional<int> domain;            ///< flag; else TELLTALE_DOMAIN; else an error
-  std::string profiles_file;            ///< flag; else TELLTALE_DDS_PROFILES; else the build's
+  std::optional<int> domain;  ///< flag; else TELLTALE_DOMAIN; else kDefaultDomain
+  std::string profiles_file;  ///< flag; else TELLTALE_DDS_PROFILES; else the build's
   std::string participant_profile = "telltale_loopback";
   /// Unicast discovery peers (IPv4 addresses) added to the profile's initial peers: discovery on a
   /// network without multicast. Flag --dds-peer; else TELLTALE_DDS_PEERS (comma-separated).
@@ -58,8 +58,12 @@ struct DdsOptions {
   eprosima::fastdds::dds::DomainParticipantListener* listener = nullptr;
 };
 
-/// The domain id from the flag or TELLTALE_DOMAIN. Throws DdsError if neither is set or the value
-/// is outside 0..232 (the range the RTPS port mapping allows).
+/// The domain of a binary started with neither `--domain` nor TELLTALE_DOMAIN: every Telltale
+/// binary's default, so a shore and its boats started with no options meet.
+inline constexpr int kDefaultDomain = 0;
+
+/// The domain id from the flag, else TELLTALE_DOMAIN, else kDefaultDomain. Throws DdsError if the
+/// value is not a number or is outside 0..232 (the range the RTPS port mapping allows).
 [[nodiscard]] int resolve_domain(const std::optional<int>& flag);
 
 /// The profiles XML from the flag, TELLTALE_DDS_PROFILES, or the deploy/ folder of this build.
@@ -78,10 +82,9 @@ class Participant {
   eprosima::fastdds::dds::Topic* topic(const std::string& topic_name,
                                        eprosima::fastdds::dds::TypeSupport type);
   /// A writer with the named QoS profile of the profiles file. Throws DdsError.
-  eprosima::fastdds::dds::DataWriter* writer(eprosima::fastdds::dds::Topic* topic,
-                                             const std::string& profile,
-                                             eprosima::fastdds::dds::DataWriterListener* listener =
-                                                 nullptr);
+  eprosima::fastdds::dds::DataWriter* writer(
+      eprosima::fastdds::dds::Topic* topic, const std::string& profile,
+      eprosima::fastdds::dds::DataWriterListener* listener = nullptr);
   /// A reader with the named QoS profile. The listener gets every status (data, deadline,
   /// liveliness). Throws DdsError.
   eprosima::fastdds::dds::DataReader* reader(eprosima::fastdds::dds::Topic* topic,
