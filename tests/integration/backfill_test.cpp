@@ -15,6 +15,22 @@ using namespace std::chrono_literals;
 
 class BackfillTest : public ShoreFixture {
  protected:
+  static constexpr const char* kNeedsRoot =
+      "needs root and unshare(1) for a private mount (a fault test fails, never skips, without)";
+  static bool can_mount() {
+    return ::geteuid() == 0 && std::filesystem::exists("/usr/bin/unshare");
+  }
+  /// A boat_node whose --log-dir is a fresh tmpfs mounted with `mount_options` in a mount
+  /// namespace of its own (the mount goes when the boat does).
+  Process boat_on_tmpfs(const std::string& boat_id, const std::string& mount_options) {
+    const std::string log = dir_ + "/log-" + boat_id;
+    std::filesystem::create_directories(log);
+    return Process({"/usr/bin/unshare", "-m", "--propagation", "private", "sh", "-c",
+                    "mount -t tmpfs -o " + mount_options + " tmpfs '" + log + "' && exec '" +
+                        bin_dir() + "/boat_node' --domain " + std::to_string(domain_) +
+                        " --boat-id " + boat_id + " --log-dir '" + log + "'"});
+  }
+
   /// Stops the boat (it drains its backlog) and returns how many samples it published.
   long stop_boat(Process& boat) {
     EXPECT_EQ(boat.stop(SIGINT, 15s), 0) << boat.output();
@@ -77,14 +93,8 @@ TEST_F(BackfillTest, ShoreKilledAndRestartedLosesNothing) {
 // Given a log directory that exists but is read-only (a mount gone read-only), the boat refuses
 // to start: no "ready" line, exit status 1 (it would otherwise sail with no log at all).
 TEST_F(BackfillTest, ReadOnlyLogDirectoryRefusesToStart) {
-  if (::geteuid() != 0 || !std::filesystem::exists("/usr/bin/unshare"))
-    GTEST_SKIP() << "needs root and unshare for a private read-only mount";
-  const std::string ro = dir_ + "/rolog";
-  std::filesystem::create_directories(ro);
-  Process boat({"/usr/bin/unshare", "-m", "--propagation", "private", "sh", "-c",
-                "mount -t tmpfs -o ro,size=64k tmpfs '" + ro + "' && exec '" + bin_dir() +
-                    "/boat_node' --domain " + std::to_string(domain_) +
-                    " --boat-id ro1 --log-dir '" + ro + "'"});
+  ASSERT_TRUE(can_mount()) << kNeedsRoot;
+  Process boat = boat_on_tmpfs("ro1", "ro,size=64k");
   EXPECT_FALSE(boat.wait_for_line("boat_node ready: ", 5s)) << boat.output();
   EXPECT_EQ(boat.stop(SIGINT, 5s), 1) << boat.output();
 }
@@ -92,14 +102,8 @@ TEST_F(BackfillTest, ReadOnlyLogDirectoryRefusesToStart) {
 // Given a boat whose log disk is full (an 8 KB tmpfs), the node's status says so first, where the
 // dashboard and the boats API show it (it said "ok" while the log lost every record).
 TEST_F(BackfillTest, FullLogDiskIsReportedInTheNodeStatus) {
-  if (::geteuid() != 0 || !std::filesystem::exists("/usr/bin/unshare"))
-    GTEST_SKIP() << "needs root and unshare for a private tmpfs";
-  const std::string full = dir_ + "/fulllog";
-  std::filesystem::create_directories(full);
-  Process boat({"/usr/bin/unshare", "-m", "--propagation", "private", "sh", "-c",
-                "mount -t tmpfs -o size=8k tmpfs '" + full + "' && exec '" + bin_dir() +
-                    "/boat_node' --domain " + std::to_string(domain_) +
-                    " --boat-id fl1 --log-dir '" + full + "'"});
+  ASSERT_TRUE(can_mount()) << kNeedsRoot;
+  Process boat = boat_on_tmpfs("fl1", "size=8k");
   ASSERT_TRUE(boat.wait_for_line("boat_node ready: ", 20s)) << boat.output();
   std::string text;
   EXPECT_TRUE(eventually(

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -13,6 +14,12 @@
 #include <thread>
 
 namespace telltale::testing {
+
+namespace {
+// A test that writes to a socket the shore has closed (it answers a hostile request at once and
+// hangs up) gets EPIPE, as a real client does, instead of dying of SIGPIPE.
+const bool kSigpipeIgnored = [] { return ::signal(SIGPIPE, SIG_IGN) != SIG_ERR; }();
+}  // namespace
 
 Process::Process(std::vector<std::string> argv, std::vector<std::string> env) {
   // Everything the child needs is built before fork: after it, only async-signal-safe calls.
@@ -36,6 +43,8 @@ Process::Process(std::vector<std::string> argv, std::vector<std::string> env) {
     sigset_t none;
     sigemptyset(&none);
     sigprocmask(SIG_SETMASK, &none, nullptr);
+    // An ignored signal stays ignored across execve: the child gets SIGPIPE's default back.
+    ::signal(SIGPIPE, SIG_DFL);
     dup2(fds[1], STDOUT_FILENO);
     execve(args[0], args.data(), envp.data());
     _exit(127);
@@ -105,8 +114,26 @@ int Process::stop(int signo, std::chrono::milliseconds timeout) {
 }
 
 int unique_domain() {
-  // Spread over 100..229 by process id: tests run in parallel by ctest get different domains.
-  return 100 + static_cast<int>(getpid() % 130);
+  // One of 100..229, held with an exclusive lock on a file of its own for the life of this
+  // process, so tests run in parallel never share a domain (a process-id spread alone collided:
+  // a boat of one test was acknowledged by another test's shore). The search starts at a place
+  // given by the process id; the lock goes when the process ends, however it ends.
+  static const int domain = [] {
+    const int start = static_cast<int>(getpid() % 130);
+    for (int i = 0; i < 130; ++i) {
+      const int d = 100 + (start + i) % 130;
+      const std::string lock = (std::filesystem::temp_directory_path() /
+                                ("telltale_test_domain_" + std::to_string(d) + ".lock"))
+                                   .string();
+      const int fd = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+      if (fd < 0) continue;
+      if (::flock(fd, LOCK_EX | LOCK_NB) == 0) return d;  // fd kept open: the lock is held
+      ::close(fd);
+    }
+    throw std::runtime_error("no free DDS test domain in 100..229");
+  }();
+  (void)kSigpipeIgnored;
+  return domain;
 }
 
 std::string make_temp_dir() {

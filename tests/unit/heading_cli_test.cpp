@@ -10,37 +10,15 @@
 #include <string>
 
 #include "csv.hpp"
+#include "fusion_cli_fixture.hpp"
 #include "telltale/fusion/heading_monitor.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-class HeadingCli : public ::testing::Test {
+class HeadingCli : public telltale::testing::FusionCliTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("telltale_heading_cli_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  /// Exit status of `fusion_cli args`, stdout and stderr to files in the directory.
-  int run(const std::string& args) const {
-    const std::string cmd = std::string(TELLTALE_FUSION_CLI) + " " + args + " >" + path("out.txt") +
-                            " 2>" + path("err.txt");
-    const int rc = std::system(cmd.c_str());
-    return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-  }
-  std::string read(const std::string& name) const {
-    std::ifstream in(path(name));
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  }
-  void write(const std::string& name, const std::string& text) const {
-    std::ofstream(path(name)) << text;
-  }
-  fs::path dir_;
 };
 
 TEST_F(HeadingCli, SimulateThenFuseMatchesTruth) {

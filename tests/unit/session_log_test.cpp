@@ -112,7 +112,7 @@ class SessionLogFaults : public SessionLogRuns {
 // then removed, then every record appended before, during and after the spell is read back in
 // order (none torn, none off the record grid).
 TEST_F(SessionLogFaults, DiskFullSpellLosesNothingAndReportsIt) {
-  if (!mount_tmpfs("size=256k,mode=0755")) GTEST_SKIP() << "needs root and mount namespaces";
+  if (!mount_tmpfs("size=256k,mode=0755")) FAIL() << "needs root and mount namespaces (a fault test fails, never skips, without them)";
   const auto ballast = dir_ / "ballast";
   {
     // Fill the filesystem, then give back a little over one page.
@@ -180,7 +180,7 @@ TEST_F(SessionLogRuns, ReaderResynchronisesAfterATornRecord) {
 // Given a log directory that exists but cannot be written (a read-only mount), the log refuses
 // to open: a boat must not say "ready" and then sail without a log.
 TEST_F(SessionLogFaults, ReadOnlyDirectoryIsRefused) {
-  if (!mount_tmpfs("size=64k", MS_RDONLY)) GTEST_SKIP() << "needs root and mount namespaces";
+  if (!mount_tmpfs("size=64k", MS_RDONLY)) FAIL() << "needs root and mount namespaces (a fault test fails, never skips, without them)";
   EXPECT_THROW(SessionLog({dir_, "ro", 0x1, 100000, 1ULL << 30}), std::runtime_error);
 }
 

@@ -11,30 +11,14 @@
 #include <fstream>
 #include <string>
 
+#include "fusion_cli_fixture.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-class StepsCli : public ::testing::Test {
+class StepsCli : public telltale::testing::FusionCliTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("telltale_steps_cli_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  int run(const std::string& args) const {
-    const std::string cmd = std::string(TELLTALE_FUSION_CLI) + " " + args + " >" + path("out.txt") +
-                            " 2>" + path("err.txt");
-    const int rc = std::system(cmd.c_str());
-    return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-  }
-  std::string read(const std::string& name) const {
-    std::ifstream in(path(name));
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  }
   /// 10 s of a phone at 50 Hz walking at 2 steps/s (vertical +-2 m/s^2); every `every`-th row
   /// is written twice with the same stamp (a batch the OS stamped once).
   void write_walk(const std::string& name, int every, bool backwards_at_row_100 = false) const {
@@ -49,7 +33,6 @@ class StepsCli : public ::testing::Test {
       if (every > 0 && n % every == 0) out << t << ",0.1,0.2," << az + 0.01 << "\n";
     }
   }
-  fs::path dir_;
 };
 
 TEST_F(StepsCli, RepeatedTimeStampsAreMergedAndCounted) {
