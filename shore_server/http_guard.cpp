@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <string>
 
 namespace telltale::shore {
@@ -268,6 +269,23 @@ bool GuardedServer::process_and_close_socket(socket_t sock) {
     --count;
   }
   tl_connection = nullptr;
+  if (conn.close_after) {
+    // A body refused unread (413 at once): the client may still be sending it and reads our
+    // answer only once it has. Closing now would reset the connection under it and lose the
+    // answer, so the write side is shut (the answer, then FIN) and what still comes is read and
+    // dropped for at most 1 s: enough for a body on any link that matters, too short to hold a
+    // thread for a hostile sender.
+    ::shutdown(sock, SHUT_WR);
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+    char sink[16384];
+    for (auto now = std::chrono::steady_clock::now(); now < until;
+         now = std::chrono::steady_clock::now()) {
+      pollfd p{sock, POLLIN, 0};
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(until - now);
+      if (::poll(&p, 1, static_cast<int>(left.count()) + 1) <= 0) break;
+      if (::recv(sock, sink, sizeof sink, 0) <= 0) break;
+    }
+  }
   ::shutdown(sock, SHUT_RDWR);
   ::close(sock);
   busy_.fetch_sub(1);
