@@ -315,40 +315,40 @@ Reject Ingest::wearable(const msg::WearableMotion& m) {
   return r;
 }
 
+namespace {
+/// The generated deserialize, then the key's raw length checked against what Fast DDS kept: a
+/// key it cut to its bound (or that holds a NUL) is emptied, which the door refuses as an id.
+/// Any Fast CDR exception is a malformed payload, not a sample.
+template <class Base, class Msg, class KeyOf>
+bool strict_deserialize(Base& type, eprosima::fastrtps::rtps::SerializedPayload_t* payload,
+                        void* data, KeyOf key_of) {
+  try {
+    if (!type.Base::deserialize(payload, data)) return false;
+  } catch (...) {
+    return false;
+  }
+  auto& key = key_of(*static_cast<Msg*>(data));
+  if (!key_string_intact(payload, key.size())) key = "";
+  return true;
+}
+}  // namespace
+
 bool StrictBoatAttitudeType::deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload,
                                          void* data) {
-  try {
-    if (!msg::BoatAttitudePubSubType::deserialize(payload, data)) return false;
-  } catch (...) {
-    return false;  // any Fast CDR exception: a malformed payload, not a sample
-  }
-  auto* m = static_cast<msg::BoatAttitude*>(data);
-  if (!key_string_intact(payload, m->boat_id().size())) m->boat_id("");
-  return true;
+  return strict_deserialize<msg::BoatAttitudePubSubType, msg::BoatAttitude>(
+      *this, payload, data, [](msg::BoatAttitude & m) -> auto& { return m.boat_id(); });
 }
 
 bool StrictNodeStatusType::deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload,
                                        void* data) {
-  try {
-    if (!msg::NodeStatusPubSubType::deserialize(payload, data)) return false;
-  } catch (...) {
-    return false;  // any Fast CDR exception: a malformed payload, not a sample
-  }
-  auto* m = static_cast<msg::NodeStatus*>(data);
-  if (!key_string_intact(payload, m->node_id().size())) m->node_id("");
-  return true;
+  return strict_deserialize<msg::NodeStatusPubSubType, msg::NodeStatus>(
+      *this, payload, data, [](msg::NodeStatus & m) -> auto& { return m.node_id(); });
 }
 
 bool StrictWearableMotionType::deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload,
                                            void* data) {
-  try {
-    if (!msg::WearableMotionPubSubType::deserialize(payload, data)) return false;
-  } catch (...) {
-    return false;  // any Fast CDR exception: a malformed payload, not a sample
-  }
-  auto* m = static_cast<msg::WearableMotion*>(data);
-  if (!key_string_intact(payload, m->athlete_id().size())) m->athlete_id("");
-  return true;
+  return strict_deserialize<msg::WearableMotionPubSubType, msg::WearableMotion>(
+      *this, payload, data, [](msg::WearableMotion & m) -> auto& { return m.athlete_id(); });
 }
 
 }  // namespace telltale::shore

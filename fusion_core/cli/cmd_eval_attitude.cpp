@@ -22,7 +22,8 @@ struct EvalAttitudeOptions {
   std::vector<double> rates_hz{25.0, 100.0};
   std::vector<std::string> filters;    // empty = all
   std::vector<std::string> scenarios;  // empty = all
-  std::string broad_dir;               // empty = look in the usual places
+  std::string broad_dir;               // empty = broad/ in the real-data folder
+  std::string data_dir;                // --data: the real-data folder (real_data_dir)
   bool skip_broad = false;
   bool skip_sim = false;
   bool uncalibrated = false;  ///< raw datasheet sensor errors instead of the calibrated instrument
@@ -37,13 +38,11 @@ void progress_done() {
   if (progress_enabled()) std::fprintf(stderr, "\r\033[K");
 }
 
-std::string find_broad_dir(const std::string& requested) {
-  if (!requested.empty()) return requested;
-  for (const char* d :
-       {"/work/shared/data/broad", "../shared/data/broad", "../../shared/data/broad"}) {
-    if (std::filesystem::is_directory(d)) return d;
-  }
-  return {};
+/// --broad-dir, else broad/ in the real-data folder (real_data_dir), else none.
+std::string find_broad_dir(const EvalAttitudeOptions& o) {
+  if (!o.broad_dir.empty()) return o.broad_dir;
+  const std::string d = real_data_dir(o.data_dir) + "/broad";
+  return std::filesystem::is_directory(d) ? d : std::string();
 }
 
 void run_eval_attitude(const EvalAttitudeOptions& o) {
@@ -92,9 +91,9 @@ void run_eval_attitude(const EvalAttitudeOptions& o) {
     }
   }
   if (o.skip_broad) return;
-  const std::string dir = find_broad_dir(o.broad_dir);
+  const std::string dir = find_broad_dir(o);
   if (dir.empty()) {
-    std::printf("\n(BROAD recordings not found: pass --broad-dir)\n");
+    std::printf("\n(BROAD recordings not found: pass --data DIR or --broad-dir DIR)\n");
     return;
   }
   std::vector<std::string> trials;
@@ -144,8 +143,10 @@ void register_eval_attitude(CLI::App& eval, std::vector<std::function<void()>>& 
   cmd->add_option("--rate-hz", opts->rates_hz, "sample rates")->capture_default_str();
   cmd->add_option("--filters", opts->filters, "filters (default: all)");
   cmd->add_option("--scenarios", opts->scenarios, "scenarios (default: all)");
-  cmd->add_option("--broad-dir", opts->broad_dir,
-                  "BROAD CSV folder (default: /work/shared/data/broad or ../shared/data/broad)");
+  cmd->add_option("--data", opts->data_dir,
+                  "real recordings folder (default: $TELLTALE_DATA, else ../shared/data); "
+                  "BROAD is its broad/");
+  cmd->add_option("--broad-dir", opts->broad_dir, "BROAD CSV folder (default: DATA/broad)");
   cmd->add_flag("--no-broad", opts->skip_broad, "skip the BROAD recordings");
   cmd->add_flag("--no-sim", opts->skip_sim, "skip the simulator (BROAD only)");
   cmd->add_flag("--uncalibrated", opts->uncalibrated,

@@ -98,11 +98,7 @@ void gait_table(const EvalOptions& o) {
   }
 }
 
-std::string data_dir(const EvalOptions& o) {
-  if (!o.data_dir.empty()) return o.data_dir;
-  if (const char* env = std::getenv("TELLTALE_DATA"); env && *env) return env;
-  return "../shared/data";
-}
+std::string data_dir(const EvalOptions& o) { return real_data_dir(o.data_dir); }
 
 std::string find_oxford(const EvalOptions& o) {
   if (!o.oxford_dir.empty()) return o.oxford_dir;

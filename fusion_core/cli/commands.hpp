@@ -4,8 +4,10 @@
 /// main() maps io::CsvError and UsageError to exit status 2 with one line on stderr.
 
 #include <CLI/CLI.hpp>
+#include <cstdlib>
 #include <functional>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace telltale::cli {
@@ -15,6 +17,15 @@ class UsageError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+/// The folder of real recordings the evaluations read (broad/, ipol_gait/, oxford_steps/, ...):
+/// `flag` (--data) if given, else $TELLTALE_DATA, else ../shared/data relative to the working
+/// directory. A user's clone has none of them: each evaluation says which table it skipped.
+inline std::string real_data_dir(const std::string& flag) {
+  if (!flag.empty()) return flag;
+  if (const char* env = std::getenv("TELLTALE_DATA"); env && *env) return env;
+  return "../shared/data";
+}
 
 void register_attitude(CLI::App& app);
 void register_heading(CLI::App& app);

@@ -6,7 +6,8 @@
 #include "csv.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"Telltale fusion core, offline: attitude, heading, steps, PDR, simulation, evaluation"};
+  CLI::App app{
+      "Telltale fusion core, offline: attitude, heading, steps, PDR, simulation, evaluation"};
   app.require_subcommand(1);
   telltale::cli::register_attitude(app);
   telltale::cli::register_heading(app);
