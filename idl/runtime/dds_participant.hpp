@@ -32,7 +32,6 @@ inline constexpr const char* kTopicWearableMotion = "telltale_wearable_motion";
 inline constexpr const char* kTopicBoatBackfill = "telltale_boat_backfill";
 inline constexpr const char* kTopicShoreAck = "telltale_shore_ack";
 inline constexpr const char* kTopicBoatFix = "telltale_boat_fix";
-inline constexpr const char* kTopicBoatFix = "telltale_boat_fix";
 
 /// Setup failure (profile file, participant, topic, entity): main() prints it and exits non-zero.
 class DdsError : public std::runtime_error {
