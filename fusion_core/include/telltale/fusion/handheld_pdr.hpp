@@ -1,0 +1,238 @@
+#pragma once
+/// \file
+/// Pedestrian dead reckoning for a phone held in front of the walker (the reading / texting pose
+/// of real phone walks, issue 19 item 2), in stages, each with its Params and State:
+///
+///   1. tilt: the up direction in the phone's frame from TelltaleAttitudeFilter (attitude_telltale);
+///   2. StandBiasLearner: the gyro bias from the walker standing still (a hand, not a table);
+///   3. WalkStepDetector: steps from the vertical specific force, counted only once the motion
+///      is a walk (a regular cadence with the phone's tilt steady), so handling the phone,
+///      standing and pausing make no steps and no distance;
+///   4. step length from height and cadence (StepLengthModel, hand-held row);
+///   5. WalkingHeading: the phone's yaw about the vertical, the bias-corrected gyro integrated
+///      about the up direction. A phone held in front keeps a fixed yaw to the walking direction,
+///      so turns of the phone are turns of the walk; the magnetometer (unreliable indoors) only
+///      orients the track once, at the start, and never steers it;
+///   6. the track: each step laid at the heading the phone had at that step.
+///
+/// Steps are reported with the time of the step itself (they are confirmed up to a few steps
+/// later): HandheldPdr::update returns the steps it confirmed at this sample.
+///
+/// Frames: the phone's own axes (any right-handed frame; Android: x right, y up the screen, z out
+/// of the screen); the accelerometer reads specific force (+g up at rest). Track: x east, y north
+/// (magnetic), heading clockwise from north. No heap in update().
+
+#include <Eigen/Core>
+#include <array>
+#include <cstddef>
+
+#include "telltale/fusion/attitude_telltale.hpp"
+#include "telltale/fusion/imu_sample.hpp"
+#include "telltale/fusion/pdr.hpp"
+
+namespace telltale::fusion {
+
+// ---------------------------------------------------------------------------------------------
+/// Gyro bias from standing. A hand holding a phone is never still (tremor: 0.05-0.25 rad/s rms,
+/// acceleration 0.05-0.4 m/s^2 rms), so no single second gives the bias; but the phone's
+/// orientation stays put while the walker stands, so over a stand of T seconds the mean rate is
+/// the bias plus (net rotation) / T: a few degrees over a 20 s stand, under 0.005 rad/s. Each
+/// stand is weighted by T^2 (its error goes as 1/T) and the current stand counts as it grows.
+struct StandBiasParams {
+  double window_s = 1.0;          ///< quiet test window
+  /// Quiet: |f| rms about its mean and the rate rms below these over the window. A walking step
+  /// moves |f| by 1-3 m/s^2 (heel strike), handling turns the phone at 2-7 rad/s; a hand
+  /// holding it stays below both.
+  double max_acc_sd_m_s2 = 0.4;
+  double max_gyro_rms_rad_s = 0.4;
+  double min_stand_s = 3.0;       ///< shorter quiet stretches are pauses of a moving hand
+  /// A stand's mean rate above this is a slow turn on the spot, not a bias (phone gyros are
+  /// factory- and OS-calibrated to well under 1 deg/s).
+  double max_bias_rad_s = 0.03;
+};
+class StandBiasLearner {
+ public:
+  using Params = StandBiasParams;
+  struct State {
+    // Window sums.
+    double win_t0_s = 0.0;
+    int win_n = 0;
+    double win_a = 0.0, win_a2 = 0.0, win_w2 = 0.0;
+    Eigen::Vector3d win_w = Eigen::Vector3d::Zero();
+    // The stand in progress (consecutive quiet windows) and the stands before it.
+    double stand_s = 0.0;
+    Eigen::Vector3d stand_w_dt = Eigen::Vector3d::Zero();  ///< integral of the rate
+    double done_weight = 0.0;                              ///< sum of T^2
+    Eigen::Vector3d done_sum = Eigen::Vector3d::Zero();    ///< sum of T^2 * mean
+    Eigen::Vector3d bias = Eigen::Vector3d::Zero();
+    bool quiet = false;  ///< the last full window was quiet
+    bool have_bias = false;
+    double last_t_s = 0.0;
+    bool started = false;
+  };
+  explicit StandBiasLearner(Params p = {}) : params_(p) {}
+  void update(const ImuSample& s);
+  [[nodiscard]] const Eigen::Vector3d& bias_rad_s() const { return state_.bias; }
+  [[nodiscard]] bool quiet() const { return state_.quiet; }
+  [[nodiscard]] const State& state() const { return state_; }
+
+ private:
+  void close_stand();
+  Params params_;
+  State state_;
+};
+
+// ---------------------------------------------------------------------------------------------
+/// Steps from the vertical specific force (f . up - its 2 s mean, smoothed over 0.2 s): one step
+/// per peak followed by a valley, the peak-to-valley swing at least `min_swing_m_s2`. Such peaks
+/// also come from handling the phone and from a hand moving while the walker stands, so a peak
+/// is only a candidate: the detector says "walking" once `confirm_steps` candidates in a row have
+/// a walking cadence (intervals in [min_interval_s, max_interval_s], each within
+/// `max_interval_ratio` of the one before: gait is regular, handling is not) with the phone's tilt
+/// steady over them (up moved less than `max_tilt_deg` from their mean, the rate rms below
+/// `max_gyro_rms_rad_s`: a phone held in front while walking; handling turns it). Then the held
+/// candidates become steps, and every further candidate with a walking interval. A gap longer
+/// than `pause_intervals` step intervals (or max_interval_s) ends the walk: a pause.
+struct WalkStepParams {
+  double smooth_s = 0.2;       ///< moving mean: a step's vertical bounce is 1.5-2.5 Hz
+  double mean_s = 2.0;         ///< the specific force's mean over this is taken out (g, scale)
+  double min_swing_m_s2 = 1.0; ///< a hand-held phone's vertical swing per step: 1.5-6 m/s^2
+  double min_interval_s = 0.3; ///< 3.3 steps/s: faster than any walk
+  double max_interval_s = 1.2; ///< 50 steps/min: slower is not a walk
+  double max_interval_ratio = 1.5;
+  int confirm_steps = 4;       ///< two strides
+  double max_tilt_deg = 20.0;
+  double max_gyro_rms_rad_s = 1.5;
+  double pause_intervals = 2.5;
+};
+class WalkStepDetector {
+ public:
+  using Params = WalkStepParams;
+  static constexpr int kMaxHeld = 16;
+  struct Candidate {
+    double t_s = 0.0;
+    double interval_s = 0.0;  ///< since the previous candidate (0: first of a run)
+    Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+    double gyro_ms = 0.0;  ///< mean squared rate since the previous candidate
+  };
+  struct State {
+    // Moving sums (ring of the last mean_s of vertical force).
+    static constexpr std::size_t kRing = 256;
+    std::array<double, kRing> ring_t{}, ring_v{};
+    std::size_t head = 0, size = 0;
+    double sum_v = 0.0;
+    std::array<double, 32> sm_v{};  ///< last smoothing window of centred values
+    std::array<double, 32> sm_t{};
+    std::size_t sm_head = 0, sm_size = 0;
+    double sm_sum = 0.0;
+    double prev_s = 0.0, prev2_s = 0.0, prev_t_s = 0.0;  ///< smoothed signal, two samples
+    int have_prev = 0;
+    // Peak-valley.
+    bool have_peak = false;
+    double peak_t_s = 0.0, peak_v = 0.0;
+    Eigen::Vector3d peak_up = Eigen::Vector3d::UnitZ();
+    double min_since_peak = 0.0;
+    // Rate since the last candidate.
+    double w2_sum = 0.0;
+    int w2_n = 0;
+    // Candidates of a run not yet confirmed.
+    std::array<Candidate, kMaxHeld> held{};
+    int held_n = 0;
+    bool walking = false;
+    double last_cand_t_s = -1e9;
+    double interval_s = 0.0;  ///< the walk's current step interval (0: none yet)
+  };
+  explicit WalkStepDetector(Params p = {}) : params_(p) {}
+  /// Feeds one sample with the up direction (unit, phone frame). Returns how many steps became
+  /// known at this sample; their times are steps()[0..n).
+  int update(const ImuSample& s, const Eigen::Vector3d& up);
+  [[nodiscard]] const std::array<Candidate, kMaxHeld>& steps() const { return out_; }
+  [[nodiscard]] bool walking() const { return state_.walking; }
+  [[nodiscard]] double interval_s() const { return state_.interval_s; }
+  [[nodiscard]] const State& state() const { return state_; }
+
+ private:
+  int on_candidate(const Candidate& c);
+  bool run_is_walk() const;
+  Params params_;
+  State state_;
+  std::array<Candidate, kMaxHeld> out_{};
+};
+
+// ---------------------------------------------------------------------------------------------
+/// The phone's yaw about the vertical: d(yaw)/dt = (w - bias) . up (counter-clockwise seen from
+/// above), heading = start - yaw. A short history lets a step confirmed late take the heading
+/// it had when it was walked.
+class WalkingHeading {
+ public:
+  static constexpr std::size_t kHistory = 1024;  ///< samples: 20 s at 50 Hz
+  void update(double t_s, const Eigen::Vector3d& gyro_unbiased, const Eigen::Vector3d& up);
+  /// Heading (clockwise from north, rad) now, and at an earlier time within the history.
+  [[nodiscard]] double heading_rad() const { return offset_rad_ - yaw_rad_; }
+  [[nodiscard]] double heading_at(double t_s) const;
+  /// The yaw integrated so far (counter-clockwise, rad) and the offset heading = offset - yaw.
+  [[nodiscard]] double yaw_rad() const { return yaw_rad_; }
+  void set_offset(double offset_rad) { offset_rad_ = offset_rad; }
+
+ private:
+  double yaw_rad_ = 0.0, offset_rad_ = 0.0, last_t_s_ = 0.0;
+  bool started_ = false;
+  std::array<double, kHistory> hist_yaw_{};
+  std::array<double, kHistory> hist_t_{};
+  std::size_t hist_head_ = 0, hist_size_ = 0;
+};
+
+// ---------------------------------------------------------------------------------------------
+struct HandheldPdrParams {
+  double height_m = 1.75;
+  double step_scale = 1.0;  ///< personal factor on the model's step length (1: population)
+  TelltaleAttitudeParams attitude;
+  StandBiasParams bias;
+  WalkStepParams steps;
+  /// The magnetometer orients the track once, from its mean over the stand before the first
+  /// walk (heading of the phone's forward axis: the horizontal part of y - z, the top of the
+  /// screen for a phone held flat or tilted toward the face). false: the track starts north.
+  bool orient_with_mag = true;
+};
+
+struct HandheldStep {
+  double t_s = 0.0;
+  double x_m = 0.0, y_m = 0.0, heading_deg = 0.0, length_m = 0.0, step_hz = 0.0;
+  double distance_m = 0.0;
+  std::size_t steps = 0;
+};
+
+class HandheldPdr {
+ public:
+  using Params = HandheldPdrParams;
+  explicit HandheldPdr(Params p = {}, const StepLengthModel& lengths = builtin_step_length_model());
+  /// Feeds one sample (mag may be NaN). Returns how many steps were laid at it: steps()[0..n),
+  /// each with its own time (at or before this sample's).
+  int update(const ImuSample& s, const Eigen::Vector3d& mag_uT);
+  [[nodiscard]] const std::array<HandheldStep, WalkStepDetector::kMaxHeld>& steps() const {
+    return laid_;
+  }
+  [[nodiscard]] const HandheldStep& last() const { return last_; }
+  [[nodiscard]] bool walking() const { return detector_.walking(); }
+  [[nodiscard]] bool standing() const { return bias_.quiet(); }
+  [[nodiscard]] const Eigen::Vector3d& gyro_bias_rad_s() const { return bias_.bias_rad_s(); }
+  [[nodiscard]] double heading_rad() const { return heading_.heading_rad(); }
+  [[nodiscard]] const Eigen::Vector3d& up() const { return att_.state().up_body; }
+
+ private:
+  Params params_;
+  StepLengthModel lengths_;
+  TelltaleAttitudeFilter att_;
+  StandBiasLearner bias_;
+  WalkStepDetector detector_;
+  WalkingHeading heading_;
+  std::array<HandheldStep, WalkStepDetector::kMaxHeld> laid_{};
+  HandheldStep last_;
+  Eigen::Vector2d mag_offset_sum_ = Eigen::Vector2d::Zero();  ///< unit vectors of the offset
+  int mag_n_ = 0;
+  bool oriented_ = false;
+  std::array<double, 4> intervals_{};
+  int interval_n_ = 0;
+};
+
+}  // namespace telltale::fusion

@@ -1,0 +1,342 @@
+#include "telltale/fusion/handheld_pdr.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace telltale::fusion {
+
+// ---------------------------------------------------------------------------------------------
+void StandBiasLearner::update(const ImuSample& s) {
+  auto& st = state_;
+  if (!st.started) {
+    st.started = true;
+    st.last_t_s = s.t_s;
+    st.win_t0_s = s.t_s;
+    return;
+  }
+  const double dt = s.t_s - st.last_t_s;
+  st.last_t_s = s.t_s;
+  if (!(dt > 0.0) || dt > 0.5) {  // a gap: the window and the stand restart
+    close_stand();
+    st.win_n = 0;
+    st.win_a = st.win_a2 = st.win_w2 = 0.0;
+    st.win_w.setZero();
+    st.win_t0_s = s.t_s;
+    return;
+  }
+  const double a = s.acc_body_m_s2.norm();
+  st.win_a += a;
+  st.win_a2 += a * a;
+  st.win_w2 += s.gyro_body_rad_s.squaredNorm();
+  st.win_w += s.gyro_body_rad_s * dt;
+  ++st.win_n;
+  const double span = s.t_s - st.win_t0_s;
+  if (span < params_.window_s) return;
+  const double n = static_cast<double>(st.win_n);
+  const double mean_a = st.win_a / n;
+  const double sd_a = std::sqrt(std::max(0.0, st.win_a2 / n - mean_a * mean_a));
+  const double rms_w = std::sqrt(st.win_w2 / n);
+  st.quiet = sd_a < params_.max_acc_sd_m_s2 && rms_w < params_.max_gyro_rms_rad_s;
+  if (st.quiet) {
+    st.stand_s += span;
+    st.stand_w_dt += st.win_w;
+  } else {
+    close_stand();
+  }
+  st.win_n = 0;
+  st.win_a = st.win_a2 = st.win_w2 = 0.0;
+  st.win_w.setZero();
+  st.win_t0_s = s.t_s;
+  // The estimate: the closed stands and the one in progress, each weighted by T^2.
+  double weight = st.done_weight;
+  Eigen::Vector3d sum = st.done_sum;
+  if (st.stand_s >= params_.min_stand_s) {
+    const Eigen::Vector3d mean = st.stand_w_dt / st.stand_s;
+    if (mean.norm() <= params_.max_bias_rad_s) {
+      weight += st.stand_s * st.stand_s;
+      sum += st.stand_s * st.stand_s * mean;
+    }
+  }
+  if (weight > 0.0) {
+    st.bias = sum / weight;
+    st.have_bias = true;
+  }
+}
+
+void StandBiasLearner::close_stand() {
+  auto& st = state_;
+  if (st.stand_s >= params_.min_stand_s) {
+    const Eigen::Vector3d mean = st.stand_w_dt / st.stand_s;
+    if (mean.norm() <= params_.max_bias_rad_s) {
+      st.done_weight += st.stand_s * st.stand_s;
+      st.done_sum += st.stand_s * st.stand_s * mean;
+    }
+  }
+  st.stand_s = 0.0;
+  st.stand_w_dt.setZero();
+  st.quiet = false;
+}
+
+// ---------------------------------------------------------------------------------------------
+int WalkStepDetector::update(const ImuSample& s, const Eigen::Vector3d& up) {
+  auto& st = state_;
+  // The vertical specific force, its mean over mean_s taken out.
+  const double v = s.acc_body_m_s2.dot(up);
+  if (st.size == State::kRing) {
+    st.sum_v -= st.ring_v[st.head];
+    st.head = (st.head + 1) % State::kRing;
+    --st.size;
+  }
+  {
+    const std::size_t i = (st.head + st.size) % State::kRing;
+    st.ring_t[i] = s.t_s;
+    st.ring_v[i] = v;
+    st.sum_v += v;
+    ++st.size;
+  }
+  while (st.size > 1 && s.t_s - st.ring_t[st.head] > params_.mean_s) {
+    st.sum_v -= st.ring_v[st.head];
+    st.head = (st.head + 1) % State::kRing;
+    --st.size;
+  }
+  const double centred = v - st.sum_v / static_cast<double>(st.size);
+  // Smoothed over smooth_s.
+  constexpr std::size_t kSm = 32;
+  if (st.sm_size == kSm) {
+    st.sm_sum -= st.sm_v[st.sm_head];
+    st.sm_head = (st.sm_head + 1) % kSm;
+    --st.sm_size;
+  }
+  {
+    const std::size_t i = (st.sm_head + st.sm_size) % kSm;
+    st.sm_t[i] = s.t_s;
+    st.sm_v[i] = centred;
+    st.sm_sum += centred;
+    ++st.sm_size;
+  }
+  while (st.sm_size > 1 && s.t_s - st.sm_t[st.sm_head] >= params_.smooth_s) {
+    st.sm_sum -= st.sm_v[st.sm_head];
+    st.sm_head = (st.sm_head + 1) % kSm;
+    --st.sm_size;
+  }
+  const double sm = st.sm_sum / static_cast<double>(st.sm_size);
+  st.w2_sum += s.gyro_body_rad_s.squaredNorm();
+  ++st.w2_n;
+
+  int emitted = 0;
+  // A pause: no candidate for pause_intervals step intervals.
+  if (st.walking) {
+    const double limit =
+        std::min(params_.max_interval_s, params_.pause_intervals * st.interval_s);
+    if (s.t_s - st.last_cand_t_s > std::max(limit, params_.min_interval_s)) {
+      st.walking = false;
+      st.held_n = 0;
+    }
+  }
+  // Peak, then a valley min_swing below it.
+  if (st.have_prev >= 2) {
+    const bool local_max = st.prev_s > st.prev2_s && st.prev_s >= sm && st.prev_s > 0.0;
+    if (local_max && (!st.have_peak || st.prev_s > st.peak_v)) {
+      st.have_peak = true;
+      st.peak_t_s = st.prev_t_s;
+      st.peak_v = st.prev_s;
+      st.peak_up = up;
+      st.min_since_peak = st.prev_s;
+    }
+    if (st.have_peak) {
+      st.min_since_peak = std::min(st.min_since_peak, sm);
+      if (st.peak_v - st.min_since_peak >= params_.min_swing_m_s2 && sm < 0.0) {
+        Candidate c;
+        c.t_s = st.peak_t_s;
+        c.up = st.peak_up;
+        c.gyro_ms = st.w2_n > 0 ? st.w2_sum / st.w2_n : 0.0;
+        st.w2_sum = 0.0;
+        st.w2_n = 0;
+        st.have_peak = false;
+        if (c.t_s - st.last_cand_t_s >= params_.min_interval_s) emitted = on_candidate(c);
+      } else if (s.t_s - st.peak_t_s > params_.max_interval_s) {
+        st.have_peak = false;  // no valley: not a step's bounce
+      }
+    }
+  }
+  st.prev2_s = st.prev_s;
+  st.prev_s = sm;
+  st.prev_t_s = s.t_s;
+  st.have_prev = std::min(st.have_prev + 1, 2);
+  return emitted;
+}
+
+int WalkStepDetector::on_candidate(const Candidate& c_in) {
+  auto& st = state_;
+  Candidate c = c_in;
+  const double interval = c.t_s - st.last_cand_t_s;
+  st.last_cand_t_s = c.t_s;
+  const bool cadence = interval >= params_.min_interval_s && interval <= params_.max_interval_s;
+  if (st.walking) {
+    // The pause test in update() already ended a walk with a longer gap.
+    if (cadence) {
+      c.interval_s = interval;
+      st.interval_s = 0.75 * st.interval_s + 0.25 * interval;
+      out_[0] = c;
+      return 1;
+    }
+    st.walking = false;
+    st.held_n = 0;
+  }
+  bool extends = cadence && st.held_n > 0;
+  if (extends && st.held_n > 1) {
+    const double prev = st.held[static_cast<std::size_t>(st.held_n - 1)].interval_s;
+    extends = interval <= params_.max_interval_ratio * prev &&
+              prev <= params_.max_interval_ratio * interval;
+  }
+  if (!extends) {
+    st.held_n = 0;
+    c.interval_s = 0.0;
+  } else {
+    c.interval_s = interval;
+  }
+  if (st.held_n == kMaxHeld) {
+    std::copy(st.held.begin() + 1, st.held.end(), st.held.begin());
+    --st.held_n;
+  }
+  st.held[static_cast<std::size_t>(st.held_n++)] = c;
+  if (st.held_n >= params_.confirm_steps && run_is_walk()) {
+    st.walking = true;
+    double sum = 0.0;
+    for (int i = 1; i < st.held_n; ++i) sum += st.held[static_cast<std::size_t>(i)].interval_s;
+    st.interval_s = sum / (st.held_n - 1);
+    const int n = st.held_n;
+    std::copy(st.held.begin(), st.held.begin() + n, out_.begin());
+    st.held_n = 0;
+    return n;
+  }
+  return 0;
+}
+
+bool WalkStepDetector::run_is_walk() const {
+  const auto& st = state_;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  double w2 = 0.0;
+  for (int i = 0; i < st.held_n; ++i) {
+    mean += st.held[static_cast<std::size_t>(i)].up;
+    if (i > 0) w2 += st.held[static_cast<std::size_t>(i)].gyro_ms;
+  }
+  if (!(mean.norm() > 1e-9)) return false;
+  mean.normalize();
+  const double cos_max = std::cos(params_.max_tilt_deg * M_PI / 180.0);
+  for (int i = 0; i < st.held_n; ++i)
+    if (st.held[static_cast<std::size_t>(i)].up.dot(mean) < cos_max) return false;
+  return std::sqrt(w2 / (st.held_n - 1)) < params_.max_gyro_rms_rad_s;
+}
+
+// ---------------------------------------------------------------------------------------------
+void WalkingHeading::update(double t_s, const Eigen::Vector3d& gyro_unbiased,
+                            const Eigen::Vector3d& up) {
+  if (started_) {
+    const double dt = t_s - last_t_s_;
+    if (dt > 0.0 && dt < 1.0) yaw_rad_ += gyro_unbiased.dot(up) * dt;
+  }
+  started_ = true;
+  last_t_s_ = t_s;
+  const std::size_t i = (hist_head_ + hist_size_) % kHistory;
+  hist_t_[i] = t_s;
+  hist_yaw_[i] = yaw_rad_;
+  if (hist_size_ < kHistory)
+    ++hist_size_;
+  else
+    hist_head_ = (hist_head_ + 1) % kHistory;
+}
+
+double WalkingHeading::heading_at(double t_s) const {
+  // Newest first: the last sample at or before t_s (the oldest kept if t_s is older).
+  for (std::size_t k = hist_size_; k-- > 0;) {
+    const std::size_t i = (hist_head_ + k) % kHistory;
+    if (hist_t_[i] <= t_s) return offset_rad_ - hist_yaw_[i];
+  }
+  if (hist_size_ == 0) return heading_rad();
+  return offset_rad_ - hist_yaw_[hist_head_];
+}
+
+// ---------------------------------------------------------------------------------------------
+HandheldPdr::HandheldPdr(Params p, const StepLengthModel& lengths)
+    : params_(p),
+      lengths_(lengths),
+      att_(p.attitude),
+      bias_(p.bias),
+      detector_(p.steps) {}
+
+namespace {
+/// Heading (clockwise from magnetic north) of the horizontal part of `axis`, from the field and
+/// the up direction (same frame); NaN when degenerate.
+double magnetic_heading(const Eigen::Vector3d& mag, const Eigen::Vector3d& up,
+                        const Eigen::Vector3d& axis) {
+  Eigen::Vector3d east = mag.cross(up);
+  if (!(east.norm() > 1e-6)) return std::numeric_limits<double>::quiet_NaN();
+  east.normalize();
+  const Eigen::Vector3d north = up.cross(east);
+  const Eigen::Vector3d h = axis - axis.dot(up) * up;
+  if (!(h.norm() > 0.1)) return std::numeric_limits<double>::quiet_NaN();
+  return std::atan2(h.dot(east), h.dot(north));
+}
+}  // namespace
+
+int HandheldPdr::update(const ImuSample& s, const Eigen::Vector3d& mag_uT) {
+  if (!s.acc_body_m_s2.allFinite() || !s.gyro_body_rad_s.allFinite() || !std::isfinite(s.t_s))
+    return 0;
+  att_.update(s);
+  bias_.update(s);
+  const Eigen::Vector3d up = att_.state().up_body;
+  const Eigen::Vector3d w = s.gyro_body_rad_s - bias_.bias_rad_s();
+  heading_.update(s.t_s, w, up);
+
+  // The track's orientation, once: while standing before the first walk, each magnetometer
+  // sample says offset = (magnetic heading of the forward axis) + yaw (circular mean).
+  if (!oriented_ && params_.orient_with_mag && bias_.quiet() && mag_uT.allFinite()) {
+    const Eigen::Vector3d fwd = Eigen::Vector3d::UnitY() - Eigen::Vector3d::UnitZ();
+    const double h = magnetic_heading(mag_uT, up, fwd);
+    if (std::isfinite(h)) {
+      const double off = h + heading_.yaw_rad();
+      mag_offset_sum_ += Eigen::Vector2d(std::cos(off), std::sin(off));
+      ++mag_n_;
+    }
+  }
+
+  const int n = detector_.update(s, up);
+  if (n > 0 && !oriented_) {
+    oriented_ = true;
+    if (mag_n_ > 0) heading_.set_offset(std::atan2(mag_offset_sum_.y(), mag_offset_sum_.x()));
+  }
+  for (int k = 0; k < n; ++k) {
+    const auto& c = detector_.steps()[static_cast<std::size_t>(k)];
+    if (c.interval_s > 0.0) {
+      intervals_[static_cast<std::size_t>(interval_n_ % 4)] = c.interval_s;
+      ++interval_n_;
+    }
+    // Cadence: the mean of the last four intervals (the walk's own for its first step).
+    double interval = detector_.interval_s();
+    if (interval_n_ > 0) {
+      const int m = std::min(interval_n_, 4);
+      double sum = 0.0;
+      for (int i = 0; i < m; ++i) sum += intervals_[static_cast<std::size_t>(i)];
+      interval = sum / m;
+    }
+    const double hz = interval > 0.0 ? 1.0 / interval : 1.8;
+    const double len =
+        params_.step_scale * lengths_.length_m(PhonePose::kHandHeld, params_.height_m, hz);
+    const double heading = heading_.heading_at(c.t_s);
+    last_.t_s = c.t_s;
+    last_.x_m += len * std::sin(heading);
+    last_.y_m += len * std::cos(heading);
+    last_.heading_deg = std::remainder(heading * 180.0 / M_PI, 360.0);
+    if (last_.heading_deg < 0.0) last_.heading_deg += 360.0;
+    last_.length_m = len;
+    last_.step_hz = hz;
+    last_.distance_m += len;
+    ++last_.steps;
+    laid_[static_cast<std::size_t>(k)] = last_;
+  }
+  return n;
+}
+
+}  // namespace telltale::fusion
