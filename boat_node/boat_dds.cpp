@@ -90,6 +90,9 @@ void BoatDds::join() {
       participant_->topic(dds::kTopicBoatBackfill,
                           fdds::TypeSupport(new msg::BoatAttitudePubSubType())),
       "backfill_writer");
+  fix_writer_ = participant_->writer(
+      participant_->topic(dds::kTopicBoatFix, fdds::TypeSupport(new msg::BoatFixPubSubType())),
+      "fix_writer");
   status_writer_ =
       participant_->writer(participant_->topic(dds::kTopicNodeStatus,
                                                fdds::TypeSupport(new msg::NodeStatusPubSubType())),
@@ -110,12 +113,12 @@ BoatDds::~BoatDds() { participant_.reset(); }
 void BoatDds::rejoin() {
   std::unique_lock lock(mutex_);
   participant_.reset();  // its readers go first: no callback runs during the swap
-  attitude_writer_ = backfill_writer_ = status_writer_ = nullptr;
+  attitude_writer_ = backfill_writer_ = status_writer_ = fix_writer_ = nullptr;
   try {
     join();
   } catch (const dds::DdsError&) {
     participant_.reset();
-    attitude_writer_ = backfill_writer_ = status_writer_ = nullptr;
+    attitude_writer_ = backfill_writer_ = status_writer_ = fix_writer_ = nullptr;
   }
 }
 
@@ -126,6 +129,10 @@ bool BoatDds::publish(msg::BoatAttitude& sample) {
 bool BoatDds::backfill(msg::BoatAttitude& sample) {
   std::shared_lock lock(mutex_);
   return backfill_writer_ && backfill_writer_->write(&sample);
+}
+bool BoatDds::publish(msg::BoatFix& fix) {
+  std::shared_lock lock(mutex_);
+  return fix_writer_ && fix_writer_->write(&fix);
 }
 bool BoatDds::publish(msg::NodeStatus& status) {
   std::shared_lock lock(mutex_);

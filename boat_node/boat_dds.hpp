@@ -1,7 +1,7 @@
 #pragma once
 /// \file
-/// The boat node's DDS role. Publishes BoatAttitude (live, best effort: the write never blocks
-/// the sensor loop), backfill (reliable, from the backfill thread only) and NodeStatus; listens to
+/// The boat node's DDS role. Publishes BoatAttitude and BoatFix (live, best effort: the write
+/// never blocks the sensor loop), backfill (reliable, from the backfill thread only) and NodeStatus; listens to
 /// the shore's receipts for this boat and to the alarm rules and events the shore pushes.
 /// Constructor creates the entities and throws DdsError; destructor deletes them.
 
@@ -38,6 +38,7 @@ class BoatDds {
   bool publish(msg::BoatAttitude& sample);
   /// Reliable; may block up to the profile's max_blocking_time when the shore is slow.
   bool backfill(msg::BoatAttitude& sample);
+  bool publish(msg::BoatFix& fix);
   bool publish(msg::NodeStatus& status);
   [[nodiscard]] int domain() const { return domain_; }
 
@@ -61,6 +62,7 @@ class BoatDds {
   eprosima::fastdds::dds::DataWriter* attitude_writer_ = nullptr;
   eprosima::fastdds::dds::DataWriter* backfill_writer_ = nullptr;
   eprosima::fastdds::dds::DataWriter* status_writer_ = nullptr;
+  eprosima::fastdds::dds::DataWriter* fix_writer_ = nullptr;
 };
 
 }  // namespace telltale::boat

@@ -24,8 +24,10 @@
 #include "backfill.hpp"
 #include "boat_dds.hpp"
 #include "console.hpp"
+#include "course_sim.hpp"
 #include "csv.hpp"
 #include "dds_cli.hpp"
+#include "gnss_input.hpp"
 #include "heading_input.hpp"
 #include "imu_source.hpp"
 #include "session_log.hpp"
@@ -47,6 +49,7 @@ struct Options {
   std::string group;
   std::string source = "sim";
   std::vector<std::string> headings;
+  std::string gnss;
   double variation_deg = std::numeric_limits<double>::quiet_NaN();
   double rate_hz = 25.0;
   double imu_rate_hz = 100.0;
@@ -170,6 +173,13 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   const std::uint64_t seed = o.seed ? o.seed : std::hash<std::string>{}(o.boat_id);
   auto source = telltale::boat::make_imu_source(o.source, seed, o.imu_rate_hz, o.replay,
                                                 [&] { return shutdown.stop_requested(); });
+  // GNSS: an explicit --gnss receiver, else the simulated race course with --source sim.
+  std::unique_ptr<telltale::boat::GnssInput> gnss;
+  if (!o.gnss.empty()) gnss = std::make_unique<telltale::boat::GnssInput>(o.gnss);
+  std::unique_ptr<telltale::boat::CourseSim> course;
+  telltale::boat::GnssGate course_gate;
+  if (!gnss && o.source.rfind("sim", 0) == 0)
+    course = std::make_unique<telltale::boat::CourseSim>(seed);
   std::unique_ptr<telltale::boat::HeadingInput> heading;
   if (!o.headings.empty())
     heading = std::make_unique<telltale::boat::HeadingInput>(o.headings, o.variation_deg);
@@ -262,9 +272,10 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
                                                     static_cast<std::uint8_t>(o.leds_per_bar)};
 
   std::printf(
-      "boat_node ready: boat=%s domain=%d source=%s rate=%gHz boot=%016llx log=%s "
+      "boat_node ready: boat=%s domain=%d source=%s gnss=%s rate=%gHz boot=%016llx log=%s "
       "earlier_runs=%zu\n",
-      o.boat_id.c_str(), dds.domain(), source->describe().c_str(), o.rate_hz,
+      o.boat_id.c_str(), dds.domain(), source->describe().c_str(),
+      gnss ? gnss->describe().c_str() : (course ? "sim:course" : "none"), o.rate_hz,
       static_cast<unsigned long long>(boot_id), o.log_dir.c_str(), earlier->pending());
   std::fflush(stdout);
 
@@ -284,6 +295,25 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   auto next_console = start;
   auto next_flush = start + std::chrono::seconds(1);
   std::string addresses = local_addresses();
+  telltale::msg::BoatFix fix_msg;
+  fix_msg.boat_id(o.boat_id);
+  fix_msg.boot_id(boot_id);
+  std::uint64_t fix_seq = 0;
+  std::vector<telltale::boat::GnssFix> fixes;
+  double next_course_s = 0.0;
+  const auto publish_fix = [&](const telltale::boat::GnssFix& f, unsigned long long t_utc_ns) {
+    fix_msg.seq(++fix_seq);
+    fix_msg.t_utc_ns(t_utc_ns);
+    fix_msg.gnss_utc_ns(f.gnss_utc_ns);
+    fix_msg.lat_deg(f.lat_deg);
+    fix_msg.lon_deg(f.lon_deg);
+    fix_msg.sog_m_s(f.sog_m_s);
+    fix_msg.cog_deg(f.cog_deg);
+    fix_msg.fix(static_cast<telltale::msg::FixKind>(f.fix));
+    fix_msg.satellites(static_cast<std::uint8_t>(f.satellites));
+    fix_msg.hdop(static_cast<float>(f.hdop));
+    if (!dds.publish(fix_msg)) ++write_failures;
+  };
 
   while (!shutdown.stop_requested()) {
     const auto sample = source->next();
@@ -310,6 +340,16 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       continue;
     }
     filter.update(mounting.apply(*sample));
+
+    // GNSS: the receiver's fixes as they come; the simulated course at 10 Hz on the sample clock.
+    if (gnss) {
+      gnss->take(fixes);
+      for (const auto& f : fixes) publish_fix(f, telltale::utc_now_ns());
+    } else if (course && t + 1e-9 >= next_course_s) {
+      next_course_s = t + 0.1;
+      const unsigned long long t_ns = start_utc_ns + static_cast<unsigned long long>(t * 1e9);
+      if (auto f = course_gate.on_epoch(course->at(t, t_ns), t, t_ns)) publish_fix(*f, t_ns);
+    }
 
     if (t + 1e-9 >= next_publish_s) {
       next_publish_s += publish_period_s;
@@ -403,6 +443,23 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       if (!backfiller->shore_seen()) text += "; no shore receipt yet";
       if (const auto n = earlier->pending())
         text += "; delivering " + std::to_string(n) + " earlier run(s) from the log";
+      if (gnss) {
+        const auto gs = gnss->stats();
+        if (!gs.connected) text += "; gnss not connected";
+        if (gs.gate.epochs == 0) {
+          text += "; gnss: no data";
+        } else if (gs.gate.fixes == 0) {
+          text += "; gnss: no fix";
+        }
+        if (gs.gate.jumps) text += "; gnss jumps " + std::to_string(gs.gate.jumps);
+        const auto bad = gs.nmea.bad_checksum + gs.nmea.malformed + gs.nmea.missing_checksum;
+        if (bad) text += "; gnss bad lines " + std::to_string(bad);
+        if (std::isfinite(gs.clock_offset_s) && std::abs(gs.clock_offset_s) > 1.0) {
+          char buf[48];
+          std::snprintf(buf, sizeof buf, "; clock %+.1f s vs gnss", gs.clock_offset_s);
+          text += buf;
+        }
+      }
       status.t_utc_ns(telltale::utc_now_ns());
       status.uptime_s(std::chrono::duration<double>(now - start).count());
       status.samples_published(seq);
@@ -429,9 +486,10 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   const std::size_t earlier_pending = earlier->pending();
   earlier.reset();
   std::printf(
-      "boat_node stopped: boat=%s published=%llu resent=%llu shore_has_all=%s bad_samples=%u "
-      "acked=%llu backfill_failures=%llu earlier_runs_pending=%zu\n",
+      "boat_node stopped: boat=%s published=%llu fixes=%llu resent=%llu shore_has_all=%s "
+      "bad_samples=%u acked=%llu backfill_failures=%llu earlier_runs_pending=%zu\n",
       o.boat_id.c_str(), static_cast<unsigned long long>(seq),
+      static_cast<unsigned long long>(fix_seq),
       static_cast<unsigned long long>(backfiller->resent()), complete ? "yes" : "no", bad_samples,
       static_cast<unsigned long long>(backfiller->acked()),
       static_cast<unsigned long long>(backfiller->send_failures()), earlier_pending);
@@ -454,6 +512,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--heading", o.headings,
                  "heading sensor, repeatable: nmea:DEVICE[@BAUD] | nmea:udp:[ADDR:]PORT");
+  app.add_option("--gnss", o.gnss,
+                 "GNSS receiver: gpsd[:HOST[:PORT]] | nmea:DEVICE[@BAUD] | nmea:udp:[ADDR:]PORT "
+                 "(default with --source sim: a simulated race course)");
   app.add_option("--variation-deg", o.variation_deg,
                  "magnetic variation (E positive) to use HDM/HDG sentences without one");
   app.add_option("--rate-hz", o.rate_hz, "publish rate, Hz")->capture_default_str();

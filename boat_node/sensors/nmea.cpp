@@ -1,4 +1,4 @@
-// NMEA 0183 heading sentences: parser, line assembler, serial and UDP readers (see nmea.hpp).
+// NMEA 0183: framing, heading sentences, line assembler, serial and UDP readers (see nmea.hpp).
 #include "nmea.hpp"
 
 #include "serial_port.hpp"
@@ -34,9 +34,33 @@ int hex_value(char c) {
 
 using fusion::wrap_360_deg;
 
-/// Strict unsigned decimal: digits with at most one '.', nothing else ("nan", "1e3", "-2",
-/// " 5" are all rejected). from_chars alone would accept "nan" and "inf".
-bool parse_number(std::string_view f, double& out) {
+/// Optional signed angle: empty -> NaN with ok; "x.x" + 'E'/'W' -> +x / -x.
+bool parse_signed(std::string_view value, std::string_view dir, double& out) {
+  if (value.empty() && dir.empty()) {
+    out = kNaN;
+    return true;
+  }
+  double v = 0.0;
+  if (!parse_nmea_number(value, v) || v > 180.0) return false;
+  if (dir == "E") {
+    out = v;
+  } else if (dir == "W") {
+    out = -v;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+bool parse_heading_field(std::string_view f, double& out) {
+  if (!parse_nmea_number(f, out) || out > 360.0) return false;
+  out = wrap_360_deg(out);
+  return true;
+}
+
+}  // namespace
+
+bool parse_nmea_number(std::string_view f, double& out) {
   if (f.empty() || f.size() > 16) return false;
   int dots = 0;
   int digits = 0;
@@ -54,46 +78,46 @@ bool parse_number(std::string_view f, double& out) {
   return r.ec == std::errc() && r.ptr == f.data() + f.size() && std::isfinite(out);
 }
 
-/// Splits "a,b,c" into at most N fields; returns the field count (N + 1 if there are more).
-template <std::size_t N>
-std::size_t split_fields(std::string_view s, std::array<std::string_view, N>& out) {
-  std::size_t n = 0;
-  std::size_t start = 0;
-  for (std::size_t i = 0; i <= s.size(); ++i) {
-    if (i == s.size() || s[i] == ',') {
-      if (n == N) return N + 1;
-      out[n++] = s.substr(start, i - start);
-      start = i + 1;
-    }
+NmeaStatus frame_nmea(std::string_view line, const NmeaParseOptions& options, NmeaFrame& out) {
+  while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.remove_suffix(1);
+  if (line.size() > kNmeaMaxLine) return NmeaStatus::kTooLong;
+  if (line.size() < 6 || line[0] != '$') return NmeaStatus::kNotNmea;
+  for (std::size_t i = 1; i < 6; ++i) {
+    const char c = line[i];
+    if (!((c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9'))) return NmeaStatus::kNotNmea;
   }
-  return n;
-}
-
-/// Optional signed angle: empty -> NaN with ok; "x.x" + 'E'/'W' -> +x / -x.
-bool parse_signed(std::string_view value, std::string_view dir, double& out) {
-  if (value.empty() && dir.empty()) {
-    out = kNaN;
-    return true;
+  // Checksum: XOR of everything between '$' and '*'.
+  std::string_view body = line.substr(1);
+  const std::size_t star = body.find('*');
+  out.had_checksum = false;
+  if (star != std::string_view::npos) {
+    const std::string_view cs = body.substr(star + 1);
+    body = body.substr(0, star);
+    if (cs.size() != 2 || hex_value(cs[0]) < 0 || hex_value(cs[1]) < 0)
+      return NmeaStatus::kBadChecksum;
+    unsigned sum = 0;
+    for (char c : body) sum ^= static_cast<unsigned char>(c);
+    if (sum != static_cast<unsigned>(hex_value(cs[0]) * 16 + hex_value(cs[1])))
+      return NmeaStatus::kBadChecksum;
+    out.had_checksum = true;
+  } else if (!options.accept_missing_checksum) {
+    return NmeaStatus::kMissingChecksum;
   }
-  double v = 0.0;
-  if (!parse_number(value, v) || v > 180.0) return false;
-  if (dir == "E") {
-    out = v;
-  } else if (dir == "W") {
-    out = -v;
+  for (char c : body) {
+    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) > 0x7e)
+      return NmeaStatus::kMalformed;
+  }
+  out.talker = {body[0], body[1], '\0'};
+  out.type = body.substr(2, 3);
+  if (body.size() == 5) {
+    out.fields = {};
+  } else if (body[5] == ',') {
+    out.fields = body.substr(6);
   } else {
-    return false;
+    return NmeaStatus::kMalformed;
   }
-  return true;
+  return NmeaStatus::kOk;
 }
-
-bool parse_heading_field(std::string_view f, double& out) {
-  if (!parse_number(f, out) || out > 360.0) return false;
-  out = wrap_360_deg(out);
-  return true;
-}
-
-}  // namespace
 
 const char* nmea_status_name(NmeaStatus s) {
   switch (s) {
@@ -117,56 +141,19 @@ const char* nmea_status_name(NmeaStatus s) {
 
 NmeaParseResult parse_nmea_heading(std::string_view line, const NmeaParseOptions& options) {
   NmeaParseResult res;
-  while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.remove_suffix(1);
-  if (line.size() > kNmeaMaxLine) {
-    res.status = NmeaStatus::kTooLong;
-    return res;
-  }
-  if (line.size() < 6 || line[0] != '$') return res;  // kNotNmea
-  for (std::size_t i = 1; i < 6; ++i) {
-    const char c = line[i];
-    if (!((c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9'))) return res;
-  }
-  // Checksum: XOR of everything between '$' and '*'.
-  std::string_view body = line.substr(1);
-  const std::size_t star = body.find('*');
-  if (star != std::string_view::npos) {
-    const std::string_view cs = body.substr(star + 1);
-    body = body.substr(0, star);
-    if (cs.size() != 2 || hex_value(cs[0]) < 0 || hex_value(cs[1]) < 0) {
-      res.status = NmeaStatus::kBadChecksum;
-      return res;
-    }
-    unsigned sum = 0;
-    for (char c : body) sum ^= static_cast<unsigned char>(c);
-    if (sum != static_cast<unsigned>(hex_value(cs[0]) * 16 + hex_value(cs[1]))) {
-      res.status = NmeaStatus::kBadChecksum;
-      return res;
-    }
-    res.heading.had_checksum = true;
-  } else if (!options.accept_missing_checksum) {
-    res.status = NmeaStatus::kMissingChecksum;
-    return res;
-  }
-  for (char c : body) {
-    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) > 0x7e) {
-      res.status = NmeaStatus::kMalformed;
-      return res;
-    }
-  }
-  const std::string_view type = body.substr(2, 3);
+  NmeaFrame frame;
+  res.status = frame_nmea(line, options, frame);
+  if (res.status != NmeaStatus::kOk) return res;
   NmeaHeading& h = res.heading;
-  h.talker = {body[0], body[1], '\0'};
+  h.had_checksum = frame.had_checksum;
+  h.talker = frame.talker;
+  const std::string_view type = frame.type;
   if (type != "HDT" && type != "HDG" && type != "HDM") {
     res.status = NmeaStatus::kUnsupported;
     return res;
   }
-  if (body.size() < 6 || body[5] != ',') {
-    res.status = NmeaStatus::kMalformed;
-    return res;
-  }
   std::array<std::string_view, 5> f{};
-  const std::size_t n = split_fields(body.substr(6), f);
+  const std::size_t n = split_nmea_fields(frame.fields, f);
   res.status = NmeaStatus::kMalformed;
   h.deviation_deg = kNaN;
   h.variation_deg = kNaN;
@@ -261,7 +248,7 @@ void NmeaStreamReader::stop() {
 NmeaReaderStats NmeaStreamReader::stats() const {
   NmeaReaderStats s;
   s.bytes = bytes_.load();
-  s.headings = headings_.load();
+  s.accepted = accepted_.load();
   s.unsupported = unsupported_.load();
   s.bad_checksum = bad_checksum_.load();
   s.missing_checksum = missing_checksum_.load();
@@ -271,12 +258,10 @@ NmeaReaderStats NmeaStreamReader::stats() const {
 }
 
 void NmeaStreamReader::on_line(std::string_view line, NmeaClock::time_point t,
-                               const NmeaHeadingCallback& cb) {
-  const NmeaParseResult r = parse_nmea_heading(line, options_);
-  switch (r.status) {
+                               const NmeaLineHandler& handler) {
+  switch (handler(line, t)) {
     case NmeaStatus::kOk:
-      ++headings_;
-      if (cb) cb(r.heading, t);
+      ++accepted_;
       break;
     case NmeaStatus::kUnsupported:
       ++unsupported_;
@@ -303,6 +288,14 @@ void NmeaStreamReader::account_assembler() {
 }
 
 bool NmeaStreamReader::poll_once(int timeout_ms, const NmeaHeadingCallback& cb) {
+  return poll_lines(timeout_ms, [this, &cb](std::string_view line, NmeaClock::time_point t) {
+    const NmeaParseResult r = parse_nmea_heading(line, options_);
+    if (r.status == NmeaStatus::kOk && cb) cb(r.heading, t);
+    return r.status;
+  });
+}
+
+bool NmeaStreamReader::poll_lines(int timeout_ms, const NmeaLineHandler& handler) {
   if (stopped_.load()) return false;
   pollfd fds[2] = {{fd_, POLLIN, 0}, {stop_pipe_[0], POLLIN, 0}};
   const int r = ::poll(fds, 2, timeout_ms);
@@ -310,7 +303,7 @@ bool NmeaStreamReader::poll_once(int timeout_ms, const NmeaHeadingCallback& cb) 
   if (stopped_.load() || (fds[1].revents & POLLIN) != 0) return false;
   if (r == 0) return true;
   if ((fds[0].revents & POLLIN) != 0) {
-    const bool ok = read_available(cb);
+    const bool ok = read_available(handler);
     account_assembler();
     return ok;
   }
@@ -328,7 +321,7 @@ NmeaSerialReader::NmeaSerialReader(const std::string& device, int baud, NmeaPars
   attach(open_serial_raw(device, baud));
 }
 
-bool NmeaSerialReader::read_available(const NmeaHeadingCallback& cb) {
+bool NmeaSerialReader::read_available(const NmeaLineHandler& handler) {
   std::array<char, 512> buf{};
   const ssize_t n = ::read(fd(), buf.data(), buf.size());
   if (n < 0) return errno == EAGAIN || errno == EINTR;
@@ -336,7 +329,7 @@ bool NmeaSerialReader::read_available(const NmeaHeadingCallback& cb) {
   bytes_ += static_cast<std::uint64_t>(n);
   const auto t = NmeaClock::now();
   assembler_.feed(buf.data(), static_cast<std::size_t>(n),
-                  [&](std::string_view line) { on_line(line, t, cb); });
+                  [&](std::string_view line) { on_line(line, t, handler); });
   return true;
 }
 
@@ -363,14 +356,14 @@ NmeaUdpReader::NmeaUdpReader(const std::string& address, std::uint16_t port,
   port_ = ntohs(sa.sin_port);
 }
 
-bool NmeaUdpReader::read_available(const NmeaHeadingCallback& cb) {
+bool NmeaUdpReader::read_available(const NmeaLineHandler& handler) {
   std::array<char, 2048> buf{};
   for (;;) {
     const ssize_t n = ::recv(fd(), buf.data(), buf.size(), 0);
     if (n < 0) return errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR;
     bytes_ += static_cast<std::uint64_t>(n);
     const auto t = NmeaClock::now();
-    const auto line = [&](std::string_view l) { on_line(l, t, cb); };
+    const auto line = [&](std::string_view l) { on_line(l, t, handler); };
     assembler_.feed(buf.data(), static_cast<std::size_t>(n), line);
     assembler_.end_of_record(line);
   }

@@ -1,14 +1,17 @@
 #pragma once
 /// \file
-/// NMEA 0183 heading input for the boat node: `HDT`, `HDG` and `HDM` sentences from any talker,
-/// parsed from a serial device or a UDP port.
+/// NMEA 0183 for the boat node: framing (address, checksum), the heading sentences `HDT`, `HDG`
+/// and `HDM` from any talker, and the readers of a serial device or a UDP port. The GNSS
+/// sentences are parsed in nmea_gnss.hpp on the same framing and readers.
 ///
 /// Layers, each usable alone:
+/// - frame_nmea(): one line -> talker, sentence type and fields, or the reason it is not a
+///   sentence (checksum, address, characters, length). Never throws.
 /// - parse_nmea_heading(): one line -> a heading or the reason it is not one. Never throws.
 /// - NmeaLineAssembler: a byte stream (partial reads, CR, LF or CRLF, garbage between sentences,
 ///   over-long lines) -> complete lines starting with '$'. Fixed buffer, never grows.
-/// - NmeaSerialReader / NmeaUdpReader: poll() a file descriptor, hand every parsed heading to a
-///   callback with its receive time, count what was skipped; stop() from any thread.
+/// - NmeaSerialReader / NmeaUdpReader: poll() a file descriptor, hand every line to a parser
+///   (heading or GNSS) with its receive time, count what was skipped; stop() from any thread.
 ///
 /// Decisions (NMEA 0183 leaves them to the receiver):
 /// - Checksum: verified whenever "*hh" is present (hex, either case). A sentence WITHOUT a
@@ -67,6 +70,38 @@ struct NmeaParseOptions {
   bool accept_missing_checksum = false;  ///< see the file comment
 };
 
+/// One framed sentence: views into the line handed to frame_nmea().
+struct NmeaFrame {
+  std::array<char, 3> talker{};  ///< two letters and a NUL
+  std::string_view type;         ///< three letters: "RMC", "HDT", ...
+  std::string_view fields;       ///< everything after "$TTSSS," up to '*' (may be empty)
+  bool had_checksum = false;
+};
+
+/// Checks the address, the checksum, the characters and the length of one line (trailing CR/LF
+/// allowed). kOk fills `out`; otherwise the reason. Never throws, never allocates.
+[[nodiscard]] NmeaStatus frame_nmea(std::string_view line, const NmeaParseOptions& options,
+                                    NmeaFrame& out);
+
+/// Splits "a,b,c" into at most N fields; returns the field count (N + 1 if there are more).
+template <std::size_t N>
+std::size_t split_nmea_fields(std::string_view s, std::array<std::string_view, N>& out) {
+  std::size_t n = 0;
+  std::size_t start = 0;
+  for (std::size_t i = 0; i <= s.size(); ++i) {
+    if (i == s.size() || s[i] == ',') {
+      if (n == N) return N + 1;
+      out[n++] = s.substr(start, i - start);
+      start = i + 1;
+    }
+  }
+  return n;
+}
+
+/// Strict unsigned decimal: digits with at most one '.', nothing else ("nan", "1e3", "-2",
+/// " 5" are all rejected: from_chars alone would accept "nan" and "inf").
+[[nodiscard]] bool parse_nmea_number(std::string_view f, double& out);
+
 struct NmeaParseResult {
   NmeaStatus status = NmeaStatus::kNotNmea;
   NmeaHeading heading{};  ///< valid when status == kOk
@@ -106,7 +141,7 @@ class NmeaLineAssembler {
 /// What a reader saw, by outcome.
 struct NmeaReaderStats {
   std::uint64_t bytes = 0;
-  std::uint64_t headings = 0;  ///< handed to the callback
+  std::uint64_t accepted = 0;  ///< sentences the parser took (headings, GNSS sentences)
   std::uint64_t unsupported = 0;
   std::uint64_t bad_checksum = 0;
   std::uint64_t missing_checksum = 0;
@@ -117,6 +152,9 @@ struct NmeaReaderStats {
 using NmeaClock = std::chrono::steady_clock;
 /// Called on the reader's thread for every heading, with the time its bytes were read.
 using NmeaHeadingCallback = std::function<void(const NmeaHeading&, NmeaClock::time_point)>;
+/// Called on the reader's thread for every line, with the time its bytes were read; returns
+/// what the line was (kOk when taken), which the reader counts.
+using NmeaLineHandler = std::function<NmeaStatus(std::string_view, NmeaClock::time_point)>;
 
 /// Common poll loop of the readers (a file descriptor plus a self-pipe for stop()).
 class NmeaStreamReader {
@@ -125,22 +163,25 @@ class NmeaStreamReader {
   NmeaStreamReader& operator=(const NmeaStreamReader&) = delete;
   virtual ~NmeaStreamReader();
 
-  /// Waits up to timeout_ms for data, parses what came, calls `cb`. Returns false once stopped
-  /// or when the device is gone (EOF, hang-up, read error).
+  /// Waits up to timeout_ms for data, hands every line that came to `handler`. Returns false
+  /// once stopped or when the device is gone (EOF, hang-up, read error).
+  bool poll_lines(int timeout_ms, const NmeaLineHandler& handler);
+  /// Headings: poll_lines with parse_nmea_heading, `cb` called for every heading.
   bool poll_once(int timeout_ms, const NmeaHeadingCallback& cb);
   /// Loops poll_once until stop() or the device is gone.
   void run(const NmeaHeadingCallback& cb);
   /// Thread-safe and async-signal-safe: makes run() return within one poll.
   void stop();
   [[nodiscard]] NmeaReaderStats stats() const;
+  [[nodiscard]] const NmeaParseOptions& options() const { return options_; }
 
  protected:
   explicit NmeaStreamReader(NmeaParseOptions options);
   /// Takes ownership of fd (closed in the destructor). Throws std::system_error.
   void attach(int fd);
   /// Reads once from fd into the assembler; false at EOF/error.
-  virtual bool read_available(const NmeaHeadingCallback& cb) = 0;
-  void on_line(std::string_view line, NmeaClock::time_point t, const NmeaHeadingCallback& cb);
+  virtual bool read_available(const NmeaLineHandler& handler) = 0;
+  void on_line(std::string_view line, NmeaClock::time_point t, const NmeaLineHandler& handler);
   /// Publishes the assembler's counters to the atomics stats() reads.
   void account_assembler();
   [[nodiscard]] int fd() const { return fd_; }
@@ -151,7 +192,7 @@ class NmeaStreamReader {
   int fd_ = -1;
   int stop_pipe_[2] = {-1, -1};
   std::atomic<bool> stopped_{false};
-  std::atomic<std::uint64_t> bytes_{0}, headings_{0}, unsupported_{0}, bad_checksum_{0},
+  std::atomic<std::uint64_t> bytes_{0}, accepted_{0}, unsupported_{0}, bad_checksum_{0},
       missing_checksum_{0}, malformed_{0}, garbage_{0};
   std::uint64_t assembler_dropped_ = 0;  ///< overlong + truncated already added to malformed_
 
@@ -167,7 +208,7 @@ class NmeaSerialReader : public NmeaStreamReader {
   NmeaSerialReader(const std::string& device, int baud = 4800, NmeaParseOptions options = {});
 
  private:
-  bool read_available(const NmeaHeadingCallback& cb) override;
+  bool read_available(const NmeaLineHandler& handler) override;
 };
 
 /// A UDP socket bound to `address:port` (port 0: the OS picks one, see port()). One or more
@@ -180,7 +221,7 @@ class NmeaUdpReader : public NmeaStreamReader {
   [[nodiscard]] std::uint16_t port() const { return port_; }
 
  private:
-  bool read_available(const NmeaHeadingCallback& cb) override;
+  bool read_available(const NmeaLineHandler& handler) override;
   std::uint16_t port_ = 0;
 };
 

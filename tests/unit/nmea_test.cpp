@@ -250,7 +250,7 @@ TEST(NmeaSerial, ReadsAPseudoTerminalInPiecesAndStopsCleanly) {
   for (int i = 0; i < 20; ++i)
     EXPECT_DOUBLE_EQ(got.h[static_cast<std::size_t>(i)].true_deg, i + 0.5);
   EXPECT_EQ(reader.stats().bad_checksum, 1u);
-  EXPECT_EQ(reader.stats().headings, 20u);
+  EXPECT_EQ(reader.stats().accepted, 20u);
   EXPECT_GT(reader.stats().garbage_bytes, 0u);
   ::close(master);
 }
