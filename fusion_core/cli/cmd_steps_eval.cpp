@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -17,6 +18,7 @@
 
 #include "commands.hpp"
 #include "gait_io.hpp"
+#include "telltale/fusion/handheld_pdr.hpp"
 #include "telltale/fusion/sim/gait_sim.hpp"
 #include "telltale/fusion/sim/pose_dataset.hpp"
 #include "telltale/fusion/steps.hpp"
@@ -31,7 +33,7 @@ struct EvalOptions {
   std::string oxford_dir;
   /// The real recordings (SPEC section 7): --data, else $TELLTALE_DATA, else ../shared/data.
   std::string data_dir;
-  std::string tables = "gait,ipol,oxford,pose,pdr";
+  std::string tables = "gait,ipol,oxford,pose,pdr,ipin";
   int loops = 40;
   /// First loop seed: 2001 is the report set; the PDR was tuned on 100-139 (--first-seed 100).
   int first_seed = 2001;
@@ -353,6 +355,114 @@ void pdr_table(int loops, int first_seed) {
   }
 }
 
+/// IPIN 2023 phone walks (DATA/ipin_pdr/, README.md there), scored as that README says: the
+/// track of `fusion_cli pdr --height-m 1.75` (HandheldPdr, no calibration walk) between the first
+/// and last landmark times; (a) the distance walked (the track's polyline from its position at
+/// the first landmark through every step up to the last landmark's time) within 10 % of the
+/// landmark polyline's length, (b) loop closure (the track's positions at the first and last
+/// landmark times apart) in % of that length, goal <= 2 % on >= 90 % of walks. The position at
+/// a time is that of the last step at or before it.
+void ipin_table(const EvalOptions& o) {
+  namespace fs = std::filesystem;
+  const std::string dir = data_dir(o) + "/ipin_pdr";
+  std::vector<std::string> names;
+  if (fs::is_directory(dir))
+    for (const auto& e : fs::directory_iterator(dir)) {
+      const std::string f = e.path().filename().string();
+      const std::string suffix = ".imu.csv";
+      if (f.size() > suffix.size() && f.compare(f.size() - suffix.size(), suffix.size(), suffix) == 0)
+        names.push_back(f.substr(0, f.size() - suffix.size()));
+    }
+  if (names.empty()) {
+    std::printf("\n(no IPIN walks found in %s: table skipped; --data DIR)\n", dir.c_str());
+    return;
+  }
+  std::sort(names.begin(), names.end());
+  std::printf(
+      "\n## IPIN 2023 phone walks (%s, height 1.75 m, no calibration walk): between the first and "
+      "last landmark\n\n| walk | landmark polyline m | walked m | ratio | closure %% | steps |\n"
+      "|---|---|---|---|---|---|\n",
+      dir.c_str());
+  std::vector<double> ratios, closures;
+  for (const auto& name : names) {
+    std::ifstream posi(dir + "/" + name + ".posi.csv");
+    std::string line;
+    std::getline(posi, line);  // t_s,east_m,north_m
+    std::vector<std::array<double, 3>> marks;
+    while (std::getline(posi, line)) {
+      std::array<double, 3> m{};
+      if (std::sscanf(line.c_str(), "%lf,%lf,%lf", &m[0], &m[1], &m[2]) == 3) marks.push_back(m);
+    }
+    if (marks.size() < 2) {
+      std::printf("| %s | (no landmarks) | | | | |\n", name.c_str());
+      continue;
+    }
+    const auto records = read_imu_csv(dir + "/" + name + ".imu.csv", false);
+    fusion::HandheldPdrParams params;
+    params.height_m = 1.75;
+    fusion::HandheldPdr pdr(params);
+    std::vector<std::array<double, 3>> track;  // t, x, y: one row per step
+    for (const auto& r : records) {
+      const int n = pdr.update(r.imu, r.mag_uT);
+      for (int k = 0; k < n; ++k) {
+        const auto& st = pdr.steps()[static_cast<std::size_t>(k)];
+        track.push_back({st.t_s, st.x_m, st.y_m});
+      }
+    }
+    const double t0 = marks.front()[0], t1 = marks.back()[0];
+    double poly = 0.0;
+    for (std::size_t i = 1; i < marks.size(); ++i)
+      poly += std::hypot(marks[i][1] - marks[i - 1][1], marks[i][2] - marks[i - 1][2]);
+    auto pos_at = [&track](double t) {
+      std::array<double, 2> p{0.0, 0.0};
+      for (const auto& r : track) {
+        if (r[0] > t) break;
+        p = {r[1], r[2]};
+      }
+      return p;
+    };
+    const auto a = pos_at(t0), b = pos_at(t1);
+    double walked = 0.0;
+    std::array<double, 2> prev = a;
+    std::size_t steps = 0;
+    for (const auto& r : track) {
+      if (r[0] < t0 || r[0] > t1) continue;
+      walked += std::hypot(r[1] - prev[0], r[2] - prev[1]);
+      prev = {r[1], r[2]};
+      ++steps;
+    }
+    const double ratio = walked / poly;
+    const double closure = 100.0 * std::hypot(b[0] - a[0], b[1] - a[1]) / poly;
+    ratios.push_back(ratio);
+    closures.push_back(closure);
+    std::printf("| %s | %.1f | %.1f | %.3f | %.2f | %zu |\n", name.c_str(), poly, walked, ratio,
+                closure, steps);
+    std::fflush(stdout);
+  }
+  if (ratios.empty()) return;
+  auto mean = [](const std::vector<double>& v) {
+    double s = 0.0;
+    for (double x : v) s += x;
+    return s / static_cast<double>(v.size());
+  };
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  };
+  const auto within10 =
+      std::count_if(ratios.begin(), ratios.end(), [](double r) { return std::fabs(r - 1.0) <= 0.1; });
+  const auto closed =
+      std::count_if(closures.begin(), closures.end(), [](double c) { return c <= 2.0; });
+  std::printf("| mean | | | %.3f | %.2f | |\n| median | | | %.3f | %.2f | |\n", mean(ratios),
+              mean(closures), median(ratios), median(closures));
+  std::printf("\n(a) distance within 10 %%: %ld / %zu walks; (b) closure <= 2 %%: %ld / %zu walks "
+              "(goal: >= 90 %%)\n",
+              static_cast<long>(within10), ratios.size(), static_cast<long>(closed),
+              closures.size());
+  std::fflush(stdout);
+}
+
 void run_eval(const EvalOptions& o) {
   if (o.tables.find("gait") != std::string::npos) gait_table(o);
   if (o.tables.find("ipol") != std::string::npos) {
@@ -362,6 +472,7 @@ void run_eval(const EvalOptions& o) {
   if (o.tables.find("oxford") != std::string::npos) oxford_table(o);
   if (o.tables.find("pose") != std::string::npos) pose_table();
   if (o.tables.find("pdr") != std::string::npos) pdr_table(o.loops, o.first_seed);
+  if (o.tables.find("ipin") != std::string::npos) ipin_table(o);
 }
 
 }  // namespace
@@ -373,7 +484,7 @@ void register_steps_eval(CLI::App& app) {
                                  "traces, pose classifier, PDR closed loops");
   cmd->add_option("--people", opts->people, "simulated people per gait")->capture_default_str();
   cmd->add_option("--data", opts->data_dir,
-                  "folder of the real recordings (ipol_gait/, oxford_steps/); default: "
+                  "folder of the real recordings (ipol_gait/, oxford_steps/, ipin_pdr/); default: "
                   "$TELLTALE_DATA, else ../shared/data (relative to the working directory)");
   cmd->add_option("--oxford", opts->oxford_dir,
                   "Oxford step traces (default: DATA/oxford_steps, then tests/data/oxford_steps)");
@@ -384,7 +495,7 @@ void register_steps_eval(CLI::App& app) {
                   "seeds 1-23 trained the model)")
       ->check(CLI::Range(24, 1000000000))
       ->capture_default_str();
-  cmd->add_option("--tables", opts->tables, "comma list: gait, ipol, oxford, pose, pdr")
+  cmd->add_option("--tables", opts->tables, "comma list: gait, ipol, oxford, pose, pdr, ipin (IPIN 2023 phone walks, DATA/ipin_pdr)")
       ->capture_default_str();
   cmd->callback([opts] { run_eval(*opts); });
 }
