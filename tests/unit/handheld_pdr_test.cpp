@@ -1,0 +1,258 @@
+// HandheldPdr (issue 19 item 2) on synthetic phone walks that carry what the IPIN 2023 walks
+// showed (the real logs may not be copied here): a phone handled at random first (rotations of
+// 2-7 rad/s, the hand's jerks), then held in front of a walker standing still (hand tremor, a
+// slow yaw wander), then a closed loop walked with the phone held in front (tilted 50 deg toward
+// the face, like the logs), with pauses at corners. The gyro carries a constant bias.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "telltale/fusion/handheld_pdr.hpp"
+
+namespace {
+
+using telltale::fusion::HandheldPdr;
+using telltale::fusion::HandheldPdrParams;
+using telltale::fusion::HandheldStep;
+using telltale::fusion::ImuSample;
+using telltale::fusion::PhonePose;
+
+constexpr double kG = 9.80665;
+constexpr double kRate = 50.0;
+constexpr double kTilt = 50.0 * M_PI / 180.0;  // phone's screen tilted toward the face
+
+enum class Phase { kHandling, kStanding, kWalking, kPause };
+
+struct Segment {
+  Phase phase;
+  double duration_s;
+  double turn_deg = 0.0;  ///< heading change over the segment (walking: a corner at its start)
+};
+
+struct Truth {
+  double distance_m = 0.0;
+  double steps = 0.0;
+  double x_m = 0.0, y_m = 0.0;  ///< where the walk ends (it starts at 0, 0)
+  double heading_rad = 0.0;     ///< walking direction at the end
+  std::vector<std::pair<double, double>> quiet;  ///< [t0, t1] of handling, standing, pauses
+};
+
+/// Phone -> world (ENU) for a walker heading `heading` (clockwise from north): x right, y up the
+/// screen (forward and up), z out of the screen (toward the face).
+Eigen::Matrix3d held_in_front(double heading, double extra_pitch = 0.0) {
+  const Eigen::Vector3d fwd(std::sin(heading), std::cos(heading), 0.0);
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d right(std::cos(heading), -std::sin(heading), 0.0);
+  const double a = kTilt + extra_pitch;
+  Eigen::Matrix3d r;
+  r.col(0) = right;
+  r.col(1) = fwd * std::cos(a) + up * std::sin(a);
+  r.col(2) = -fwd * std::sin(a) + up * std::cos(a);
+  return r;
+}
+
+struct Walk {
+  std::vector<ImuSample> samples;
+  Truth truth;
+};
+
+/// The step's true length: the population model's own at this height and cadence, so the test
+/// checks the pipeline (counting, gating, heading), not the model.
+double true_step_length(double step_hz) {
+  return telltale::fusion::builtin_step_length_model().length_m(PhonePose::kHandHeld, 1.75,
+                                                                step_hz);
+}
+
+Walk synthesise(const std::vector<Segment>& plan, const Eigen::Vector3d& gyro_bias,
+                unsigned seed, double step_hz = 1.8) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  Walk w;
+  const double dt = 1.0 / kRate;
+  const double step_len = true_step_length(step_hz);
+  const double speed = step_len * step_hz;
+  double t = 0.0, heading = 0.3, walk_phase = 0.0;
+  // Orientations and world accelerations sampled; the gyro is the rotation between samples.
+  std::vector<Eigen::Matrix3d> rot;
+  std::vector<Eigen::Vector3d> acc_world;
+  std::vector<double> times;
+  for (const auto& seg : plan) {
+    const double t_start = t;
+    const int n = static_cast<int>(seg.duration_s * kRate);
+    // Handling: a random rotation axis and angle per 1.5 s, in and out smoothly, and the hand's
+    // jerks (the angles reach 60-170 deg: rates of 2-7 rad/s).
+    Eigen::Vector3d axis = Eigen::Vector3d::UnitX();
+    double angle = 0.0;
+    const double heading0 = heading;
+    for (int i = 0; i < n; ++i, t += dt) {
+      const double ts = t - t_start;
+      Eigen::Matrix3d r;
+      Eigen::Vector3d a = Eigen::Vector3d::Zero();
+      // A hand's tremor (8 Hz, 0.3 deg) and a slow yaw wander (+-1.5 deg, 20 s) in every phase.
+      const double tremor = 0.005 * std::sin(2.0 * M_PI * 8.0 * t);
+      const double wander = 0.026 * std::sin(2.0 * M_PI * t / 20.0);
+      switch (seg.phase) {
+        case Phase::kHandling: {
+          const double k = std::fmod(ts, 1.5) / 1.5;
+          if (std::fmod(ts, 1.5) < dt) {
+            axis = Eigen::Vector3d(n01(rng), n01(rng), n01(rng)).normalized();
+            angle = (1.0 + 2.0 * u01(rng));
+          }
+          const double env = std::sin(M_PI * k);
+          r = held_in_front(heading) *
+              Eigen::AngleAxisd(angle * env * env, axis).toRotationMatrix();
+          a = 3.0 * Eigen::Vector3d(std::sin(7.0 * t + 1.0), std::sin(5.0 * t),
+                                    std::sin(11.0 * t + 2.0)) * env;
+          break;
+        }
+        case Phase::kStanding:
+        case Phase::kPause:
+          heading = heading0 + seg.turn_deg * M_PI / 180.0 * std::min(1.0, ts / 2.0);
+          r = held_in_front(heading + wander, tremor);
+          a = 0.1 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+          break;
+        case Phase::kWalking: {
+          // A corner over the first 1.5 s; the step's bounce (vertical 2.5 m/s^2, forward 1.2,
+          // lateral sway at half the cadence) and the phone pitching 2 deg with each step.
+          heading = heading0 + seg.turn_deg * M_PI / 180.0 * std::min(1.0, ts / 1.5);
+          walk_phase += 2.0 * M_PI * step_hz * dt;
+          const double ramp = std::min(1.0, ts / 0.3);
+          const Eigen::Vector3d fwd(std::sin(heading), std::cos(heading), 0.0);
+          const Eigen::Vector3d right(std::cos(heading), -std::sin(heading), 0.0);
+          a = ramp * (2.5 * std::sin(walk_phase) * Eigen::Vector3d::UnitZ() +
+                      1.2 * std::cos(walk_phase) * fwd + 0.5 * std::sin(0.5 * walk_phase) * right);
+          r = held_in_front(heading + wander, tremor + 0.035 * std::sin(walk_phase));
+          const double v = speed * ramp;
+          w.truth.x_m += v * dt * std::sin(heading);
+          w.truth.y_m += v * dt * std::cos(heading);
+          w.truth.distance_m += v * dt;
+          w.truth.steps += step_hz * dt * ramp;
+          break;
+        }
+      }
+      rot.push_back(r);
+      acc_world.push_back(a);
+      times.push_back(t);
+    }
+    if (seg.phase != Phase::kWalking) w.truth.quiet.emplace_back(t_start, t);
+  }
+  w.truth.heading_rad = heading;
+  for (std::size_t i = 0; i < rot.size(); ++i) {
+    ImuSample s;
+    s.t_s = times[i];
+    const Eigen::Vector3d f_world = acc_world[i] + Eigen::Vector3d(0.0, 0.0, kG);
+    s.acc_body_m_s2 = rot[i].transpose() * f_world +
+                      0.05 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+    // Body rate: the rotation from this sample to the next (the last repeats).
+    const std::size_t j = i + 1 < rot.size() ? i : i - 1;
+    const Eigen::AngleAxisd d(Eigen::Matrix3d(rot[j].transpose() * rot[j + 1]));
+    s.gyro_body_rad_s = d.axis() * d.angle() / dt + gyro_bias +
+                        0.005 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+    w.samples.push_back(s);
+  }
+  return w;
+}
+
+struct Run {
+  std::vector<HandheldStep> steps;
+  double heading_end_rad = 0.0;
+};
+
+Run run(const Walk& w, HandheldPdrParams p = {}) {
+  p.orient_with_mag = false;
+  HandheldPdr pdr(p);
+  Run r;
+  const Eigen::Vector3d no_mag = Eigen::Vector3d::Constant(std::nan(""));
+  for (const auto& s : w.samples) {
+    const int n = pdr.update(s, no_mag);
+    for (int k = 0; k < n; ++k) r.steps.push_back(pdr.steps()[static_cast<std::size_t>(k)]);
+  }
+  r.heading_end_rad = pdr.heading_rad();
+  return r;
+}
+
+double wrap(double a) { return std::remainder(a, 2.0 * M_PI); }
+
+// The lead-in of every IPIN log: handling, then standing. Nothing is a step.
+// Seen failing: the seed-003 Pdr (the old `fusion_cli pdr`) counts 35-39 steps here; HandheldPdr
+// with confirm_steps = 1 and the tilt and rate tests off (every bounce a step) 51-52; with
+// min_swing_m_s2 = 0.05 (the hand's tremor a bounce) 16-27, all while standing.
+TEST(HandheldPdr, HandlingAndStandingMakeNoSteps) {
+  for (unsigned seed : {7u, 8u, 9u}) {
+    const auto ws = synthesise({{Phase::kHandling, 30.0}, {Phase::kStanding, 30.0}},
+                               Eigen::Vector3d(0.01, -0.008, 0.005), seed);
+    const auto r = run(ws);
+    EXPECT_EQ(r.steps.size(), 0u) << "seed " << seed << ": first at " << r.steps.front().t_s;
+  }
+}
+
+/// Handling, standing, then a square loop of 4 legs with pauses of 5 s at two corners.
+std::vector<Segment> loop_plan() {
+  return {{Phase::kHandling, 30.0}, {Phase::kStanding, 30.0}, {Phase::kWalking, 20.0, 0.0},
+          {Phase::kPause, 5.0},     {Phase::kWalking, 20.0, 90.0}, {Phase::kWalking, 20.0, 90.0},
+          {Phase::kPause, 8.0, 45.0}, {Phase::kWalking, 20.0, 45.0}, {Phase::kStanding, 10.0}};
+}
+
+// A walk with pauses: no step in any pause (beyond the step that ends the walking), the count and
+// the distance within 3 % of the truth (the model's length is the truth's: this checks counting).
+// Seen failing: the seed-003 Pdr counts 34-37 steps too many (29-35 m too far), 108 of them in
+// the handling, standing and pauses; HandheldPdr with min_swing_m_s2 = 0.05 puts 119 steps there.
+TEST(HandheldPdr, WalkWithPausesCountsOnlyWalking) {
+  for (unsigned seed : {11u, 12u, 13u}) {
+    const auto w = synthesise(loop_plan(), Eigen::Vector3d(0.01, -0.008, 0.005), seed);
+    const auto r = run(w);
+    ASSERT_FALSE(r.steps.empty());
+    const double interval = 1.0 / 1.8;
+    for (const auto& s : r.steps)
+      for (const auto& q : w.truth.quiet)
+        EXPECT_FALSE(s.t_s > q.first + interval && s.t_s < q.second)
+            << "seed " << seed << ": step at " << s.t_s << " in [" << q.first << ", " << q.second
+            << "]";
+    const double steps = static_cast<double>(r.steps.size());
+    EXPECT_NEAR(steps, w.truth.steps, 0.03 * w.truth.steps) << "seed " << seed;
+    EXPECT_NEAR(r.steps.back().distance_m, w.truth.distance_m, 0.03 * w.truth.distance_m)
+        << "seed " << seed;
+  }
+}
+
+// A constant gyro bias of (0.01, -0.008, 0.005) rad/s: 0.17 deg/s about the vertical of a phone
+// held in front (and 0.7 deg/s in all), 19 deg over the walk. Learnt while standing (30 s, with
+// the hand's tremor and a +-1.5 deg yaw wander), the heading at the end is within 3 deg of the
+// truth and the end point within 3 % of the distance walked of the true end.
+// Seen failing: the seed-003 Pdr ends 9-88 deg and 32-39 m off; HandheldPdr with the stand
+// learner off (min_stand_s = 1e9) 18-19 deg and 5.1 m (bound 3.2 m); the control below checks
+// that the bias is large enough to matter.
+TEST(HandheldPdr, GyroBiasLearntWhileStandingBoundsHeadingDrift) {
+  const Eigen::Vector3d bias(0.01, -0.008, 0.005);
+  for (unsigned seed : {21u, 22u, 23u}) {
+    const auto w = synthesise(loop_plan(), bias, seed);
+    const auto r = run(w);
+    ASSERT_FALSE(r.steps.empty());
+    // The track starts north (no magnetometer): compare turns since the walk began.
+    const double start_truth = 0.3;
+    const double start_est = r.steps.front().heading_deg * M_PI / 180.0;
+    const double err = wrap((r.heading_end_rad - start_est) - (w.truth.heading_rad - start_truth));
+    EXPECT_LT(std::fabs(err) * 180.0 / M_PI, 3.0) << "seed " << seed;
+    // End point: the estimated track rotated onto the truth's start direction.
+    const double rot = start_truth - start_est;
+    const auto& e = r.steps.back();
+    const double x = e.x_m * std::cos(rot) + e.y_m * std::sin(rot);
+    const double y = -e.x_m * std::sin(rot) + e.y_m * std::cos(rot);
+    EXPECT_LT(std::hypot(x - w.truth.x_m, y - w.truth.y_m), 0.03 * w.truth.distance_m)
+        << "seed " << seed << ": end " << x << ", " << y << " truth " << w.truth.x_m << ", "
+        << w.truth.y_m;
+    // Control: without the stand's bias the same walk drifts far beyond the bound.
+    HandheldPdrParams off;
+    off.bias.max_bias_rad_s = 0.0;
+    const auto r0 = run(w, off);
+    const double s0 = r0.steps.front().heading_deg * M_PI / 180.0;
+    const double err0 = wrap((r0.heading_end_rad - s0) - (w.truth.heading_rad - start_truth));
+    EXPECT_GT(std::fabs(err0) * 180.0 / M_PI, 10.0) << "seed " << seed;
+  }
+}
+
+}  // namespace
