@@ -6,23 +6,51 @@
 
 namespace telltale::fusion {
 
+namespace {
+/// Heading (clockwise from magnetic north) of the horizontal part of `axis`, from the field and
+/// the up direction (same frame); NaN when degenerate.
+double magnetic_heading(const Eigen::Vector3d& mag, const Eigen::Vector3d& up,
+                        const Eigen::Vector3d& axis) {
+  Eigen::Vector3d east = mag.cross(up);
+  if (!(east.norm() > 1e-6)) return std::numeric_limits<double>::quiet_NaN();
+  east.normalize();
+  const Eigen::Vector3d north = up.cross(east);
+  const Eigen::Vector3d h = axis - axis.dot(up) * up;
+  if (!(h.norm() > 0.1)) return std::numeric_limits<double>::quiet_NaN();
+  return std::atan2(h.dot(east), h.dot(north));
+}
+/// The phone's forward axis: the horizontal part of y - z is the top of the screen for a phone
+/// held flat or tilted toward the face, and stays horizontal-capable for a phone held upright.
+const Eigen::Vector3d kForward(0.0, 1.0, -1.0);
+}  // namespace
+
 // ---------------------------------------------------------------------------------------------
-void StandBiasLearner::update(const ImuSample& s) {
+void StandBiasLearner::clear_window() {
+  auto& st = state_;
+  st.win_n = 0;
+  st.win_a = st.win_a2 = st.win_w2 = 0.0;
+  st.win_w.setZero();
+  st.win_yaw = {};
+  st.win_yaw_ok = true;
+}
+
+void StandBiasLearner::update(const ImuSample& s, const Eigen::Vector3d& up,
+                              const Eigen::Vector3d& mag_uT) {
   auto& st = state_;
   if (!st.started) {
     st.started = true;
     st.last_t_s = s.t_s;
     st.win_t0_s = s.t_s;
+    st.t_origin_s = s.t_s;
     return;
   }
   const double dt = s.t_s - st.last_t_s;
   st.last_t_s = s.t_s;
   if (!(dt > 0.0) || dt > 0.5) {  // a gap: the window and the stand restart
     close_stand();
-    st.win_n = 0;
-    st.win_a = st.win_a2 = st.win_w2 = 0.0;
-    st.win_w.setZero();
+    clear_window();
     st.win_t0_s = s.t_s;
+    st.have_psi_m = false;
     return;
   }
   const double a = s.acc_body_m_s2.norm();
@@ -31,6 +59,35 @@ void StandBiasLearner::update(const ImuSample& s) {
   st.win_w2 += s.gyro_body_rad_s.squaredNorm();
   st.win_w += s.gyro_body_rad_s * dt;
   ++st.win_n;
+  // The gyro's and the field's yaw about the vertical (counter-clockwise seen from above).
+  st.psi_g += s.gyro_body_rad_s.dot(up) * dt;
+  if (params_.mag_yaw_bias) {
+    const double h = mag_uT.allFinite() ? magnetic_heading(mag_uT, up, kForward)
+                                        : std::numeric_limits<double>::quiet_NaN();
+    if (std::isfinite(h)) {
+      const double raw = -h;  // a counter-clockwise turn lowers the heading
+      st.psi_m = st.have_psi_m ? st.psi_m + std::remainder(raw - st.psi_m_raw, 2.0 * M_PI) : raw;
+      st.psi_m_raw = raw;
+      st.have_psi_m = true;
+      const double t = s.t_s - st.t_origin_s;
+      const double d = st.psi_g - st.psi_m;
+      const double b = mag_uT.norm();
+      const double bv = mag_uT.dot(up);
+      auto& y = st.win_yaw;
+      y.n += 1.0;
+      y.t += t;
+      y.d += d;
+      y.tt += t * t;
+      y.td += t * d;
+      y.b += b;
+      y.bb += b * b;
+      y.bh += std::sqrt(std::max(0.0, b * b - bv * bv));
+      y.up += up;
+    } else {
+      st.win_yaw_ok = false;
+      st.have_psi_m = false;  // the next field sample starts a new unwrap (the window is void)
+    }
+  }
   const double span = s.t_s - st.win_t0_s;
   if (span < params_.window_s) return;
   const double n = static_cast<double>(st.win_n);
@@ -41,27 +98,81 @@ void StandBiasLearner::update(const ImuSample& s) {
   if (st.quiet) {
     st.stand_s += span;
     st.stand_w_dt += st.win_w;
+    st.stand_yaw.add(st.win_yaw);
+    st.stand_yaw_ok = st.stand_yaw_ok && st.win_yaw_ok;
   } else {
     close_stand();
   }
-  st.win_n = 0;
-  st.win_a = st.win_a2 = st.win_w2 = 0.0;
-  st.win_w.setZero();
+  clear_window();
   st.win_t0_s = s.t_s;
-  // The estimate: the closed stands and the one in progress, each weighted by T^2.
+  update_estimate();
+}
+
+namespace {
+/// Least-squares slope of d against t from the sums; NaN if the stand is unfit for it.
+double mag_slope(const StandBiasLearner::State::YawSums& y, const StandBiasParams& p) {
+  if (y.n < 10.0) return std::numeric_limits<double>::quiet_NaN();
+  const double mb = y.b / y.n;
+  const double sd_b = std::sqrt(std::max(0.0, y.bb / y.n - mb * mb));
+  if (sd_b > p.max_mag_norm_sd_uT || y.bh / y.n < p.min_mag_horizontal_uT)
+    return std::numeric_limits<double>::quiet_NaN();
+  const double den = y.n * y.tt - y.t * y.t;
+  if (!(den > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  return (y.n * y.td - y.t * y.d) / den;
+}
+}  // namespace
+
+void StandBiasLearner::update_estimate() {
+  auto& st = state_;
+  // The gyro estimate: the closed stands and the one in progress, each weighted by T^2.
   double weight = st.done_weight;
   Eigen::Vector3d sum = st.done_sum;
+  double mweight = st.mag_weight, msum = st.mag_sum;
+  Eigen::Vector3d mup = st.mag_up;
   if (st.stand_s >= params_.min_stand_s) {
+    const double w = st.stand_s * st.stand_s;
     const Eigen::Vector3d mean = st.stand_w_dt / st.stand_s;
     if (mean.norm() <= params_.max_bias_rad_s) {
-      weight += st.stand_s * st.stand_s;
-      sum += st.stand_s * st.stand_s * mean;
+      weight += w;
+      sum += w * mean;
+    }
+    const double slope = st.stand_yaw_ok && params_.mag_yaw_bias
+                             ? mag_slope(st.stand_yaw, params_)
+                             : std::numeric_limits<double>::quiet_NaN();
+    if (std::isfinite(slope) && std::fabs(slope) <= params_.max_bias_rad_s &&
+        st.stand_yaw.up.norm() > 0.0) {
+      mweight += w;
+      msum += w * slope;
+      mup += w * st.stand_yaw.up.normalized();
     }
   }
   if (weight > 0.0) {
     st.bias = sum / weight;
     st.have_bias = true;
   }
+  if (mweight > 0.0 && mup.norm() > 0.0) {
+    // The component along the stands' vertical from the field; the others from the gyro.
+    const Eigen::Vector3d u = mup.normalized();
+    st.vertical_bias = msum / mweight;
+    st.bias += (st.vertical_bias - st.bias.dot(u)) * u;
+    st.have_bias = true;
+  }
+}
+
+void StandBiasLearner::close_mag_stand() {
+  auto& st = state_;
+  if (params_.mag_yaw_bias && st.stand_yaw_ok && st.stand_s >= params_.min_stand_s) {
+    const double slope = mag_slope(st.stand_yaw, params_);
+    if (std::isfinite(slope) && std::fabs(slope) <= params_.max_bias_rad_s &&
+        st.stand_yaw.up.norm() > 0.0) {
+      const double w = st.stand_s * st.stand_s;
+      st.mag_weight += w;
+      st.mag_sum += w * slope;
+      st.mag_up += w * st.stand_yaw.up.normalized();
+    }
+  }
+  st.stand_yaw = {};
+  st.stand_yaw_ok = true;
 }
 
 void StandBiasLearner::close_stand() {
@@ -73,6 +184,7 @@ void StandBiasLearner::close_stand() {
       st.done_sum += st.stand_s * st.stand_s * mean;
     }
   }
+  close_mag_stand();
   st.stand_s = 0.0;
   st.stand_w_dt.setZero();
   st.quiet = false;
@@ -266,35 +378,20 @@ HandheldPdr::HandheldPdr(Params p, const StepLengthModel& lengths)
       bias_(p.bias),
       detector_(p.steps) {}
 
-namespace {
-/// Heading (clockwise from magnetic north) of the horizontal part of `axis`, from the field and
-/// the up direction (same frame); NaN when degenerate.
-double magnetic_heading(const Eigen::Vector3d& mag, const Eigen::Vector3d& up,
-                        const Eigen::Vector3d& axis) {
-  Eigen::Vector3d east = mag.cross(up);
-  if (!(east.norm() > 1e-6)) return std::numeric_limits<double>::quiet_NaN();
-  east.normalize();
-  const Eigen::Vector3d north = up.cross(east);
-  const Eigen::Vector3d h = axis - axis.dot(up) * up;
-  if (!(h.norm() > 0.1)) return std::numeric_limits<double>::quiet_NaN();
-  return std::atan2(h.dot(east), h.dot(north));
-}
-}  // namespace
 
 int HandheldPdr::update(const ImuSample& s, const Eigen::Vector3d& mag_uT) {
   if (!s.acc_body_m_s2.allFinite() || !s.gyro_body_rad_s.allFinite() || !std::isfinite(s.t_s))
     return 0;
   att_.update(s);
-  bias_.update(s);
   const Eigen::Vector3d up = att_.state().up_body;
+  bias_.update(s, up, mag_uT);
   const Eigen::Vector3d w = s.gyro_body_rad_s - bias_.bias_rad_s();
   heading_.update(s.t_s, w, up);
 
   // The track's orientation, once: while standing before the first walk, each magnetometer
   // sample says offset = (magnetic heading of the forward axis) + yaw (circular mean).
   if (!oriented_ && params_.orient_with_mag && bias_.quiet() && mag_uT.allFinite()) {
-    const Eigen::Vector3d fwd = Eigen::Vector3d::UnitY() - Eigen::Vector3d::UnitZ();
-    const double h = magnetic_heading(mag_uT, up, fwd);
+    const double h = magnetic_heading(mag_uT, up, kForward);
     if (std::isfinite(h)) {
       const double off = h + heading_.yaw_rad();
       mag_offset_sum_ += Eigen::Vector2d(std::cos(off), std::sin(off));

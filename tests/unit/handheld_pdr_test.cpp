@@ -256,3 +256,86 @@ TEST(HandheldPdr, GyroBiasLearntWhileStandingBoundsHeadingDrift) {
 }
 
 }  // namespace
+
+namespace {
+
+using telltale::fusion::StandBiasLearner;
+
+/// A walker standing 20 s with the phone held in front: its yaw wanders 10 deg (a 30 s sine, so
+/// the stand ends 8.7 deg away from where it began: what the real stands showed), the hand's
+/// tremor on top; a constant gyro bias; a fixed magnetic field bent by indoor iron (not north,
+/// its horizontal part 18 uT), with 0.4 uT noise per axis. Returns the learner's vertical bias
+/// error (rad/s) about the stand's vertical.
+double stand_bias_error(bool use_mag, unsigned seed, const Eigen::Vector3d& bias,
+                        double field_step_uT = 0.0) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  telltale::fusion::StandBiasParams p;
+  p.mag_yaw_bias = use_mag;
+  StandBiasLearner learner(p);
+  const double dt = 1.0 / kRate;
+  const Eigen::Vector3d field_world(-11.0, 14.0, -38.0);  // ENU, disturbed: points north-west
+  auto rot_at = [](double t) {
+    const double wander = 10.0 * M_PI / 180.0 * std::sin(2.0 * M_PI * t / 30.0);
+    const double tremor = 0.005 * std::sin(2.0 * M_PI * 8.0 * t);
+    return held_in_front(1.1 + wander, tremor);
+  };
+  Eigen::Vector3d up_mean = Eigen::Vector3d::Zero();
+  const int n = static_cast<int>(20.0 * kRate);
+  for (int i = 0; i <= n; ++i) {
+    const double t = i * dt;
+    const Eigen::Matrix3d r = rot_at(t), r1 = rot_at(t + dt);
+    ImuSample s;
+    s.t_s = t;
+    s.acc_body_m_s2 = r.transpose() * (Eigen::Vector3d(0.0, 0.0, kG) +
+                                       0.1 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng)));
+    const Eigen::AngleAxisd d(Eigen::Matrix3d(r.transpose() * r1));
+    s.gyro_body_rad_s = d.axis() * d.angle() / dt + bias +
+                        0.005 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+    // A magnet coming near the phone in the second half (the field is then not one fixed
+    // vector): field_step_uT more downward and half of it east by the end.
+    const Eigen::Vector3d extra =
+        t > 10.0 ? Eigen::Vector3d(Eigen::Vector3d(0.5, 0.0, -1.0) * field_step_uT * (t - 10.0) / 10.0)
+                 : Eigen::Vector3d::Zero();
+    const Eigen::Vector3d mag = r.transpose() * (field_world + extra) +
+                                0.4 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+    const Eigen::Vector3d up = r.transpose() * Eigen::Vector3d::UnitZ();
+    up_mean += up;
+    learner.update(s, up, mag);
+  }
+  const Eigen::Vector3d u = up_mean.normalized();
+  return (learner.bias_rad_s() - bias).dot(u);
+}
+
+constexpr double kDegS = M_PI / 180.0;
+
+// The bias about the vertical from a stand with the field: within 0.03 deg/s (the heading then
+// drifts under 2.5 deg over an 80 s out-and-back leg, what a 2 % loop closure needs), whatever
+// the 8.7 deg net yaw wander.
+// Seen failing: with mag_yaw_bias = false (the gyro-only learner) the same stands are 0.43-0.44
+// deg/s off (checked below as the control); with the magnetic yaw's sign flipped (psi_m = +h)
+// 1.31 deg/s.
+TEST(StandBiasLearner, MagneticYawOverAStandGivesTheVerticalBias) {
+  const Eigen::Vector3d bias(0.004, -0.006, 0.005);
+  for (unsigned seed : {31u, 32u, 33u}) {
+    const double err = stand_bias_error(true, seed, bias);
+    EXPECT_LT(std::fabs(err), 0.03 * kDegS) << "seed " << seed << ": " << err / kDegS << " deg/s";
+    const double err0 = stand_bias_error(false, seed, bias);
+    EXPECT_GT(std::fabs(err0), 0.3 * kDegS) << "seed " << seed << ": " << err0 / kDegS;
+  }
+}
+
+// A field that changes during the stand (a magnet coming near: |B| grows 7 uT, the horizontal part turns 12 deg) is not a fixed
+// vector: the stand gives no magnetic estimate and the learner keeps the gyro's.
+// Seen failing: with max_mag_norm_sd_uT = 1e9 the slope is taken and is 0.53-0.54 deg/s off
+// (the gyro's own estimate: 0.43-0.45).
+TEST(StandBiasLearner, ChangingFieldGivesNoMagneticEstimate) {
+  const Eigen::Vector3d bias(0.004, -0.006, 0.005);
+  for (unsigned seed : {41u, 42u}) {
+    const double with_step = stand_bias_error(true, seed, bias, 8.0);
+    const double gyro_only = stand_bias_error(false, seed, bias, 8.0);
+    EXPECT_NEAR(with_step, gyro_only, 1e-12) << "seed " << seed;
+  }
+}
+
+}  // namespace

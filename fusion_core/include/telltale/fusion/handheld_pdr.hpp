@@ -49,6 +49,22 @@ struct StandBiasParams {
   /// A stand's mean rate above this is a slow turn on the spot, not a bias (phone gyros are
   /// factory- and OS-calibrated to well under 1 deg/s).
   double max_bias_rad_s = 0.03;
+  /// The bias about the vertical from the magnetometer during stands. A standing walker stays
+  /// on one spot, so the field there is one fixed vector even when indoor iron bends it; the
+  /// phone's yaw change over the stand is then the change of the field's horizontal direction
+  /// seen from the phone (tilt-compensated), and d = (gyro yaw) - (magnetic yaw) grows as
+  /// bias * t whatever the hand's yaw wander does (the wander is in both and cancels). Its slope
+  /// (least squares over the stand's samples) is the bias about the stand's vertical; the other
+  /// two components stay the gyro learner's. Never used while walking: the walker then moves
+  /// through the field's disturbances, and a direction change of the field is not a turn.
+  bool mag_yaw_bias = true;
+  /// The magnetic yaw's noise goes as 1/|B horizontal|: below this (a field nearly along the
+  /// vertical, or a dead sensor) a stand says nothing. Earth's horizontal field is 10-40 uT.
+  double min_mag_horizontal_uT = 5.0;
+  /// |B| is the same at one spot whatever the phone's orientation; a stand whose |B| varies by
+  /// more than this (rms) had the phone moved past a magnetic source (or the walker stepped),
+  /// so its field was not one fixed vector: no estimate from it.
+  double max_mag_norm_sd_uT = 2.0;
 };
 class StandBiasLearner {
  public:
@@ -65,19 +81,50 @@ class StandBiasLearner {
     double done_weight = 0.0;                              ///< sum of T^2
     Eigen::Vector3d done_sum = Eigen::Vector3d::Zero();    ///< sum of T^2 * mean
     Eigen::Vector3d bias = Eigen::Vector3d::Zero();
+    // Magnetic yaw: psi_g = integral of w . up (raw gyro), psi_m = the phone's yaw from the
+    // field (unwrapped, counter-clockwise), d = psi_g - psi_m. Least-squares sums of d against t
+    // (t from the stand's start) over the window and over the stand; |B| sums for its rms.
+    struct YawSums {
+      double n = 0.0, t = 0.0, d = 0.0, tt = 0.0, td = 0.0, b = 0.0, bb = 0.0, bh = 0.0;
+      Eigen::Vector3d up = Eigen::Vector3d::Zero();
+      void add(const YawSums& o) {
+        n += o.n; t += o.t; d += o.d; tt += o.tt; td += o.td;
+        b += o.b; bb += o.bb; bh += o.bh; up += o.up;
+      }
+    };
+    double psi_g = 0.0, psi_m = 0.0, psi_m_raw = 0.0;
+    bool have_psi_m = false;
+    double t_origin_s = 0.0;  ///< t origin of the sums (the first sample)
+    YawSums win_yaw, stand_yaw;
+    bool win_yaw_ok = true;    ///< every sample of the window had a usable field
+    bool stand_yaw_ok = true;  ///< and every window of the stand
+    double mag_weight = 0.0;  ///< sum of T^2 of the stands with a magnetic slope
+    double mag_sum = 0.0;     ///< sum of T^2 * slope (rad/s about that stand's up)
+    Eigen::Vector3d mag_up = Eigen::Vector3d::Zero();  ///< sum of T^2 * the stand's mean up
+    double vertical_bias = 0.0;  ///< the magnetic estimate about mag_up (valid if mag_weight > 0)
     bool quiet = false;  ///< the last full window was quiet
     bool have_bias = false;
     double last_t_s = 0.0;
     bool started = false;
   };
   explicit StandBiasLearner(Params p = {}) : params_(p) {}
-  void update(const ImuSample& s);
+  /// One sample with the up direction (unit, phone frame) and the field (NaN: none).
+  void update(const ImuSample& s, const Eigen::Vector3d& up, const Eigen::Vector3d& mag_uT);
+  /// The bias: the gyro learner's, its component along the stands' vertical replaced by the
+  /// magnetic estimate once a stand gave one.
   [[nodiscard]] const Eigen::Vector3d& bias_rad_s() const { return state_.bias; }
+  /// The magnetic estimate of the bias about the vertical (rad/s) and whether there is one.
+  [[nodiscard]] bool has_mag_vertical_bias() const { return state_.mag_weight > 0.0; }
+  [[nodiscard]] double mag_vertical_bias_rad_s() const { return state_.vertical_bias; }
   [[nodiscard]] bool quiet() const { return state_.quiet; }
   [[nodiscard]] const State& state() const { return state_; }
 
  private:
   void close_stand();
+  void clear_window();
+  void update_estimate();
+  /// The stand's magnetic slope into the sums (if it qualifies).
+  void close_mag_stand();
   Params params_;
   State state_;
 };
