@@ -77,6 +77,10 @@ std::optional<GnssFix> GnssGate::on_epoch(const sensors::GnssReading& r, double 
     out.lat_deg = out.lon_deg = out.sog_m_s = out.cog_deg = kNaN;
     return out;
   }
+  if (out.gnss_utc_ns != 0 && out.gnss_utc_ns == last_gnss_utc_ns_) {
+    ++stats_.repeats;
+    return std::nullopt;
+  }
   const Point here{r.lat_deg, r.lon_deg, t_s, r.hdop};
   const bool speed_ok = !(r.sog_m_s > p_.max_speed_m_s);
   if (anchor_ && (!speed_ok || !plausible(*anchor_, here))) {
@@ -92,6 +96,7 @@ std::optional<GnssFix> GnssGate::on_epoch(const sensors::GnssReading& r, double 
   }
   n_pending_ = 0;
   anchor_ = here;
+  last_gnss_utc_ns_ = out.gnss_utc_ns;
   ++stats_.fixes;
   out.fix = r.fix;
   out.lat_deg = r.lat_deg;

@@ -15,6 +15,8 @@
 ///   trailer while switched off): the new track is accepted and counted as a re-anchor.
 /// - COG below min_cog_speed_m_s (0.3 m/s) is NaN: a receiver's velocity noise is ~0.05-0.1 m/s,
 ///   so there the course is mostly noise (tens of degrees).
+/// - A repeat: an epoch with the same GNSS time as the last accepted fix is the same fix reported
+///   again (gpsd sends a report per sentence of an epoch); dropped and counted.
 /// - GNSS time: the receiver's time of day with RMC's date, or with the boat clock's date when
 ///   only GGA/GNS came (the day that puts it nearest the boat clock). The offset boat - GNSS is
 ///   what the boat's clock is wrong by (plus the sentence's latency, tens of ms).
@@ -51,6 +53,7 @@ struct GnssGateStats {
   std::uint64_t no_fix = 0;    ///< passed on as "no fix"
   std::uint64_t jumps = 0;     ///< rejected: faster than a boat
   std::uint64_t reanchors = 0;
+  std::uint64_t repeats = 0;   ///< the same epoch again
 };
 
 class GnssGate {
@@ -75,6 +78,7 @@ class GnssGate {
   Point pending_[8]{};
   int n_pending_ = 0;
   double clock_offset_s_ = std::numeric_limits<double>::quiet_NaN();
+  std::uint64_t last_gnss_utc_ns_ = 0;  ///< of the last accepted fix
 };
 
 /// Great-circle distance, metres (haversine on a 6371 km sphere: < 0.5 % error, plenty for a

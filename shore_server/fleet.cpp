@@ -49,6 +49,16 @@ void FleetModel::update_status(const std::string& node_id, const NodeStatusInfo&
   it->second.status = status;
 }
 
+std::optional<BoatView> FleetModel::update_fix(const FixSample& fix, SteadyTime arrival) {
+  std::lock_guard lock(mutex_);
+  auto it = boats_.find(fix.boat_id);
+  if (it == boats_.end()) return std::nullopt;
+  it->second.fix = fix;
+  it->second.fix_arrival = arrival;
+  it->second.fix_fresh = true;
+  return it->second;
+}
+
 std::vector<BoatView> FleetModel::sweep(SteadyTime now) {
   std::vector<BoatView> went_stale;
   std::lock_guard lock(mutex_);
@@ -104,7 +114,11 @@ std::vector<BoatView> FleetModel::boats() const {
   std::lock_guard lock(mutex_);
   std::vector<BoatView> out;
   out.reserve(boats_.size());
-  for (const auto& [id, b] : boats_) out.push_back(b);
+  const auto now = std::chrono::steady_clock::now();
+  for (const auto& [id, b] : boats_) {
+    out.push_back(b);
+    out.back().fix_fresh = b.fix && now - b.fix_arrival < kFixFreshFor;
+  }
   return out;
 }
 
@@ -112,7 +126,9 @@ std::optional<BoatView> FleetModel::boat(const std::string& boat_id) const {
   std::lock_guard lock(mutex_);
   auto it = boats_.find(boat_id);
   if (it == boats_.end()) return std::nullopt;
-  return it->second;
+  BoatView v = it->second;
+  v.fix_fresh = v.fix && std::chrono::steady_clock::now() - v.fix_arrival < kFixFreshFor;
+  return v;
 }
 
 AthleteView FleetModel::update(const WearableSample& sample, SteadyTime arrival) {

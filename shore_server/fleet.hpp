@@ -48,6 +48,25 @@ struct AttitudeSample {
   std::uint64_t boot_id = 0;  ///< the boat node's run; seq restarts with a new one
 };
 
+/// One boat's GNSS fix, in wire units.
+struct FixSample {
+  std::string boat_id;
+  std::uint64_t seq = 0;
+  std::uint64_t t_utc_ns = 0;     ///< boat clock when the fix was read
+  std::uint64_t gnss_utc_ns = 0;  ///< the receiver's time of the fix; 0 when none
+  double lat_deg = 0.0;           ///< NaN without a fix
+  double lon_deg = 0.0;
+  double sog_m_s = 0.0;           ///< NaN when unknown
+  double cog_deg = 0.0;           ///< NaN when unknown or meaningless (slow)
+  std::string fix = "none";       ///< "none", "2d", "3d", "dgnss"
+  std::uint32_t satellites = 0;
+  double hdop = 0.0;              ///< NaN when unknown
+  std::uint64_t boot_id = 0;
+};
+
+/// A fix older than this is not shown as the boat's position (the receiver went quiet).
+inline constexpr std::chrono::seconds kFixFreshFor{5};
+
 struct NodeStatusInfo {
   std::string kind;  ///< "boat", "wearable", "shore"
   std::string software_version;
@@ -71,6 +90,9 @@ struct BoatView {
   double clock_offset_ms = 0.0;
   double window_min_offset_ms = 0.0;
   SteadyTime window_start{};
+  std::optional<FixSample> fix;  ///< the latest GNSS fix (any kind)
+  SteadyTime fix_arrival{};
+  bool fix_fresh = false;  ///< a fix came within kFixFreshFor (set by boats() / boat())
 };
 
 /// One athlete's latest wearable motion, in wire units.
@@ -109,6 +131,9 @@ class FleetModel {
   /// Records a sample and returns the boat's view after it.
   BoatView update(const AttitudeSample& sample, SteadyTime arrival, std::uint64_t arrival_utc_ns);
   void update_status(const std::string& node_id, const NodeStatusInfo& status);
+  /// Records a GNSS fix of a known boat (a fix before the boat's first attitude is not shown
+  /// live; the store keeps it). Returns the boat's view after it.
+  std::optional<BoatView> update_fix(const FixSample& fix, SteadyTime arrival);
   /// Marks boats silent for longer than stale_after as stale; returns those that just went stale.
   std::vector<BoatView> sweep(SteadyTime now);
   /// Forces a boat stale now (DDS deadline missed); its view if it just went stale.

@@ -1,4 +1,5 @@
 #include "http_api.hpp"
+#include "track_routes.hpp"
 
 #include <httplib.h>
 
@@ -248,6 +249,7 @@ struct HttpApi::Impl {
           [this, client](bool) { ctx.hub.disconnect(client); });
     });
     register_rest_routes(server, ctx);
+    register_track_routes(server, ctx);
     if (!config.web_dir.empty() && !server.set_mount_point("/", config.web_dir))
       throw std::runtime_error("web directory not found: " + config.web_dir);
   }

@@ -15,7 +15,7 @@ namespace {
 constexpr std::array<const char*, kRejectKinds> kRejectNames = {"none", "id", "time", "value",
                                                                 "text"};
 constexpr std::array<const char*, kTopics> kTopicNames = {"attitude", "backfill", "status",
-                                                          "wearable"};
+                                                          "wearable", "fix"};
 
 bool finite_in(double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; }
 /// NaN ("no value") or within [lo, hi].
@@ -178,6 +178,24 @@ Reject check(const WearableSample& s, std::uint64_t shore_now_ns) {
   return Reject::kNone;
 }
 
+Reject check(const FixSample& s, std::uint64_t shore_now_ns) {
+  if (!contract_id(s.boat_id)) return Reject::kId;
+  if (!contract_time(s.t_utc_ns, shore_now_ns)) return Reject::kTime;
+  if (s.fix != "none" && s.fix != "2d" && s.fix != "3d" && s.fix != "dgnss") return Reject::kValue;
+  if (s.fix == "none") {
+    // No fix: no position may ride along (the gate on the boat blanks it).
+    for (double v : {s.lat_deg, s.lon_deg, s.sog_m_s, s.cog_deg})
+      if (!std::isnan(v)) return Reject::kValue;
+  } else if (!finite_in(s.lat_deg, -90.0, 90.0) || !finite_in(s.lon_deg, -180.0, 180.0)) {
+    return Reject::kValue;
+  }
+  // 100 m/s: well above any boat; the boat's gate already rejects above 30.
+  if (!nan_or_in(s.sog_m_s, 0.0, 100.0) || !nan_or_in(s.cog_deg, 0.0, 360.0)) return Reject::kValue;
+  if (!nan_or_in(s.hdop, 0.0, 100.0) || s.satellites > 255) return Reject::kValue;
+  if (s.gnss_utc_ns != 0 && !contract_time(s.gnss_utc_ns, shore_now_ns)) return Reject::kTime;
+  return Reject::kNone;
+}
+
 Reject check(const std::string& node_id, const NodeStatusInfo& s, std::uint64_t t_utc_ns,
              std::uint64_t shore_now_ns) {
   if (!contract_id(node_id)) return Reject::kId;
@@ -270,6 +288,38 @@ WearableSample from_wire(const msg::WearableMotion& m) {
   return w;
 }
 
+FixSample from_wire(const msg::BoatFix& m) {
+  FixSample f;
+  f.boat_id = m.boat_id().to_string();
+  f.seq = m.seq();
+  f.t_utc_ns = m.t_utc_ns();
+  f.gnss_utc_ns = m.gnss_utc_ns();
+  f.lat_deg = m.lat_deg();
+  f.lon_deg = m.lon_deg();
+  f.sog_m_s = m.sog_m_s();
+  f.cog_deg = m.cog_deg();
+  switch (m.fix()) {
+    case msg::FIX_KIND_NONE:
+      f.fix = "none";
+      break;
+    case msg::FIX_KIND_2D:
+      f.fix = "2d";
+      break;
+    case msg::FIX_KIND_3D:
+      f.fix = "3d";
+      break;
+    case msg::FIX_KIND_DGNSS:
+      f.fix = "dgnss";
+      break;
+    default:
+      f.fix = "invalid";  // an enum value off the contract: refused by check()
+  }
+  f.satellites = m.satellites();
+  f.hdop = m.hdop();
+  f.boot_id = m.boot_id();
+  return f;
+}
+
 NodeStatusInfo from_wire(const msg::NodeStatus& m) {
   NodeStatusInfo s;
   s.kind = kind_name(m.kind());
@@ -315,6 +365,14 @@ Reject Ingest::wearable(const msg::WearableMotion& m) {
   return r;
 }
 
+Reject Ingest::fix(const msg::BoatFix& m) {
+  const FixSample f = from_wire(m);
+  const Reject r = check(f, now());
+  counters_.count(Topic::kFix, r);
+  if (r == Reject::kNone && sinks_.on_fix) sinks_.on_fix(f);
+  return r;
+}
+
 namespace {
 /// The generated deserialize, then the key's raw length checked against what Fast DDS kept: a
 /// key it cut to its bound (or that holds a NUL) is emptied, which the door refuses as an id.
@@ -349,6 +407,12 @@ bool StrictWearableMotionType::deserialize(eprosima::fastrtps::rtps::SerializedP
                                            void* data) {
   return strict_deserialize<msg::WearableMotionPubSubType, msg::WearableMotion>(
       *this, payload, data, [](msg::WearableMotion & m) -> auto& { return m.athlete_id(); });
+}
+
+bool StrictBoatFixType::deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload,
+                                    void* data) {
+  return strict_deserialize<msg::BoatFixPubSubType, msg::BoatFix>(
+      *this, payload, data, [](msg::BoatFix & m) -> auto& { return m.boat_id(); });
 }
 
 }  // namespace telltale::shore

@@ -42,8 +42,8 @@ inline constexpr std::size_t kRejectKinds = 5;
 [[nodiscard]] const char* reject_name(Reject r);
 
 /// The topics the shore reads.
-enum class Topic : std::uint8_t { kAttitude, kBackfill, kStatus, kWearable };
-inline constexpr std::size_t kTopics = 4;
+enum class Topic : std::uint8_t { kAttitude, kBackfill, kStatus, kWearable, kFix };
+inline constexpr std::size_t kTopics = 5;
 [[nodiscard]] const char* topic_name(Topic t);
 
 /// Valid UTF-8 (shortest forms, no surrogates, at most U+10FFFF).
@@ -57,6 +57,9 @@ inline constexpr std::size_t kTopics = 4;
 
 [[nodiscard]] Reject check(const AttitudeSample& s, std::uint64_t shore_now_ns);
 [[nodiscard]] Reject check(const WearableSample& s, std::uint64_t shore_now_ns);
+/// A fix: position in range (or all of lat/lon/sog/cog NaN with fix "none"), SOG in [0, 100]
+/// m/s or NaN, COG in [0, 360] or NaN, HDOP >= 0 or NaN, a known fix kind.
+[[nodiscard]] Reject check(const FixSample& s, std::uint64_t shore_now_ns);
 [[nodiscard]] Reject check(const std::string& node_id, const NodeStatusInfo& s,
                            std::uint64_t t_utc_ns, std::uint64_t shore_now_ns);
 
@@ -85,6 +88,7 @@ struct IngestSinks {
   std::function<void(const AttitudeSample&)> on_backfill;
   std::function<void(const std::string& node_id, const NodeStatusInfo&)> on_status;
   std::function<void(const WearableSample&)> on_wearable;
+  std::function<void(const FixSample&)> on_fix;
 };
 
 class Ingest {
@@ -96,6 +100,7 @@ class Ingest {
   Reject attitude(const msg::BoatAttitude& m, bool backfill);
   Reject status(const msg::NodeStatus& m);
   Reject wearable(const msg::WearableMotion& m);
+  Reject fix(const msg::BoatFix& m);
 
   [[nodiscard]] const IngestCounters& counters() const { return counters_; }
 
@@ -109,6 +114,7 @@ class Ingest {
 [[nodiscard]] AttitudeSample from_wire(const msg::BoatAttitude& m);
 [[nodiscard]] WearableSample from_wire(const msg::WearableMotion& m);
 [[nodiscard]] NodeStatusInfo from_wire(const msg::NodeStatus& m);
+[[nodiscard]] FixSample from_wire(const msg::BoatFix& m);
 
 /// The generated types, deserialising strictly: a key string longer than its bound (or with a
 /// NUL inside) arrives as an empty id, which the checks reject, instead of a truncated one that
@@ -122,6 +128,10 @@ class StrictNodeStatusType : public msg::NodeStatusPubSubType {
   bool deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload, void* data) override;
 };
 class StrictWearableMotionType : public msg::WearableMotionPubSubType {
+ public:
+  bool deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload, void* data) override;
+};
+class StrictBoatFixType : public msg::BoatFixPubSubType {
  public:
   bool deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload, void* data) override;
 };

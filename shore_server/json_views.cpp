@@ -56,6 +56,27 @@ json boat_object(const BoatView& v) {
       {"clock_offset_ms", finite_or_null(v.clock_offset_ms)},
       {"clock_suspect", std::abs(v.clock_offset_ms) > kClockSuspectMs},
   };
+  // Position: null without a fresh fix with a position (never the last one as if it were new).
+  const bool positioned = v.fix && v.fix_fresh && v.fix->fix != "none";
+  const FixSample* f = positioned ? &*v.fix : nullptr;
+  const double nan = std::nan("");
+  j["lat_deg"] = finite_or_null(f ? f->lat_deg : nan);
+  j["lon_deg"] = finite_or_null(f ? f->lon_deg : nan);
+  j["sog_m_s"] = finite_or_null(f ? f->sog_m_s : nan);
+  j["cog_deg"] = finite_or_null(f ? f->cog_deg : nan);
+  j["gnss_fix"] = v.fix && v.fix_fresh ? json(v.fix->fix) : json(nullptr);
+  if (v.fix) {
+    // GNSS time minus the boat's clock at the fix: the boat clock's true error (plus the
+    // receiver's output latency, tens of ms), beside clock_offset_ms (shore clock minus boat).
+    j["gnss"] = {{"satellites", v.fix->satellites},
+                 {"hdop", finite_or_null(v.fix->hdop)},
+                 {"fix_time", iso8601(v.fix->t_utc_ns)},
+                 {"clock_offset_ms",
+                  v.fix->gnss_utc_ns ? json((static_cast<double>(v.fix->gnss_utc_ns) -
+                                             static_cast<double>(v.fix->t_utc_ns)) *
+                                            1e-6)
+                                     : json(nullptr)}};
+  }
   if (v.status) {
     j["status"] = {{"software_version", v.status->software_version},
                    {"uptime_s", v.status->uptime_s},

@@ -164,6 +164,11 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
     store.enqueue(w);
     hub.publish_event("wearable", to_json_text(athlete_object(view)), w.athlete_id);
   };
+  callbacks.on_fix = [&](const FixSample& f) {
+    store.enqueue(f);
+    if (auto v = fleet.update_fix(f, std::chrono::steady_clock::now()))
+      hub.publish_sample(f.boat_id, boat_json(*v));
+  };
   callbacks.on_status = [&](const std::string& id, const NodeStatusInfo& st) {
     fleet.update_status(id, st);
   };

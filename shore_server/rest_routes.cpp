@@ -10,6 +10,8 @@
 #include "http_api.hpp"
 #include "json_views.hpp"
 #include "query.hpp"
+#include "route_helpers.hpp"
+#include "track_routes.hpp"
 #include "shutdown.hpp"
 
 namespace telltale::shore {
@@ -18,47 +20,6 @@ namespace {
 using nlohmann::json;
 
 constexpr std::int64_t kMaxPointsLimit = 100000;
-
-Principal who(const ShoreContext& ctx, const httplib::Request& req) {
-  return authenticate(ctx.tokens, req.get_header_value("Authorization"),
-                      req.get_header_value("Cookie"));
-}
-
-void require_coach(const Principal& p) {
-  if (p.role != Role::kCoach) throw HttpError(403, "only a coach may do this");
-}
-
-void require_boat(const Principal& p, const std::string& boat_id) {
-  if (p.role == Role::kAthlete && p.boat_id != boat_id)
-    throw HttpError(403, "an athlete sees only their own boat");
-}
-
-/// The query parameters a route accepts; any other is a 400 (a typo must not be ignored).
-void allow_params(const httplib::Request& req, std::initializer_list<const char*> allowed) {
-  for (const auto& [name, value] : req.params) {
-    if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return name == a; }))
-      throw HttpError(400, "unknown parameter '" + name + "'");
-    if (req.get_param_value_count(name) > 1)
-      throw HttpError(400, "parameter '" + name + "' given more than once");
-  }
-}
-
-const std::string* param(const httplib::Request& req, const char* name) {
-  auto it = req.params.find(name);
-  return it == req.params.end() ? nullptr : &it->second;
-}
-
-std::string path_id(const httplib::Request& req, const char* what) {
-  const std::string id = req.matches[1];
-  if (!valid_id(id)) throw HttpError(400, std::string(what) + " id must be 1-32 of [A-Za-z0-9_-]");
-  return id;
-}
-
-std::int64_t path_number(const httplib::Request& req, const char* what) {
-  const auto n = parse_int(req.matches[1], 1, INT64_MAX);
-  if (!n) throw HttpError(400, std::string(what) + " id must be a positive integer");
-  return *n;
-}
 
 enum class Format { kJson, kCsv };
 Format format_of(const httplib::Request& req) {
@@ -86,19 +47,31 @@ std::string csv_number(double v) {
 
 constexpr const char* kCsvHeader =
     "time_utc,t_s,seq,heel_deg,pitch_deg,heading_deg,heel_rate_deg_s,pitch_rate_deg_s,"
-    "yaw_rate_deg_s,accel_weight,quality\n";
+    "yaw_rate_deg_s,accel_weight,quality,lat_deg,lon_deg,sog_m_s,cog_deg\n";
 
-std::string csv_row(const AttitudeRow& r) {
+std::string csv_coordinate(double v) {
+  if (!std::isfinite(v)) return "";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.7f", v);
+  return buf;
+}
+
+/// One attitude sample with the fix current at its time (empty position columns without one).
+std::string csv_row(const AttitudeRow& r, const FixSample* f) {
   char t[32];
   std::snprintf(t, sizeof t, "%.3f", static_cast<double>(r.t_utc_ns) * 1e-9);
+  const double nan = std::nan("");
   return iso8601(r.t_utc_ns) + "," + t + "," + std::to_string(r.seq) + "," +
          csv_number(r.heel_deg) + "," + csv_number(r.pitch_deg) + "," + csv_number(r.heading_deg) +
          "," + csv_number(r.heel_rate_deg_s) + "," + csv_number(r.pitch_rate_deg_s) + "," +
          csv_number(r.yaw_rate_deg_s) + "," + csv_number(r.accel_weight) + "," +
-         csv_number(r.quality) + "\n";
+         csv_number(r.quality) + "," + csv_coordinate(f ? f->lat_deg : nan) + "," +
+         csv_coordinate(f ? f->lon_deg : nan) + "," + csv_number(f ? f->sog_m_s : nan) + "," +
+         csv_number(f ? f->cog_deg : nan) + "\n";
 }
 
-json row_object(const AttitudeRow& r) {
+json row_object(const AttitudeRow& r, const FixSample* f) {
+  const double nan = std::nan("");
   return {{"time_utc", iso8601(r.t_utc_ns)},
           {"t_s", static_cast<double>(r.t_utc_ns) * 1e-9},
           {"seq", r.seq},
@@ -109,23 +82,30 @@ json row_object(const AttitudeRow& r) {
           {"pitch_rate_deg_s", finite_or_null(r.pitch_rate_deg_s)},
           {"yaw_rate_deg_s", finite_or_null(r.yaw_rate_deg_s)},
           {"accel_weight", finite_or_null(r.accel_weight)},
-          {"quality", finite_or_null(r.quality)}};
+          {"quality", finite_or_null(r.quality)},
+          {"lat_deg", finite_or_null(f ? f->lat_deg : nan)},
+          {"lon_deg", finite_or_null(f ? f->lon_deg : nan)},
+          {"sog_m_s", finite_or_null(f ? f->sog_m_s : nan)},
+          {"cog_deg", finite_or_null(f ? f->cog_deg : nan)}};
 }
 
 /// Streams every stored sample of a boat in [from, to] as CSV or JSON, a page at a time: a long
-/// session is never held in memory whole.
+/// session is never held in memory whole. Each sample carries the fix current at its time.
 void stream_rows(httplib::Response& res, Store& store, const std::string& boat_id,
                  std::uint64_t from_ns, std::uint64_t to_ns, Format format, json head,
                  const std::string& filename) {
   if (!filename.empty())
     res.set_header("Content-Disposition", "attachment; filename=\"" + filename + "\"");
   struct Cursor {
-    std::uint64_t after;
+    std::uint64_t after = 0;
     bool started = false;
     bool first_row = true;
     bool done = false;
+    std::unique_ptr<FixJoin> fixes;
   };
-  auto cursor = std::make_shared<Cursor>(Cursor{from_ns == 0 ? 0 : from_ns - 1});
+  auto cursor = std::make_shared<Cursor>();
+  cursor->after = from_ns == 0 ? 0 : from_ns - 1;
+  cursor->fixes = std::make_unique<FixJoin>(store, boat_id, from_ns, to_ns);
   res.set_chunked_content_provider(
       format == Format::kCsv ? "text/csv" : "application/json",
       [&store, boat_id, to_ns, format, cursor, head = std::move(head)](std::size_t,
@@ -148,11 +128,12 @@ void stream_rows(httplib::Response& res, Store& store, const std::string& boat_i
         constexpr std::size_t kPage = 2000;
         const auto rows = store.attitude_page(boat_id, cursor->after, to_ns, kPage);
         for (const auto& r : rows) {
+          const FixSample* fix = cursor->fixes->at(r.t_utc_ns);
           if (format == Format::kCsv) {
-            out += csv_row(r);
+            out += csv_row(r, fix);
           } else {
             if (!cursor->first_row) out += ",";
-            out += to_json_text(row_object(r));
+            out += to_json_text(row_object(r, fix));
             cursor->first_row = false;
           }
         }
@@ -377,6 +358,12 @@ void register_rest_routes(httplib::Server& server, ShoreContext& ctx) {
                const SessionInfo s = session_or_404(req, p);
                json j = session_object(s);
                j["heel_bands"] = heel_bands(ctx.store, s);
+               const FixStats g = ctx.store.fix_stats(s.boat_id, s.start_ns, s.end_ns);
+               j["gnss"] = {{"fixes", g.fixes},
+                            {"distance_m", g.fixes ? json(g.distance_m) : json(nullptr)},
+                            {"time_with_fix_s", g.time_with_fix_s},
+                            {"sog_mean_m_s", finite_or_null(g.sog_mean_m_s)},
+                            {"sog_max_m_s", finite_or_null(g.sog_max_m_s)}};
                EventFilter f;
                f.boat_id = s.boat_id;
                f.from_ns = s.start_ns;

@@ -50,6 +50,11 @@ class ShoreDds::Listener : public fdds::DataReaderListener {
       while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
         if (accept(info, m.athlete_id().to_string())) (void)ingest_.wearable(m);
       }
+    } else if (topic == dds::kTopicBoatFix) {
+      msg::BoatFix m;
+      while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
+        if (accept(info, m.boat_id().to_string())) (void)ingest_.fix(m);
+      }
     } else if (topic == dds::kTopicNodeStatus) {
       msg::NodeStatus m;
       while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
@@ -80,7 +85,8 @@ class ShoreDds::Listener : public fdds::DataReaderListener {
 ShoreDds::ShoreDds(const dds::DdsOptions& options, FleetCallbacks callbacks)
     : callbacks_(std::move(callbacks)),
       ingest_(std::make_unique<Ingest>(IngestSinks{callbacks_.on_attitude, callbacks_.on_backfill,
-                                                   callbacks_.on_status, callbacks_.on_wearable})) {
+                                                   callbacks_.on_status, callbacks_.on_wearable,
+                                                   callbacks_.on_fix})) {
   dds::DdsOptions opts = options;
   if (!opts.security_dir.empty()) {
     writer_check_ = std::make_unique<WriterCheck>(opts.security_dir);
@@ -98,6 +104,9 @@ ShoreDds::ShoreDds(const dds::DdsOptions& options, FleetCallbacks callbacks)
   participant_->reader(participant_->topic(dds::kTopicWearableMotion,
                                            fdds::TypeSupport(new StrictWearableMotionType())),
                        "wearable_reader", listener_.get());
+  participant_->reader(
+      participant_->topic(dds::kTopicBoatFix, fdds::TypeSupport(new StrictBoatFixType())),
+      "fix_reader", listener_.get());
   participant_->reader(
       participant_->topic(dds::kTopicNodeStatus, fdds::TypeSupport(new StrictNodeStatusType())),
       "status_reader", listener_.get());

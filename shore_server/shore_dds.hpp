@@ -30,6 +30,8 @@ struct FleetCallbacks {
   std::function<void(const std::string& node_id, const NodeStatusInfo&)> on_status;
   /// An athlete's wearable motion.
   std::function<void(const WearableSample&)> on_wearable;
+  /// A GNSS fix (any kind, "none" included).
+  std::function<void(const FixSample&)> on_fix;
   /// A boat missed its DDS deadline (no sample within the deadline period).
   std::function<void(const std::string& boat_id)> on_deadline_missed;
 };

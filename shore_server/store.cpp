@@ -41,6 +41,21 @@ CREATE TABLE IF NOT EXISTS wearable (
   distance_m REAL,
   PRIMARY KEY (athlete_id, t_utc_ns)
 ) WITHOUT ROWID;
+CREATE TABLE IF NOT EXISTS fixes (
+  boat_id TEXT NOT NULL,
+  t_utc_ns INTEGER NOT NULL,
+  seq INTEGER NOT NULL,
+  gnss_utc_ns INTEGER NOT NULL,
+  lat_deg REAL,
+  lon_deg REAL,
+  sog_m_s REAL,
+  cog_deg REAL,
+  fix TEXT NOT NULL,
+  satellites INTEGER NOT NULL,
+  hdop REAL,
+  boot_id INTEGER NOT NULL,
+  PRIMARY KEY (boat_id, t_utc_ns)
+) WITHOUT ROWID;
 CREATE TABLE IF NOT EXISTS sessions (
   id INTEGER PRIMARY KEY AUTOINCREMENT,
   boat_id TEXT NOT NULL,
@@ -329,6 +344,133 @@ void Store::commit_wearable(const std::vector<WearableSample>& batch) {
   }
 }
 
+void Store::enqueue(const FixSample& fix) {
+  std::lock_guard lock(mutex_);
+  if (fix_queue_.size() >= config_.max_backlog) {
+    ++dropped_;
+    return;
+  }
+  fix_queue_.push_back(fix);
+}
+
+void Store::commit_fixes(const std::vector<FixSample>& batch) {
+  std::lock_guard db_lock(db_mutex_);
+  try {
+    exec(db_, "BEGIN");
+    Stmt ins(db_,
+             "INSERT OR IGNORE INTO fixes (boat_id, t_utc_ns, seq, gnss_utc_ns, lat_deg, lon_deg, "
+             "sog_m_s, cog_deg, fix, satellites, hdop, boot_id) VALUES (?,?,?,?,?,?,?,?,?,?,?,?)");
+    for (const auto& f : batch) {
+      ins.reset();
+      ins.bind(1, f.boat_id).bind_u(2, f.t_utc_ns).bind_u(3, f.seq).bind_u(4, f.gnss_utc_ns);
+      ins.bind(5, f.lat_deg).bind(6, f.lon_deg).bind(7, f.sog_m_s).bind(8, f.cog_deg);
+      ins.bind(9, f.fix).bind(10, static_cast<std::int64_t>(f.satellites)).bind(11, f.hdop);
+      ins.bind_u(12, f.boot_id);
+      ins.step();
+    }
+    exec(db_, "COMMIT");
+  } catch (const StoreError& e) {
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    std::lock_guard lock(mutex_);
+    last_error_ = std::string("fixes: ") + e.what();
+  }
+}
+
+std::vector<FixSample> Store::fix_page(const std::string& boat_id, std::uint64_t after_ns,
+                                       std::uint64_t to_ns, std::size_t limit) {
+  std::lock_guard lock(reader_mutex_);
+  Stmt q(reader_,
+         "SELECT t_utc_ns, seq, gnss_utc_ns, lat_deg, lon_deg, sog_m_s, cog_deg, fix, satellites, "
+         "hdop, boot_id FROM fixes WHERE boat_id = ? AND t_utc_ns > ? AND t_utc_ns <= ? AND "
+         "fix <> 'none' ORDER BY t_utc_ns LIMIT ?");
+  q.bind(1, boat_id).bind_u(2, after_ns).bind_u(3, to_ns).bind(4, static_cast<std::int64_t>(limit));
+  std::vector<FixSample> rows;
+  while (q.step()) {
+    FixSample f;
+    f.boat_id = boat_id;
+    f.t_utc_ns = q.u64(0);
+    f.seq = q.u64(1);
+    f.gnss_utc_ns = q.u64(2);
+    f.lat_deg = q.dbl(3);
+    f.lon_deg = q.dbl(4);
+    f.sog_m_s = q.dbl(5);
+    f.cog_deg = q.dbl(6);
+    f.fix = q.text(7);
+    f.satellites = static_cast<std::uint32_t>(q.i64(8));
+    f.hdop = q.dbl(9);
+    f.boot_id = q.u64(10);
+    rows.push_back(std::move(f));
+  }
+  return rows;
+}
+
+void Store::visit_fixes(const std::string& boat_id, std::uint64_t from_ns, std::uint64_t to_ns,
+                        const std::function<bool(const FixSample&)>& visit, std::size_t page) {
+  if (from_ns > to_ns) return;
+  // Exclusive keyset: the first page starts just before from_ns.
+  std::uint64_t after = from_ns == 0 ? 0 : from_ns - 1;
+  // (t_utc_ns 0 is off the contract, the door refuses it: "> 0" misses nothing.)
+  for (;;) {
+    const auto rows = fix_page(boat_id, after, to_ns, page);
+    for (const auto& f : rows)
+      if (!visit(f)) return;
+    if (rows.size() < page) return;
+    after = rows.back().t_utc_ns;
+  }
+}
+
+std::vector<FixSample> Store::track(const std::string& boat_id, std::uint64_t from_ns,
+                                    std::uint64_t to_ns, std::size_t max_points) {
+  std::vector<FixSample> all;
+  visit_fixes(boat_id, from_ns, to_ns, [&](const FixSample& f) {
+    all.push_back(f);
+    return true;
+  });
+  if (max_points == 0 || all.size() <= max_points) return all;
+  // Even in time, not in count: a receiver that paused does not get its points crowded.
+  std::vector<FixSample> out;
+  out.reserve(max_points);
+  const double t0 = static_cast<double>(all.front().t_utc_ns);
+  const double span = static_cast<double>(all.back().t_utc_ns) - t0;
+  std::size_t i = 0;
+  for (std::size_t k = 0; k < max_points && i < all.size(); ++k) {
+    const double target = t0 + span * static_cast<double>(k) / static_cast<double>(max_points - 1);
+    while (i + 1 < all.size() && static_cast<double>(all[i].t_utc_ns) < target) ++i;
+    if (out.empty() || out.back().t_utc_ns != all[i].t_utc_ns) out.push_back(all[i]);
+  }
+  if (out.back().t_utc_ns != all.back().t_utc_ns) out.back() = all.back();
+  return out;
+}
+
+FixStats Store::fix_stats(const std::string& boat_id, std::uint64_t from_ns, std::uint64_t to_ns) {
+  // Distance sailed: the receiver's speed (Doppler, ~0.05 m/s noise) integrated over time, not
+  // the sum of position steps: at 10 Hz a metre of position scatter between fixes would add
+  // more than the boat sails. A gap longer than 5 s (receiver or link silent) adds nothing: the
+  // boat's speed over it is unknown.
+  FixStats st;
+  std::uint64_t prev_t = 0;
+  double prev_sog = std::numeric_limits<double>::quiet_NaN();
+  double max_sog = std::numeric_limits<double>::quiet_NaN();
+  visit_fixes(boat_id, from_ns, to_ns, [&](const FixSample& f) {
+    ++st.fixes;
+    if (std::isfinite(f.sog_m_s) && !(f.sog_m_s <= max_sog)) max_sog = f.sog_m_s;
+    if (prev_t != 0 && std::isfinite(prev_sog) && std::isfinite(f.sog_m_s)) {
+      const double dt = static_cast<double>(f.t_utc_ns - prev_t) * 1e-9;
+      if (dt > 0.0 && dt <= 5.0) {
+        st.distance_m += 0.5 * (prev_sog + f.sog_m_s) * dt;
+        st.time_with_fix_s += dt;
+      }
+    }
+    prev_t = f.t_utc_ns;
+    prev_sog = f.sog_m_s;
+    return true;
+  });
+  st.sog_max_m_s = max_sog;
+  st.sog_mean_m_s = st.time_with_fix_s > 0.0 ? st.distance_m / st.time_with_fix_s
+                                             : std::numeric_limits<double>::quiet_NaN();
+  return st;
+}
+
 std::vector<WearableSample> Store::wearable_track(const std::string& athlete_id,
                                                   std::uint64_t from_ns, std::uint64_t to_ns,
                                                   std::size_t limit) {
@@ -371,6 +513,7 @@ void Store::flush() {
 void Store::writer_loop() {
   std::vector<AttitudeSample> batch;
   std::vector<WearableSample> wearable;
+  std::vector<FixSample> fixes;
   for (;;) {
     bool stop = false;
     {
@@ -382,9 +525,12 @@ void Store::writer_loop() {
       if (!stop && backoff_.count() > 0 && std::chrono::steady_clock::now() < retry_at_) continue;
       batch.swap(queue_);
       wearable.swap(wearable_queue_);
+      fixes.swap(fix_queue_);
     }
     if (!wearable.empty()) commit_wearable(wearable);
     wearable.clear();
+    if (!fixes.empty()) commit_fixes(fixes);
+    fixes.clear();
     if (!batch.empty()) {
       const std::size_t n = batch.size();
       const bool ok = commit(batch);
@@ -677,11 +823,17 @@ void Store::apply_retention() {
                      "DELETE FROM attitude WHERE boat_id = ?1 AND t_utc_ns BETWEEN ?2 AND ?3 "
                      "AND NOT EXISTS (SELECT 1 FROM sessions k WHERE k.boat_id = ?1 AND "
                      "k.start_ns <= attitude.t_utc_ns AND k.end_ns >= attitude.t_utc_ns)");
+    Stmt del_fixes(db_,
+                   "DELETE FROM fixes WHERE boat_id = ?1 AND t_utc_ns BETWEEN ?2 AND ?3 "
+                   "AND NOT EXISTS (SELECT 1 FROM sessions k WHERE k.boat_id = ?1 AND "
+                   "k.start_ns <= fixes.t_utc_ns AND k.end_ns >= fixes.t_utc_ns)");
     for (const auto& g : gone) {
       del_session.reset();
       del_session.bind(1, g.id).step();
       del_samples.reset();
       del_samples.bind(1, g.boat_id).bind_u(2, g.start_ns).bind_u(3, g.end_ns).step();
+      del_fixes.reset();
+      del_fixes.bind(1, g.boat_id).bind_u(2, g.start_ns).bind_u(3, g.end_ns).step();
     }
     Stmt e(db_, "DELETE FROM alarm_events WHERE phase = 'cleared' AND cleared_ns < ?");
     e.bind_u(1, cutoff).step();

@@ -1,6 +1,7 @@
 #pragma once
 /// \file
-/// The shore's recording in SQLite (WAL): attitude samples, sessions, alarm rules and events.
+/// The shore's recording in SQLite (WAL): attitude samples, GNSS fixes, sessions, alarm rules and
+/// events. A session is a boat and a time span; its fixes are the boat's fixes in that span.
 ///
 /// Writes: the DDS listener queues samples (never blocks on disk); one writer thread commits them
 /// in batches. Durability window: a sample is on disk at most `commit_interval` after it arrived
@@ -90,6 +91,15 @@ struct AttitudeRow {
   double quality = 0.0;
 };
 
+/// What the fixes of a span say about the sailing.
+struct FixStats {
+  std::int64_t fixes = 0;         ///< with a position
+  double distance_m = 0.0;        ///< distance sailed: SOG integrated over time (see fix_stats)
+  double time_with_fix_s = 0.0;
+  double sog_mean_m_s = 0.0;      ///< distance / time with a fix; NaN without fixes
+  double sog_max_m_s = 0.0;       ///< NaN without fixes
+};
+
 struct EventFilter {
   std::optional<std::string> boat_id;
   std::uint64_t from_ns = 0;
@@ -115,6 +125,21 @@ class Store {
   [[nodiscard]] std::vector<WearableSample> wearable_track(const std::string& athlete_id,
                                                            std::uint64_t from_ns,
                                                            std::uint64_t to_ns, std::size_t limit);
+  /// Queues one GNSS fix (committed with the next batch).
+  void enqueue(const FixSample& fix);
+  /// The boat's fixes with a position in [from_ns, to_ns], oldest first. More than `max_points`
+  /// are thinned evenly in time to max_points (first and last kept).
+  [[nodiscard]] std::vector<FixSample> track(const std::string& boat_id, std::uint64_t from_ns,
+                                             std::uint64_t to_ns, std::size_t max_points);
+  /// One page of fixes with a position after `after_ns` (exclusive) up to `to_ns`.
+  [[nodiscard]] std::vector<FixSample> fix_page(const std::string& boat_id, std::uint64_t after_ns,
+                                                std::uint64_t to_ns, std::size_t limit);
+  /// Calls `visit` for every fix with a position of the boat in [from_ns, to_ns], in time order.
+  void visit_fixes(const std::string& boat_id, std::uint64_t from_ns, std::uint64_t to_ns,
+                   const std::function<bool(const FixSample&)>& visit, std::size_t page = 2000);
+  /// Distance sailed and speeds over [from_ns, to_ns].
+  [[nodiscard]] FixStats fix_stats(const std::string& boat_id, std::uint64_t from_ns,
+                                   std::uint64_t to_ns);
   /// Waits (up to 10 s) until everything queued before the call is committed.
   void flush();
 
@@ -173,6 +198,7 @@ class Store {
   /// Commits a batch; on failure puts it back in the queue and returns false.
   bool commit(std::vector<AttitudeSample>& batch);
   void commit_wearable(const std::vector<WearableSample>& batch);
+  void commit_fixes(const std::vector<FixSample>& batch);
   void extend_session(const std::string& boat_id, std::uint64_t t_ns);
   void apply_retention();
   /// Shore time (ns since 1970) of the batch being committed: the sessions' arrival time.
@@ -213,6 +239,7 @@ class Store {
   std::condition_variable flushed_cv_;
   std::vector<AttitudeSample> queue_;
   std::vector<WearableSample> wearable_queue_;
+  std::vector<FixSample> fix_queue_;
   std::uint64_t enqueued_ = 0;
   std::uint64_t processed_ = 0;  ///< enqueued samples the writer has dealt with
   std::uint64_t committed_ = 0;

@@ -13,7 +13,8 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr std::uint64_t kNow = 1796215200ull * 1000000000ull;  // 2026-12-02T12:40:00Z
 
-/// A reading `north_m` metres north of 54.34 N 10.19 E.
+/// A reading `north_m` metres north of 54.34 N 10.19 E, with a receiver time `north_m` s after
+/// 12:40 (each reading its own epoch).
 GnssReading at(double north_m, double sog = 3.0, double cog = 0.0) {
   GnssReading r;
   r.lat_deg = 54.34 + north_m / 111195.0;
@@ -23,7 +24,7 @@ GnssReading at(double north_m, double sog = 3.0, double cog = 0.0) {
   r.fix = GnssFixKind::k3D;
   r.satellites = 10;
   r.hdop = 1.0;
-  r.time_of_day_s = 12 * 3600 + 40 * 60;
+  r.time_of_day_s = 12 * 3600 + 40 * 60 + north_m;
   r.date_ddmmyy = 21226;
   return r;
 }
@@ -89,6 +90,13 @@ TEST(GnssGate, CourseAtStandstillIsMarkedMeaningless) {
 
 TEST(GnssGate, GnssTimeGivesTheBoatClockOffset) {
   GnssGate gate;
+  // The same epoch reported twice (gpsd: one report per sentence) goes out once.
+  {
+    GnssGate g;
+    EXPECT_TRUE(g.on_epoch(at(1.0), 0.0, kNow));
+    EXPECT_FALSE(g.on_epoch(at(1.0), 0.01, kNow));
+    EXPECT_EQ(g.stats().repeats, 1u);
+  }
   // The receiver says 12:40:00.000 on 2026-12-02; the boat clock is 2.5 s fast.
   const auto f = gate.on_epoch(at(0), 0.0, kNow + 2500000000ull);
   ASSERT_TRUE(f);
