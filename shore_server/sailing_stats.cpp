@@ -50,6 +50,26 @@ std::optional<double> estimate_wind_from_deg(const std::vector<SailingPoint>& pt
     }
   }
   if (best_score < 0.2 * total) return std::nullopt;
+  // The band is 25 deg wide, so the best direction is only known to +-12 deg. The wind bisects
+  // the tacking angle: refine it as the bisector of the two tacks' mean courses (twice: the
+  // first bisector recentres the bands).
+  double refined = static_cast<double>(best);
+  for (int pass = 0; pass < 2; ++pass) {
+    double sx[2] = {0, 0}, sy[2] = {0, 0};
+    for (const auto& p : pts) {
+      if (!sailing(p)) continue;
+      const double off = diff180(p.cog_deg, refined);
+      const double a = std::abs(off);
+      if (a < 25.0 || a > 60.0) continue;
+      const int side = off > 0 ? 1 : 0;
+      sx[side] += p.dt_s * std::cos(p.cog_deg * M_PI / 180.0);
+      sy[side] += p.dt_s * std::sin(p.cog_deg * M_PI / 180.0);
+    }
+    if ((sx[0] == 0 && sy[0] == 0) || (sx[1] == 0 && sy[1] == 0)) break;
+    const double m0 = std::atan2(sy[0], sx[0]) * 180.0 / M_PI;
+    const double m1 = std::atan2(sy[1], sx[1]) * 180.0 / M_PI;
+    refined = std::fmod(m0 + diff180(m1, m0) / 2.0 + 360.0, 360.0);
+  }
   // Upwind or downwind: upwind the boat heels away from the wind's side. Starboard tack (wind
   // over the starboard side, course left of the wind) heels to port (heel < 0).
   const auto agreement = [&](double w) {
@@ -62,7 +82,7 @@ std::optional<double> estimate_wind_from_deg(const std::vector<SailingPoint>& pt
     }
     return a;
   };
-  const double w = static_cast<double>(best), opposite = std::fmod(w + 180.0, 360.0);
+  const double w = refined, opposite = std::fmod(w + 180.0, 360.0);
   return agreement(w) >= agreement(opposite) ? w : opposite;
 }
 

@@ -351,6 +351,7 @@ void Store::enqueue(const FixSample& fix) {
     return;
   }
   fix_queue_.push_back(fix);
+  ++fixes_enqueued_;
 }
 
 void Store::commit_fixes(const std::vector<FixSample>& batch) {
@@ -505,9 +506,12 @@ std::vector<WearableSample> Store::wearable_track(const std::string& athlete_id,
 void Store::flush() {
   std::unique_lock lock(mutex_);
   const std::uint64_t target = enqueued_;
+  const std::uint64_t fix_target = fixes_enqueued_;
   cv_.notify_all();
-  flushed_cv_.wait_for(lock, std::chrono::seconds(10),
-                       [&] { return processed_ >= target || stopping_ || backoff_.count() > 0; });
+  flushed_cv_.wait_for(lock, std::chrono::seconds(10), [&] {
+    return (processed_ >= target && fixes_processed_ >= fix_target) || stopping_ ||
+           backoff_.count() > 0;
+  });
 }
 
 void Store::writer_loop() {
@@ -529,7 +533,11 @@ void Store::writer_loop() {
     }
     if (!wearable.empty()) commit_wearable(wearable);
     wearable.clear();
-    if (!fixes.empty()) commit_fixes(fixes);
+    if (!fixes.empty()) {
+      commit_fixes(fixes);
+      std::lock_guard lock(mutex_);
+      fixes_processed_ += fixes.size();
+    }
     fixes.clear();
     if (!batch.empty()) {
       const std::size_t n = batch.size();

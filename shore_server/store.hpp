@@ -240,6 +240,8 @@ class Store {
   std::vector<AttitudeSample> queue_;
   std::vector<WearableSample> wearable_queue_;
   std::vector<FixSample> fix_queue_;
+  std::uint64_t fixes_enqueued_ = 0;
+  std::uint64_t fixes_processed_ = 0;  ///< fixes the writer has dealt with (flush waits for them)
   std::uint64_t enqueued_ = 0;
   std::uint64_t processed_ = 0;  ///< enqueued samples the writer has dealt with
   std::uint64_t committed_ = 0;

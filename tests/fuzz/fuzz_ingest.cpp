@@ -53,6 +53,10 @@ Ingest& ingest() {
                              [](const WearableSample& w) {
                                FUZZ_CHECK(check(w, kNow) == Reject::kNone);
                                store().enqueue(w);
+                             },
+                             [](const FixSample& f) {
+                               FUZZ_CHECK(check(f, kNow) == Reject::kNone);
+                               store().enqueue(f);
                              }},
                  [] { return kNow; });
   return *i;
@@ -83,12 +87,12 @@ eprosima::fastrtps::rtps::SerializedPayload_t payload(std::string_view bytes) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   telltale::fuzz::Input in(data, size);
   const std::uint8_t pick = in.byte();
-  const int topic = pick % 4;
+  const int topic = pick % 5;
   const bool as_cdr = (pick & 4) != 0;
   Ingest& door = ingest();
   const auto before = door.counters().rejected_total();
   std::uint64_t accepted_before = 0;
-  for (auto t : {Topic::kAttitude, Topic::kBackfill, Topic::kStatus, Topic::kWearable})
+  for (auto t : {Topic::kAttitude, Topic::kBackfill, Topic::kStatus, Topic::kWearable, Topic::kFix})
     accepted_before += door.counters().accepted(t);
 
   bool handed = true;
@@ -124,6 +128,24 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       m.software_version(text(in));
     }
     if (handed) (void)door.status(m);
+  } else if (topic == 4) {
+    telltale::msg::BoatFix m;
+    if (as_cdr) {
+      auto p = payload(in.rest());
+      StrictBoatFixType type;
+      handed = type.deserialize(&p, &m);
+    } else {
+      m.boat_id(text(in));
+      m.t_utc_ns(time_near(in));
+      m.gnss_utc_ns((in.byte() & 1) ? 0 : time_near(in));
+      m.lat_deg(in.raw_double());
+      m.lon_deg(in.raw_double());
+      m.sog_m_s(in.raw_double());
+      m.cog_deg(in.raw_double());
+      m.fix(static_cast<telltale::msg::FixKind>(in.byte() % 6));
+      m.hdop(static_cast<float>(in.raw_double()));
+    }
+    if (handed) (void)door.fix(m);
   } else {
     telltale::msg::WearableMotion m;
     if (as_cdr) {
@@ -141,7 +163,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (handed) (void)door.wearable(m);
   }
   std::uint64_t accepted_after = 0;
-  for (auto t : {Topic::kAttitude, Topic::kBackfill, Topic::kStatus, Topic::kWearable})
+  for (auto t : {Topic::kAttitude, Topic::kBackfill, Topic::kStatus, Topic::kWearable, Topic::kFix})
     accepted_after += door.counters().accepted(t);
   // Each sample handed to the door is counted exactly once, accepted or refused.
   if (handed)

@@ -138,7 +138,9 @@ TEST_F(FleetTest, AuthAndOpenEndpoints) {
   ASSERT_TRUE(spec);
   ASSERT_EQ(spec->status, 200);
   const json doc = json::parse(spec->body);
-  for (const char* path : {"/healthz", "/api/v1/boats", "/api/v1/stream", "/api/v1/login"})
+  for (const char* path : {"/healthz", "/api/v1/boats", "/api/v1/stream", "/api/v1/login",
+                           "/api/v1/boats/{id}/track", "/api/v1/sessions/{id}/gpx",
+                           "/api/v1/sessions/{id}/heel_speed"})
     EXPECT_TRUE(doc["paths"].contains(path)) << path;
 
   for (const auto& headers :

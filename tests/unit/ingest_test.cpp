@@ -33,11 +33,13 @@ struct Sinks {
   std::vector<AttitudeSample> attitude, backfill;
   std::vector<std::pair<std::string, NodeStatusInfo>> status;
   std::vector<WearableSample> wearable;
+  std::vector<FixSample> fixes;
   IngestSinks sinks() {
     return {[this](const AttitudeSample& s) { attitude.push_back(s); },
             [this](const AttitudeSample& s) { backfill.push_back(s); },
             [this](const std::string& id, const NodeStatusInfo& s) { status.emplace_back(id, s); },
-            [this](const WearableSample& w) { wearable.push_back(w); }};
+            [this](const WearableSample& w) { wearable.push_back(w); },
+            [this](const FixSample& f) { fixes.push_back(f); }};
   }
 };
 
@@ -221,6 +223,65 @@ TEST(JsonText, InvalidUtf8IsReplacedNotThrown) {
   SessionInfo s;
   s.boat_id = "x\xFF";
   EXPECT_NO_THROW((void)to_json_text(session_object(s)));
+}
+
+}  // namespace
+}  // namespace telltale::shore
+
+namespace telltale::shore {
+namespace {
+
+msg::BoatFix good_fix() {
+  msg::BoatFix m;
+  m.boat_id("b1");
+  m.seq(1);
+  m.t_utc_ns(kNow - 1000000000ULL);
+  m.gnss_utc_ns(kNow - 1000000000ULL);
+  m.lat_deg(54.344);
+  m.lon_deg(10.19);
+  m.sog_m_s(3.0);
+  m.cog_deg(42.0);
+  m.fix(msg::FIX_KIND_3D);
+  m.satellites(11);
+  m.hdop(0.8f);
+  return m;
+}
+
+// Given fixes off the contract (a position without a fix, a fix without a position, values
+// out of range or NaN where a number is due, an unknown fix kind), the door refuses and counts
+// each; a good fix and a no-fix epoch pass.
+TEST_F(IngestTest, FixesOffTheContractAreRefusedAndCounted) {
+  EXPECT_EQ(ingest.fix(good_fix()), Reject::kNone);
+  auto none = good_fix();
+  none.fix(msg::FIX_KIND_NONE);
+  none.lat_deg(std::nan(""));
+  none.lon_deg(std::nan(""));
+  none.sog_m_s(std::nan(""));
+  none.cog_deg(std::nan(""));
+  EXPECT_EQ(ingest.fix(none), Reject::kNone);
+  ASSERT_EQ(got.fixes.size(), 2u);
+  EXPECT_EQ(got.fixes[0].fix, "3d");
+  EXPECT_EQ(got.fixes[1].fix, "none");
+
+  std::vector<msg::BoatFix> bad;
+  auto m = good_fix(); m.lat_deg(91.0); bad.push_back(m);
+  m = good_fix(); m.lon_deg(std::nan("")); bad.push_back(m);
+  m = good_fix(); m.lon_deg(-180.5); bad.push_back(m);
+  m = good_fix(); m.sog_m_s(-1.0); bad.push_back(m);
+  m = good_fix(); m.sog_m_s(std::numeric_limits<double>::infinity()); bad.push_back(m);
+  m = good_fix(); m.cog_deg(400.0); bad.push_back(m);
+  m = good_fix(); m.hdop(-1.0f); bad.push_back(m);
+  m = good_fix(); m.fix(static_cast<msg::FixKind>(9)); bad.push_back(m);
+  m = good_fix(); m.fix(msg::FIX_KIND_NONE); bad.push_back(m);  // none, yet a position
+  for (const auto& b : bad) EXPECT_EQ(ingest.fix(b), Reject::kValue) << b.lat_deg();
+  m = good_fix(); m.boat_id("bad id"); EXPECT_EQ(ingest.fix(m), Reject::kId);
+  m = good_fix(); m.t_utc_ns(1); EXPECT_EQ(ingest.fix(m), Reject::kTime);
+  m = good_fix(); m.gnss_utc_ns(5); EXPECT_EQ(ingest.fix(m), Reject::kTime);
+  EXPECT_EQ(got.fixes.size(), 2u);
+  EXPECT_EQ(ingest.counters().accepted(Topic::kFix), 2u);
+  EXPECT_EQ(ingest.counters().rejected(Topic::kFix, Reject::kValue), bad.size());
+  EXPECT_EQ(ingest.counters().rejected(Topic::kFix, Reject::kId), 1u);
+  EXPECT_EQ(ingest.counters().rejected(Topic::kFix, Reject::kTime), 2u);
 }
 
 }  // namespace

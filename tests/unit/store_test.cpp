@@ -122,6 +122,59 @@ TEST_F(StoreTest, DeduplicatesSplitsSessionsAndAcknowledgesContiguousRuns) {
   EXPECT_EQ(acks[1].acked_seq, 1u);
 }
 
+// Given a boat sailing north at 3 m/s with 1 m of position noise per fix at 10 Hz, the
+// distance sailed is the speed integrated (not the noisy position steps, which add ~1 m per
+// fix), a 30 s receiver gap adds nothing, the track thins evenly in time, and a no-fix epoch is
+// stored but never part of the track.
+TEST_F(StoreTest, FixesGiveDistanceSpeedsAndATrack) {
+  Store store(config());
+  std::uint64_t seq = 0;
+  const auto fix = [&](double t_s, double north_m, const char* kind = "3d") {
+    FixSample f;
+    f.boat_id = "b";
+    f.seq = ++seq;
+    f.t_utc_ns = kT0 + static_cast<std::uint64_t>(t_s * 1e9);
+    f.fix = kind;
+    const bool has = std::string(kind) != "none";
+    f.lat_deg = has ? 54.0 + north_m / 111195.0 : std::nan("");
+    f.lon_deg = has ? 10.0 : std::nan("");
+    f.sog_m_s = has ? 3.0 : std::nan("");
+    f.cog_deg = has ? 0.0 : std::nan("");
+    f.satellites = 9;
+    f.hdop = 0.9;
+    return f;
+  };
+  double noise = 1.0;
+  for (int i = 0; i <= 600; ++i) {  // 60 s
+    noise = -noise;
+    store.enqueue(fix(i * 0.1, 3.0 * i * 0.1 + noise));
+  }
+  store.enqueue(fix(75.0, 225.0, "none"));  // 30 s of silence, then no fix, then fixes again
+  for (int i = 0; i <= 100; ++i) store.enqueue(fix(90.0 + i * 0.1, 270.0 + 0.3 * i));
+  store.enqueue(sample("b", 1, 1, kT0));
+  store.flush();
+  const FixStats st = store.fix_stats("b", 0, UINT64_MAX);
+  EXPECT_EQ(st.fixes, 601 + 101);
+  EXPECT_NEAR(st.distance_m, 3.0 * (60.0 + 10.0), 0.01);  // the gap adds nothing
+  EXPECT_NEAR(st.time_with_fix_s, 70.0, 1e-6);
+  EXPECT_NEAR(st.sog_mean_m_s, 3.0, 1e-9);
+  EXPECT_NEAR(st.sog_max_m_s, 3.0, 1e-9);
+  const auto all = store.track("b", 0, UINT64_MAX, 100000);
+  EXPECT_EQ(all.size(), 702u);
+  for (const auto& f : all) EXPECT_NE(f.fix, "none");
+  const auto thin = store.track("b", 0, UINT64_MAX, 50);
+  ASSERT_LE(thin.size(), 50u);
+  EXPECT_GE(thin.size(), 30u);  // the times that fall in the 30 s gap have no point of their own
+  EXPECT_EQ(thin.front().t_utc_ns, all.front().t_utc_ns);
+  EXPECT_EQ(thin.back().t_utc_ns, all.back().t_utc_ns);
+  // Evenly in time: no two kept points closer than half the mean spacing (except across the gap).
+  const double spacing = 100.0 / 49.0;
+  for (std::size_t i = 1; i < thin.size(); ++i)
+    EXPECT_GT(static_cast<double>(thin[i].t_utc_ns - thin[i - 1].t_utc_ns) * 1e-9, 0.4 * spacing);
+  // A range: only its fixes.
+  EXPECT_EQ(store.track("b", kT0 + 90 * kSecond, UINT64_MAX, 100000).size(), 101u);
+}
+
 // After a restart the receipt of a run is rebuilt from what is on disk.
 TEST_F(StoreTest, ReceiptsSurviveARestart) {
   {
