@@ -1,5 +1,6 @@
 // Telltale dashboard: hash routes over one live feed.
 //   #/fleet            every boat as a card (default)
+//   #/map              the fleet on a map: positions, course arrows, two-minute trails
 //   #/boat/ID          one boat: live charts, alarms, alarm rules editor (coach)
 //   #/review?boat=ID&session=N&vs=M   session review, overlay, export
 //   #/wearables        athletes: steps, cadence, gait, pose, dead-reckoned track
@@ -8,6 +9,7 @@
 import { api, has, loadCapabilities } from './js/api.js';
 import { mountBoat } from './js/boat.js';
 import { mountFleet } from './js/fleet.js';
+import { mountMap } from './js/map.js';
 import { Live } from './js/live.js';
 import { mountReview } from './js/review.js';
 import { beep, setSound, soundOn } from './js/sound.js';
@@ -21,7 +23,7 @@ const live = new Live();
 let role = sessionStorage.getItem('telltale.role') ?? 'unknown';
 let unmount = () => {};
 
-const ROUTES = { fleet: mountFleet, boat: mountBoat, review: mountReview, wearables: mountWearables };
+const ROUTES = { fleet: mountFleet, map: mountMap, boat: mountBoat, review: mountReview, wearables: mountWearables };
 
 function showMessage(text) {
   message.textContent = text;

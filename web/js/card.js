@@ -1,6 +1,7 @@
 // One boat's card: big heel and pitch numbers, the boat seen from astern (heels) and from the
 // side (pitches), the instrument's LED panel, alarm state, stale marker and a one-minute
 // sparkline. Used by the fleet view and at the top of the boat view.
+import { speedText } from './geo.js';
 import { deg, el, svg } from './util.js';
 
 const SPARK_S = 60;
@@ -33,6 +34,10 @@ export function createCard(id) {
         el('span', { class: 'value heel', text: '–' })),
       el('div', { class: 'readout' }, el('span', { class: 'label', text: 'Pitch' }),
         el('span', { class: 'value pitch', text: '–' }))),
+    el('div', { class: 'speed-row', 'aria-label': 'speed over ground' },
+      el('span', { class: 'label', text: 'SOG' }),
+      el('span', { class: 'value speed', text: '–' }), el('span', { class: 'unit-big', text: 'kn' }),
+      el('span', { class: 'speed-ms', text: '– m/s' }), el('span', { class: 'cog' })),
     el('div', { class: 'figures' },
       svg('svg', { class: 'silhouette astern', viewBox: '-55 -52 110 70', role: 'img',
         'aria-label': 'boat from astern' },
@@ -50,6 +55,9 @@ export function createCard(id) {
   root._parts = {
     heel: root.querySelector('.heel'),
     pitch: root.querySelector('.pitch'),
+    speed: root.querySelector('.speed'),
+    speedMs: root.querySelector('.speed-ms'),
+    cog: root.querySelector('.cog'),
     astern,
     side,
     leds,
@@ -79,6 +87,11 @@ export function updateCard(root, entry, stale) {
   p.group.textContent = b.group ?? '';
   p.heel.textContent = deg(b.heel_deg);
   p.pitch.textContent = deg(b.pitch_deg);
+  const sp = speedText(b.sog_m_s);
+  p.speed.textContent = sp.kn;
+  p.speedMs.textContent = sp.ms;
+  p.cog.textContent = Number.isFinite(b.cog_deg) ? `COG ${b.cog_deg.toFixed(0).padStart(3, '0')}°`
+    : b.gnss_fix === undefined ? '' : 'no fix';
   // Seen from astern, starboard is on the right: heel > 0 (starboard down) turns the hull
   // clockwise on screen, which is a positive SVG rotation.
   p.astern.setAttribute('transform', `rotate(${(b.heel_deg ?? 0).toFixed(1)})`);
