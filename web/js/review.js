@@ -1,8 +1,13 @@
 // Session review: pick a boat and a session; heel and pitch charts (drag to zoom, double-click
 // to reset) with a time scrubber, alarm events on the timeline, the heel distribution and the
 // time in each heel band, a second session (another boat or another day) overlaid, and export.
+// With GNSS: the session's track coloured by heel with a marker that follows the scrubber, a
+// speed chart, distance and speeds, GPX download, and heel against speed (heel_speed.js).
 import { api, has, q } from './api.js';
 import { COLORS, autoResize, loadUPlot, markersPlugin, widthOf } from './charts.js';
+import { KNOTS_PER_M_S } from './geo.js';
+import { heelSpeedPanel } from './heel_speed.js';
+import { moveTrackMarker, trackPanel } from './track.js';
 import { clock, deg, duration, el, isoToSeconds, svg } from './util.js';
 
 const CHART_H = 220;
@@ -54,12 +59,15 @@ export function mountReview(container, { query, navigate }) {
         api(`/sessions/${sid}`),
         api(`/sessions/${sid}/attitude${q({ max_points: MAX_POINTS })}`),
       ]);
+      // The GNSS track over the session (none from an older server or a boat without a fix).
+      const track = await api(`/boats/${encodeURIComponent(detail.boat_id)}/track` +
+        q({ from: detail.start_t_s, to: detail.end_t_s, max_points: MAX_POINTS })).catch(() => null);
       // The session detail lists its alarm events; older servers only count them.
       let events = Array.isArray(detail.alarm_events) ? detail.alarm_events : [];
       if (!Array.isArray(detail.alarm_events) && has('/alarms/events')) {
         events = await api(`/alarms/events${q({ boat: detail.boat_id, from: detail.start_t_s, to: detail.end_t_s + 1 })}`);
       }
-      return { detail, data, events };
+      return { detail, data, events, track };
     };
     const main = await load(state.session);
     const vs = state.vs ? await load(state.vs) : null;
@@ -101,8 +109,8 @@ function render(body, uPlot, main, vs) {
     return `${s < 0 ? '-' : ''}${Math.floor(Math.abs(s) / 60)}:${String(Math.abs(s) % 60).padStart(2, '0')}`;
   };
 
-  const exportLinks = (d) => ['csv', 'json'].map((f) => el('a', {
-    class: 'button export', href: `/api/v1/sessions/${d.detail.id}/export?format=${f}`,
+  const exportLinks = (d) => ['csv', 'json', ...(d.detail.gnss ? ['gpx'] : [])].map((f) => el('a', {
+    class: 'button export', href: f === 'gpx' ? `/api/v1/sessions/${d.detail.id}/gpx` : `/api/v1/sessions/${d.detail.id}/export?format=${f}`,
     download: `${d.detail.boat_id}-session-${d.detail.id}.${f}`, dataset: { format: f, session: String(d.detail.id) },
     text: `Export ${f.toUpperCase()}`,
   }));
@@ -110,18 +118,21 @@ function render(body, uPlot, main, vs) {
     el('span', { class: 'swatch', style: `background:${color}` }),
     `${name(d)} · ${d.detail.start.slice(0, 19).replace('T', ' ')} UTC · ${duration(d.detail.duration_s)} · ` +
     `${d.detail.samples} samples${d.data.downsampled ? ` (drawn: ${d.data.t_s.length} points, peaks kept)` : ''}` +
-    ` · ${d.events.length} alarm events `, ...exportLinks(d));
+    ` · ${d.events.length} alarm events `, gnssSummary(d.detail.gnss), ...exportLinks(d));
 
   const chartsBox = el('section', { class: 'charts', 'aria-label': 'session charts' });
+  const track = main.track?.points ? trackPanel(main) : null;
   const scrub = el('input', { type: 'range', id: 'scrubber', min: 0, max: Math.ceil(m.duration_s), step: 0.1, value: 0,
     'aria-label': 'time scrubber' });
   const readout = el('output', { class: 'scrub-readout', for: 'scrubber' });
   body.append(...[
     summary(main, COLORS[0]), vs ? summary(vs, COLORS[1]) : null,
     vs ? el('p', { class: 'hint', text: overlap ? 'Overlay aligned on clock time.' : 'Overlay aligned on session start.' }) : null,
-    chartsBox,
-    el('div', { class: 'scrub' }, el('label', { for: 'scrubber', text: 'Time' }), scrub, readout,
-      el('button', { type: 'button', id: 'reset-zoom', text: 'Reset zoom', onclick: () => charts.forEach((u) => u.setScale('x', { min: data[0][0], max: data[0][data[0].length - 1] })) }))]
+    el('div', { class: `review-grid${track ? ' with-track' : ''}` },
+      el('div', { class: 'review-main' }, chartsBox,
+        el('div', { class: 'scrub' }, el('label', { for: 'scrubber', text: 'Time' }), scrub, readout,
+          el('button', { type: 'button', id: 'reset-zoom', text: 'Reset zoom', onclick: () => charts.forEach((u) => u.setScale('x', { min: data[0][0], max: data[0][data[0].length - 1] })) }))),
+      track)]
     .filter(Boolean));
 
   const charts = [];
@@ -160,6 +171,35 @@ function render(body, uPlot, main, vs) {
     box.uplot = u; // the browser tests read the zoom from here
     charts.push(u);
   }
+  // Speed over ground (knots) from the track, on the same time axis.
+  if (main.track?.points) {
+    const tr = main.track;
+    const box = el('div', { class: 'chart', dataset: { series: 'sog' } });
+    chartsBox.append(box);
+    const u = new uPlot({
+      width: widthOf(chartsBox),
+      height: Math.round(CHART_H * 0.8),
+      scales: { x: { time: false } },
+      cursor: { sync: { key: sync.key, setSeries: false }, drag: { x: true, y: false } },
+      series: [{ label: 'Time', value: (u, v) => (v === null ? '–' : `${fmtRel(v)} (${clock(t0 + v)} UTC)`) },
+        { label: `Speed kn ${name(main)}`, stroke: COLORS[2], width: 2, spanGaps: false,
+          value: (u, v) => (v === null ? '–' : `${v.toFixed(1)} kn`) }],
+      axes: [{ space: 70, values: (u, vals) => vals.map((v) => fmtRel(v)) }, { size: 50 }],
+      plugins: [markersPlugin(() => markers)],
+      hooks: {
+        setCursor: [(u) => {
+          const i = u.cursor.idx;
+          if (i !== null && i !== undefined && document.activeElement !== scrub) {
+            scrub.value = String(u.data[0][i]);
+            showReadout(u.data[0][i]);
+          }
+        }],
+      },
+    }, [tr.t_s.map((t) => t - t0), tr.sog_m_s.map((v) => (Number.isFinite(v) ? v * KNOTS_PER_M_S : null))], box);
+    box.uplot = u;
+    u.setScale('x', { min: data[0][0], max: data[0][data[0].length - 1] });
+    charts.push(u);
+  }
   const valueAt = (d, base, t) => {
     const xs = d.data.t_s;
     let lo = 0;
@@ -172,6 +212,7 @@ function render(body, uPlot, main, vs) {
     return lo < xs.length ? { heel: d.data.heel_deg[lo], pitch: d.data.pitch_deg[lo] } : null;
   };
   function showReadout(t) {
+    if (track) moveTrackMarker(track, t0 + t);
     const a = valueAt(main, t0, t);
     const b = vs ? valueAt(vs, vsT0, t) : null;
     readout.textContent = `${fmtRel(t)} · ${clock(t0 + t)} UTC · ${name(main)} heel ${deg(a?.heel)} pitch ${deg(a?.pitch)}` +
@@ -207,12 +248,21 @@ function render(body, uPlot, main, vs) {
     histogram([main, vs].filter(Boolean)),
     el('h2', { text: 'Time in each heel band' }),
     bandsTable([main, vs].filter(Boolean), name)));
+  if (m.gnss) body.append(heelSpeedPanel(m));
 
   const stopResize = autoResize(() => charts, chartsBox, CHART_H);
   return () => {
     stopResize();
     charts.forEach((u) => u.destroy());
   };
+}
+
+function gnssSummary(g) {
+  if (!g) return null;
+  const kn = (v) => (Number.isFinite(v) ? `${(v * KNOTS_PER_M_S).toFixed(1)} kn` : '–');
+  const dist = g.distance_m >= 1000 ? `${(g.distance_m / 1000).toFixed(2)} km` : `${Math.round(g.distance_m)} m`;
+  return el('span', { class: 'gnss-summary', dataset: { distanceM: String(g.distance_m) } },
+    g.fixes ? `${dist} sailed · SOG mean ${kn(g.sog_mean_m_s)}, max ${kn(g.sog_max_m_s)} · ` : 'no GNSS fix · ');
 }
 
 // Time-weighted heel histogram, 2 degree bins, each session as its own colour.
