@@ -12,6 +12,7 @@
 #include "dds_participant.hpp"
 #include "dds_security.hpp"
 #include "shutdown.hpp"
+#include "telltale/fusion/handheld_pdr.hpp"
 #include "telltale/fusion/pdr.hpp"
 #include "telltale/fusion/sim/gait_sim.hpp"
 #include "telltalePubSubTypes.h"
@@ -131,7 +132,11 @@ class WitMotionWearable : public WearableSource {
 };
 
 std::unique_ptr<WearableSource> make_source(const Options& o) {
-  if (o.source == "sim") return std::make_unique<SimWearable>("phone-switch", o.seed);
+  // The simulated walker carries the phone the way the mount says: held in front for `phone`
+  // (what HandheldPdr is for), switching poses for `body` and `foot` (as before).
+  if (o.source == "sim")
+    return std::make_unique<SimWearable>(o.mount == "phone" ? "phone-hand-held-walk" : "phone-switch",
+                                         o.seed);
   if (o.source.rfind("sim:", 0) == 0)
     return std::make_unique<SimWearable>(o.source.substr(4), o.seed);
   if (o.source.rfind("replay:", 0) == 0)
@@ -184,15 +189,28 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   if (!(o.step_scale >= 0.5 && o.step_scale <= 1.5))
     throw std::invalid_argument("--step-scale must be in 0.5..1.5");
   if (!(o.rate_hz > 0 && o.rate_hz <= 50)) throw std::invalid_argument("--rate-hz in (0, 50]");
-  if (o.mount != "phone" && o.mount != "foot")
-    throw std::invalid_argument("--mount is phone or foot");
+  if (o.mount != "phone" && o.mount != "body" && o.mount != "foot")
+    throw std::invalid_argument("--mount is phone, body or foot");
   const bool foot = o.mount == "foot";
+  const bool handheld = o.mount == "phone";
   auto source = make_source(o);
+  // One pipeline per mount, the same as `fusion_cli pdr --mount`: phone -> HandheldPdr (a phone
+  // held in front), body -> the seed-003 Pdr with its four poses, foot -> the foot Pdr.
   fusion::PdrParams params;
   params.mount = foot ? fusion::StepMount::kFoot : fusion::StepMount::kBody;
   params.height_m = o.height_m;
   params.step_scale.fill(o.step_scale);
-  auto pdr = std::make_unique<fusion::Pdr>(params);  // 110 kB: not on the stack
+  std::unique_ptr<fusion::Pdr> pdr;                 // 110 kB: not on the stack
+  std::unique_ptr<fusion::HandheldPdr> phone_pdr;
+  if (handheld) {
+    fusion::HandheldPdrParams hp;
+    hp.height_m = o.height_m;
+    hp.step_scale = o.step_scale;
+    phone_pdr = std::make_unique<fusion::HandheldPdr>(hp);
+  } else {
+    pdr = std::make_unique<fusion::Pdr>(params);
+  }
+  unsigned rejected_non_finite = 0;  // HandheldPdr drops such samples without counting them
 
   auto dds_options = o.dds;
   telltale::dds::use_node_partitions(dds_options, o.athlete_id);  // secured: its own only
@@ -233,7 +251,24 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
           start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(t));
       if (shutdown.wait_for(due - Clock::now())) break;
     }
-    const fusion::PdrOutput& p = pdr->update(s->imu, s->mag_uT);
+    fusion::PdrOutput handheld_out;
+    if (handheld) {
+      if (!s->imu.acc_body_m_s2.allFinite() || !s->imu.gyro_body_rad_s.allFinite())
+        ++rejected_non_finite;
+      phone_pdr->update(s->imu, s->mag_uT);
+      const auto& h = phone_pdr->last();
+      handheld_out.steps = h.steps;
+      handheld_out.step_hz = phone_pdr->walking() ? h.step_hz : 0.0;
+      handheld_out.cadence_spm = 60.0 * handheld_out.step_hz;
+      const double f = handheld_out.step_hz;  // the same cadence classes as Pdr
+      handheld_out.gait = f < 1.6 ? 0 : f < 1.95 ? 1 : f < 2.35 ? 2 : f < 2.75 ? 3 : 4;
+      handheld_out.pose = fusion::PhonePose::kHandHeld;
+      handheld_out.x_m = h.x_m;
+      handheld_out.y_m = h.y_m;
+      handheld_out.heading_deg = h.heading_deg;
+      handheld_out.distance_m = h.distance_m;
+    }
+    const fusion::PdrOutput& p = handheld ? handheld_out : pdr->update(s->imu, s->mag_uT);
     if (t >= next_publish) {
       next_publish = t + 1.0 / o.rate_hz;
       m.seq(++seq);
@@ -250,13 +285,12 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
     }
     if (Clock::now() >= next_status) {
       next_status += std::chrono::seconds(1);
-      const auto& d = pdr->diagnostics();
+      const unsigned bad = handheld ? rejected_non_finite : pdr->diagnostics().rejected_non_finite;
       status.t_utc_ns(telltale::utc_now_ns());
       status.uptime_s(std::chrono::duration<double>(Clock::now() - start).count());
       status.samples_published(seq);
-      status.sensor_health(d.rejected_non_finite ? telltale::msg::SENSOR_NON_FINITE
-                                                 : telltale::msg::SENSOR_OK);
-      status.health_text(d.rejected_non_finite ? "non-finite samples rejected" : "ok");
+      status.sensor_health(bad ? telltale::msg::SENSOR_NON_FINITE : telltale::msg::SENSOR_OK);
+      status.health_text(bad ? "non-finite samples rejected" : "ok");
       status_writer->write(&status);
     }
   }
@@ -277,7 +311,9 @@ int main(int argc, char** argv) {
   app.add_option("--source", o.source,
                  "sim | sim:SCENARIO | replay:FILE.csv | witmotion:DEVICE[@BAUD]")
       ->capture_default_str();
-  app.add_option("--mount", o.mount, "phone (carried) or foot (toe-mounted module)")
+  app.add_option("--mount", o.mount,
+                 "phone (held in front: HandheldPdr, as fusion_cli pdr --mount phone) | body "
+                 "(carried in any of the seed-003 poses) | foot (toe-mounted module)")
       ->capture_default_str();
   app.add_option("--height-m", o.height_m, "athlete's height (step length model)")
       ->capture_default_str();
