@@ -2,10 +2,10 @@
 // measuring delivery latency (boat write -> SSE event), and the shore's CPU and RSS from /proc.
 //
 //   build/bin/fleet_load --domain D --shore-url http://127.0.0.1:PORT --token T
-//       --shore-pid PID --boats 200 --rate-hz 25 --seconds 300 --sse-clients 1
+//       --shore-pid PID --boats 200 --rate-hz 25 --fix-hz 10 --seconds 300 --sse-clients 1
 //
-// Prints one JSON object: samples written, samples the shore committed, latency percentiles,
-// shore CPU (% of one core) and peak RSS.
+// Prints one JSON object: samples and GNSS fixes written, what the shore committed, latency
+// percentiles, shore CPU (% of one core) and peak RSS.
 #include <CLI/CLI.hpp>
 #include <httplib.h>
 
@@ -67,6 +67,7 @@ int main(int argc, char** argv) {
   int shore_pid = 0;
   int boats = 200;
   double rate_hz = 25;
+  double fix_hz = 10;
   double seconds = 300;
   int sse_clients = 1;
   CLI::App app{"Telltale fleet load generator"};
@@ -76,6 +77,8 @@ int main(int argc, char** argv) {
   app.add_option("--shore-pid", shore_pid, "shore process id (CPU and RSS)");
   app.add_option("--boats", boats)->capture_default_str();
   app.add_option("--rate-hz", rate_hz)->capture_default_str();
+  app.add_option("--fix-hz", fix_hz, "GNSS fixes per boat per second (a divisor of --rate-hz); 0: none")
+      ->capture_default_str();
   app.add_option("--seconds", seconds)->capture_default_str();
   app.add_option("--sse-clients", sse_clients, "SSE clients held open (the first measures latency)")
       ->capture_default_str();
@@ -129,6 +132,10 @@ int main(int argc, char** argv) {
                         eprosima::fastdds::dds::TypeSupport(
                             new telltale::msg::BoatAttitudePubSubType())),
       "attitude_writer");
+  auto* fix_writer = participant.writer(
+      participant.topic(telltale::dds::kTopicBoatFix,
+                        eprosima::fastdds::dds::TypeSupport(new telltale::msg::BoatFixPubSubType())),
+      "fix_writer");
   std::this_thread::sleep_for(std::chrono::seconds(3));  // discovery
   // The first seconds of latencies include discovery; count from here.
   {
@@ -144,6 +151,18 @@ int main(int argc, char** argv) {
     std::snprintf(id, sizeof id, "load-%03d", b);
     samples[static_cast<std::size_t>(b)].boat_id(id);
   }
+  std::vector<telltale::msg::BoatFix> fixes(static_cast<std::size_t>(boats));
+  for (int b = 0; b < boats; ++b) {
+    auto& f = fixes[static_cast<std::size_t>(b)];
+    f.boat_id(samples[static_cast<std::size_t>(b)].boat_id());
+    f.fix(telltale::msg::FIX_KIND_3D);
+    f.satellites(12);
+    f.hdop(0.8f);
+  }
+  // Fixes every `fix_every` attitude ticks (25 / 10 Hz: alternately every 2nd and 3rd tick).
+  const double fix_every = fix_hz > 0 ? rate_hz / fix_hz : 0.0;
+  double next_fix_tick = 0.0;
+  long fixes_written = 0;
   const auto period = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(1.0 / rate_hz));
   const auto start = Clock::now();
@@ -166,6 +185,28 @@ int main(int argc, char** argv) {
         ++failed;
       }
     }
+    if (fix_every > 0 && static_cast<double>(seq) >= next_fix_tick) {
+      next_fix_tick += fix_every;
+      const double t = static_cast<double>(seq) / rate_hz;
+      for (std::size_t b = 0; b < fixes.size(); ++b) {
+        auto& f = fixes[b];
+        f.seq(f.seq() + 1);
+        f.t_utc_ns(telltale::utc_now_ns());
+        f.gnss_utc_ns(f.t_utc_ns());
+        // Each boat sails its own circle of 200 m around its own spot, 3 m/s.
+        const double a = t * 3.0 / 200.0 + static_cast<double>(b);
+        f.lat_deg(54.34 + (static_cast<double>(b % 20) * 300.0 + 200.0 * std::sin(a)) / 111195.0);
+        f.lon_deg(10.19 + (static_cast<double>(b / 20) * 300.0 + 200.0 * std::cos(a)) / 65000.0);
+        f.sog_m_s(3.0);
+        const double cog = std::fmod(-a * 180.0 / M_PI, 360.0);  // clockwise = -a
+        f.cog_deg(cog < 0.0 ? cog + 360.0 : cog);
+        if (fix_writer->write(&f)) {
+          ++fixes_written;
+        } else {
+          ++failed;
+        }
+      }
+    }
     if (shore_pid && seq % 25 == 0) peak_rss = std::max(peak_rss, read_proc(shore_pid).rss_kb);
     tick += period;
     std::this_thread::sleep_until(tick);
@@ -177,7 +218,9 @@ int main(int argc, char** argv) {
 
   httplib::Client c(host, port);
   auto health = c.Get("/healthz");
-  const long committed = health ? json::parse(health->body)["samples_committed"].get<long>() : -1;
+  const json h = health ? json::parse(health->body, nullptr, false) : json();
+  const long committed = h.is_object() ? h.value("samples_committed", -1L) : -1;
+  const long fixes_committed = h.is_object() ? h.value("fixes_committed", -1L) : -1;
   for (auto& t : clients) t.join();  // each returns on its next event (the shore keeps streaming)
 
   std::sort(latencies_ms.begin(), latencies_ms.end());
@@ -191,6 +234,9 @@ int main(int argc, char** argv) {
               {"samples_written", written},
               {"write_failures", failed},
               {"samples_committed_by_shore", committed},
+              {"fix_hz", fix_hz},
+              {"fixes_written", fixes_written},
+              {"fixes_committed_by_shore", fixes_committed},
               {"sse_clients", sse_clients},
               {"sse_sample_events_measured", sse_events.load()},
               {"latency_ms_p50", pct(0.50)},

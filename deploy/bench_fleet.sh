@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Load benchmark (issue 7): N boats x R Hz for S seconds through real DDS into one shore, with
-# SSE clients connected; optionally wrk against GET /api/v1/boats meanwhile. Loopback only.
+# Load benchmark (issue 7): N boats x 25 Hz attitude + 10 Hz GNSS fixes (fleet_load's defaults) for
+# S seconds through real DDS into one shore, with SSE clients connected; optionally wrk against
+# GET /api/v1/boats meanwhile. Loopback only.
 #   deploy/bench_fleet.sh [BOATS] [SECONDS] [SSE_CLIENTS] [WRK_SECONDS]
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -30,4 +31,4 @@ if [ "$wrk_s" -gt 0 ]; then
 fi
 wait $load
 cat "$dir/load.json"
-echo "stored in SQLite: $(sqlite3 "$dir/bench.db" 'SELECT COUNT(*) FROM attitude')"
+echo "stored in SQLite: $(sqlite3 "$dir/bench.db" 'SELECT COUNT(*) FROM attitude') samples, $(sqlite3 "$dir/bench.db" 'SELECT COUNT(*) FROM fixes') fixes"

@@ -155,7 +155,8 @@ struct HttpApi::Impl {
       json j = {{"status", store_error.empty() ? "ok" : "degraded"},
                 {"boats", ctx.fleet.boats().size()},
                 {"stream_clients", ctx.hub.clients()},
-                {"samples_committed", ctx.store.committed()}};
+                {"samples_committed", ctx.store.committed()},
+                {"fixes_committed", ctx.store.fixes_committed()}};
       if (!store_error.empty()) j["store_error"] = store_error;
       // The writer: a failing disk shows as a backlog, refused samples and the next retry.
       const StoreHealth sh = ctx.store.health();

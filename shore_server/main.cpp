@@ -165,9 +165,10 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
     hub.publish_event("wearable", to_json_text(athlete_object(view)), w.athlete_id);
   };
   callbacks.on_fix = [&](const FixSample& f) {
+    // The dashboards get the position with the boat's next attitude frame (25 Hz): a frame of
+    // its own per fix would only add load (and carry the previous attitude's time).
     store.enqueue(f);
-    if (auto v = fleet.update_fix(f, std::chrono::steady_clock::now()))
-      hub.publish_sample(f.boat_id, boat_json(*v));
+    (void)fleet.update_fix(f, std::chrono::steady_clock::now());
   };
   callbacks.on_status = [&](const std::string& id, const NodeStatusInfo& st) {
     fleet.update_status(id, st);

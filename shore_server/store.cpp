@@ -370,6 +370,8 @@ void Store::commit_fixes(const std::vector<FixSample>& batch) {
       ins.step();
     }
     exec(db_, "COMMIT");
+    std::lock_guard lock(mutex_);
+    fixes_committed_ += batch.size();
   } catch (const StoreError& e) {
     sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
     std::lock_guard lock(mutex_);
@@ -1008,6 +1010,11 @@ std::uint64_t Store::max_event_id() {
   std::lock_guard lock(reader_mutex_);
   Stmt q(reader_, "SELECT COALESCE(MAX(id), 0) FROM alarm_events");
   return q.step() ? q.u64(0) : 0;
+}
+
+std::uint64_t Store::fixes_committed() const {
+  std::lock_guard lock(mutex_);
+  return fixes_committed_;
 }
 
 std::uint64_t Store::committed() const {

@@ -189,6 +189,8 @@ class Store {
   [[nodiscard]] std::vector<DuplicateId> duplicate_ids() const;
 
   [[nodiscard]] std::uint64_t committed() const;
+  /// GNSS fixes written (re-sent duplicates included: INSERT OR IGNORE counts them too).
+  [[nodiscard]] std::uint64_t fixes_committed() const;
   [[nodiscard]] StoreHealth health() const;
   /// Last error of the writer thread, empty if none.
   [[nodiscard]] std::string last_error() const;
@@ -241,7 +243,8 @@ class Store {
   std::vector<WearableSample> wearable_queue_;
   std::vector<FixSample> fix_queue_;
   std::uint64_t fixes_enqueued_ = 0;
-  std::uint64_t fixes_processed_ = 0;  ///< fixes the writer has dealt with (flush waits for them)
+  std::uint64_t fixes_processed_ = 0;
+  std::uint64_t fixes_committed_ = 0;  ///< fixes the writer has dealt with (flush waits for them)
   std::uint64_t enqueued_ = 0;
   std::uint64_t processed_ = 0;  ///< enqueued samples the writer has dealt with
   std::uint64_t committed_ = 0;
