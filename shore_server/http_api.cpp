@@ -164,8 +164,13 @@ struct HttpApi::Impl {
                     {"backlog", sh.backlog},
                     {"dropped", sh.dropped},
                     {"failed_commits", sh.failed_commits},
-                    {"retry_in_s", sh.retry_in_s}};
-      if (sh.failing || sh.dropped > 0) j["status"] = "degraded";
+                    {"retry_in_s", sh.retry_in_s},
+                    {"wearable_backlog", sh.wearable_backlog},
+                    {"fix_backlog", sh.fix_backlog},
+                    {"wearable_dropped", sh.wearable_dropped},
+                    {"fixes_dropped", sh.fixes_dropped}};
+      if (sh.failing || sh.dropped > 0 || sh.wearable_dropped > 0 || sh.fixes_dropped > 0)
+        j["status"] = "degraded";
       // Two nodes sailing with one boat id: flagged (their samples still share sessions).
       json duplicates = json::array();
       for (const auto& d : ctx.store.duplicate_ids())

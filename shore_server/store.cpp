@@ -318,10 +318,27 @@ void Store::enqueue(const AttitudeSample& sample) {
 
 void Store::enqueue(const WearableSample& sample) {
   std::lock_guard lock(mutex_);
+  if (wearable_queue_.size() >= config_.max_backlog) {
+    ++dropped_wearable_;
+    return;
+  }
   wearable_queue_.push_back(sample);
 }
 
-void Store::commit_wearable(const std::vector<WearableSample>& batch) {
+template <class T>
+void Store::requeue(std::vector<T>& batch, std::vector<T>& queue, std::uint64_t& dropped) {
+  std::lock_guard lock(mutex_);
+  // The failed batch is older than what came meanwhile: it goes first.
+  batch.insert(batch.end(), queue.begin(), queue.end());
+  queue.swap(batch);
+  if (queue.size() > config_.max_backlog) {
+    const std::size_t over = queue.size() - config_.max_backlog;
+    dropped += over;
+    queue.erase(queue.begin(), queue.begin() + static_cast<std::ptrdiff_t>(over));
+  }
+}
+
+bool Store::commit_wearable(const std::vector<WearableSample>& batch) {
   std::lock_guard db_lock(db_mutex_);
   try {
     exec(db_, "BEGIN");
@@ -337,24 +354,26 @@ void Store::commit_wearable(const std::vector<WearableSample>& batch) {
       ins.step();
     }
     exec(db_, "COMMIT");
+    return true;
   } catch (const StoreError& e) {
     sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
     std::lock_guard lock(mutex_);
     last_error_ = std::string("wearable: ") + e.what();
+    return false;
   }
 }
 
 void Store::enqueue(const FixSample& fix) {
   std::lock_guard lock(mutex_);
   if (fix_queue_.size() >= config_.max_backlog) {
-    ++dropped_;
+    ++dropped_fixes_;
     return;
   }
   fix_queue_.push_back(fix);
   ++fixes_enqueued_;
 }
 
-void Store::commit_fixes(const std::vector<FixSample>& batch) {
+bool Store::commit_fixes(const std::vector<FixSample>& batch) {
   std::lock_guard db_lock(db_mutex_);
   try {
     exec(db_, "BEGIN");
@@ -372,10 +391,12 @@ void Store::commit_fixes(const std::vector<FixSample>& batch) {
     exec(db_, "COMMIT");
     std::lock_guard lock(mutex_);
     fixes_committed_ += batch.size();
+    return true;
   } catch (const StoreError& e) {
     sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
     std::lock_guard lock(mutex_);
     last_error_ = std::string("fixes: ") + e.what();
+    return false;
   }
 }
 
@@ -533,20 +554,38 @@ void Store::writer_loop() {
       wearable.swap(wearable_queue_);
       fixes.swap(fix_queue_);
     }
-    if (!wearable.empty()) commit_wearable(wearable);
+    // Every kind is kept and retried when its write fails (a full disk): wearables and fixes
+    // have no backfill, so a batch dropped here would be lost for good.
+    bool failed = false;
+    const bool work = !wearable.empty() || !fixes.empty() || !batch.empty();
+    if (!wearable.empty() && !commit_wearable(wearable)) {
+      failed = true;
+      requeue(wearable, wearable_queue_, dropped_wearable_);
+    }
     wearable.clear();
     if (!fixes.empty()) {
-      commit_fixes(fixes);
-      std::lock_guard lock(mutex_);
-      fixes_processed_ += fixes.size();
+      const std::size_t n = fixes.size();
+      if (commit_fixes(fixes)) {
+        std::lock_guard lock(mutex_);
+        fixes_processed_ += n;
+      } else {
+        failed = true;
+        requeue(fixes, fix_queue_, dropped_fixes_);
+      }
     }
     fixes.clear();
     if (!batch.empty()) {
       const std::size_t n = batch.size();
-      const bool ok = commit(batch);
-      std::lock_guard lock(mutex_);
-      if (ok) {
+      if (commit(batch)) {
+        std::lock_guard lock(mutex_);
         processed_ += n;
+      } else {
+        failed = true;
+      }
+    }
+    if (work) {
+      std::lock_guard lock(mutex_);
+      if (!failed) {
         backoff_ = std::chrono::milliseconds(0);
       } else {
         ++failed_commits_;
@@ -1028,6 +1067,10 @@ StoreHealth Store::health() const {
   h.failing = backoff_.count() > 0;
   h.backlog = queue_.size();
   h.dropped = dropped_;
+  h.wearable_backlog = wearable_queue_.size();
+  h.fix_backlog = fix_queue_.size();
+  h.wearable_dropped = dropped_wearable_;
+  h.fixes_dropped = dropped_fixes_;
   h.failed_commits = failed_commits_;
   if (h.failing)
     h.retry_in_s = std::max(

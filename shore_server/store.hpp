@@ -65,6 +65,10 @@ struct StoreHealth {
   bool failing = false;       ///< the latest commit failed
   std::size_t backlog = 0;    ///< samples queued, not committed
   std::uint64_t dropped = 0;  ///< samples refused: backlog full (never acknowledged)
+  std::size_t wearable_backlog = 0;   ///< wearable samples queued, kept while writes fail
+  std::size_t fix_backlog = 0;        ///< GNSS fixes queued, kept while writes fail
+  std::uint64_t wearable_dropped = 0; ///< beyond the bound while failing: lost (no backfill)
+  std::uint64_t fixes_dropped = 0;    ///< the same for fixes
   std::uint64_t failed_commits = 0;
   double retry_in_s = 0.0;  ///< until the next attempt while failing
   std::string last_error;
@@ -199,8 +203,13 @@ class Store {
   void writer_loop();
   /// Commits a batch; on failure puts it back in the queue and returns false.
   bool commit(std::vector<AttitudeSample>& batch);
-  void commit_wearable(const std::vector<WearableSample>& batch);
-  void commit_fixes(const std::vector<FixSample>& batch);
+  /// Each false when the write failed (the caller requeues the batch).
+  bool commit_wearable(const std::vector<WearableSample>& batch);
+  bool commit_fixes(const std::vector<FixSample>& batch);
+  /// A failed batch back at the head of its queue, the queue bounded by max_backlog (the oldest
+  /// beyond it dropped and counted in `dropped`).
+  template <class T>
+  void requeue(std::vector<T>& batch, std::vector<T>& queue, std::uint64_t& dropped);
   void extend_session(const std::string& boat_id, std::uint64_t t_ns);
   void apply_retention();
   /// Shore time (ns since 1970) of the batch being committed: the sessions' arrival time.
@@ -244,7 +253,9 @@ class Store {
   std::vector<FixSample> fix_queue_;
   std::uint64_t fixes_enqueued_ = 0;
   std::uint64_t fixes_processed_ = 0;
-  std::uint64_t fixes_committed_ = 0;  ///< fixes the writer has dealt with (flush waits for them)
+  std::uint64_t fixes_committed_ = 0;
+  std::uint64_t dropped_wearable_ = 0;
+  std::uint64_t dropped_fixes_ = 0;  ///< fixes the writer has dealt with (flush waits for them)
   std::uint64_t enqueued_ = 0;
   std::uint64_t processed_ = 0;  ///< enqueued samples the writer has dealt with
   std::uint64_t committed_ = 0;

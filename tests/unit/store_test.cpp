@@ -363,5 +363,59 @@ TEST_F(StoreTest, FullDiskBacksOffBoundsTheBacklogAndSaysWhatIsLost) {
   EXPECT_NE(said.find("session logs"), std::string::npos) << said;
 }
 
+// Given a full disk, wearable samples and GNSS fixes (which no boat can resend) are kept and
+// retried like attitude, and all of them are stored once space comes back.
+TEST_F(StoreTest, FullDiskKeepsWearablesAndFixesAndStoresThemLater) {
+  const auto mnt = dir_ / "full";
+  std::filesystem::create_directories(mnt);
+  if (!private_mounts() || ::mount("tmpfs", mnt.c_str(), "tmpfs", 0, "size=1m,mode=0755") != 0)
+    FAIL() << "needs root and mount namespaces (a fault test fails, never skips, without them)";
+  struct Unmount {
+    std::filesystem::path p;
+    ~Unmount() { ::umount2(p.c_str(), MNT_DETACH); }
+  } unmount{mnt};
+  auto c = config();
+  c.path = (mnt / "s.db").string();
+  c.max_retry_interval = std::chrono::milliseconds(200);
+  Store store(c);
+  store.enqueue(sample("w", 1, 1, kT0));
+  store.flush();
+  fill_disk(mnt / "ballast");
+  constexpr int kN = 600;
+  for (int i = 0; i < kN; ++i) {
+    WearableSample w;
+    w.athlete_id = "ann";
+    w.seq = static_cast<std::uint64_t>(i + 1);
+    w.t_utc_ns = kT0 + static_cast<std::uint64_t>(i) * kSecond / 5;
+    w.gait = "walk";
+    w.pose = "hand_held";
+    store.enqueue(w);
+    FixSample f;
+    f.boat_id = "w";
+    f.seq = static_cast<std::uint64_t>(i + 1);
+    f.t_utc_ns = kT0 + static_cast<std::uint64_t>(i) * kSecond / 10;
+    f.fix = "3d";
+    f.lat_deg = 54.0 + i * 1e-6;
+    f.lon_deg = 10.0;
+    f.sog_m_s = 3.0;
+    f.cog_deg = 0.0;
+    store.enqueue(f);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));
+  StoreHealth h = store.health();
+  EXPECT_TRUE(h.failing) << "the full disk must fail the writes";
+  EXPECT_EQ(h.wearable_backlog, static_cast<std::size_t>(kN));
+  EXPECT_EQ(h.fix_backlog, static_cast<std::size_t>(kN));
+  std::filesystem::remove(mnt / "ballast");
+  for (int i = 0; i < 40 && store.health().failing; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  store.flush();
+  h = store.health();
+  EXPECT_FALSE(h.failing) << h.last_error;
+  EXPECT_EQ(h.wearable_dropped + h.fixes_dropped, 0u);
+  EXPECT_EQ(store.wearable_track("ann", 0, UINT64_MAX, 100000).size(), static_cast<std::size_t>(kN));
+  EXPECT_EQ(store.track("w", 0, UINT64_MAX, 100000).size(), static_cast<std::size_t>(kN));
+}
+
 }  // namespace
 }  // namespace telltale::shore
