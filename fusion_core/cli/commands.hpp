@@ -33,6 +33,7 @@ void register_steps(CLI::App& app);  // steps, pdr
 void register_gait_sim(CLI::App& app);
 void register_steps_eval(CLI::App& app);
 void register_simulate(CLI::App& app);
+void register_manoeuvre_eval(CLI::App& app);
 /// `eval` is a group: each area (attitude, ...) adds a subcommand through register_eval_<area>
 /// and pushes a runner with its default options; `fusion_cli eval` alone runs them all.
 void register_eval(CLI::App& app);

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   telltale::cli::register_steps_eval(app);
   telltale::cli::register_simulate(app);
   telltale::cli::register_eval(app);
+  telltale::cli::register_manoeuvre_eval(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,517 @@
+// Manoeuvres found and measured (see manoeuvres.hpp for every definition).
+#include "telltale/fusion/manoeuvres.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace telltale::fusion {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kDt = 0.1;  // grid step, s
+
+double wrap360(double a) {
+  a = std::fmod(a, 360.0);
+  return a < 0 ? a + 360.0 : a;
+}
+double diff180(double a, double b) {
+  double d = std::fmod(a - b + 540.0, 360.0) - 180.0;
+  return d == -180.0 ? 180.0 : d;
+}
+
+/// Circular median: the sample minimising the summed absolute circular distance.
+double circular_median(const std::vector<double>& a) {
+  double best = a.front(), best_cost = 1e300;
+  for (double c : a) {
+    double cost = 0.0;
+    for (double x : a) cost += std::abs(diff180(x, c));
+    if (cost < best_cost) best_cost = cost, best = c;
+  }
+  return best;
+}
+
+/// The samples on a 10 Hz grid, with prefix sums for window means.
+struct Grid {
+  double t_start = 0.0;
+  std::size_t n = 0;
+  std::vector<double> course;   // unwrapped, deg (NaN: gap)
+  std::vector<double> sog;      // NaN: gap
+  std::vector<double> ve, vn;   // velocity east/north from SOG and COG, m/s
+  std::vector<double> heel, pitch;
+  // Prefix sums (size n+1).
+  std::vector<double> pc, ps, pn, psog, pnsog, pve, pvn, pnv, pheel, pnheel, pu;
+  bool has_heel = false;
+
+  [[nodiscard]] double t(std::size_t k) const { return t_start + static_cast<double>(k) * kDt; }
+  [[nodiscard]] long idx(double t_s) const { return std::lround((t_s - t_start) / kDt); }
+  [[nodiscard]] std::pair<std::size_t, std::size_t> clamp(long a, long b) const {
+    a = std::max(0L, a);
+    b = std::min(static_cast<long>(n), b);
+    if (b < a) b = a;
+    return {static_cast<std::size_t>(a), static_cast<std::size_t>(b)};
+  }
+  /// Circular mean course over ticks [a, b) (deg in [0, 360)) and its mean resultant length;
+  /// NaN when under half the window has data.
+  [[nodiscard]] double mean_course(long a0, long b0, double* r = nullptr) const {
+    auto [a, b] = clamp(a0, b0);
+    const double cnt = pn[b] - pn[a];
+    if (b0 <= a0 || cnt < 0.5 * static_cast<double>(b0 - a0)) return kNaN;
+    const double c = pc[b] - pc[a], s = ps[b] - ps[a];
+    if (r) *r = std::hypot(c, s) / cnt;
+    return wrap360(std::atan2(s, c) / kDeg);
+  }
+  /// Mean of the unwrapped course over [a, b) (only within a window without a full turn).
+  [[nodiscard]] double mean_unwrapped(long a0, long b0) const {
+    auto [a, b] = clamp(a0, b0);
+    const double cnt = pn[b] - pn[a];
+    if (cnt < 0.5 * static_cast<double>(b0 - a0) || cnt <= 0) return kNaN;
+    return (pu[b] - pu[a]) / cnt;
+  }
+  [[nodiscard]] double mean_sog(long a0, long b0) const {
+    auto [a, b] = clamp(a0, b0);
+    const double cnt = pnsog[b] - pnsog[a];
+    if (cnt < 0.5 * static_cast<double>(b0 - a0) || cnt <= 0) return kNaN;
+    return (psog[b] - psog[a]) / cnt;
+  }
+  /// Mean velocity (east, north) over [a, b).
+  [[nodiscard]] std::pair<double, double> mean_vel(long a0, long b0) const {
+    auto [a, b] = clamp(a0, b0);
+    const double cnt = pnv[b] - pnv[a];
+    if (cnt < 0.5 * static_cast<double>(b0 - a0) || cnt <= 0) return {kNaN, kNaN};
+    return {(pve[b] - pve[a]) / cnt, (pvn[b] - pvn[a]) / cnt};
+  }
+  /// Distance made along the unit (ue, un) over [a, b): velocity integrated (gaps: the mean).
+  [[nodiscard]] double made_along(long a0, long b0, double ue, double un) const {
+    auto [me, mn] = mean_vel(a0, b0);
+    return (me * ue + mn * un) * static_cast<double>(b0 - a0) * kDt;
+  }
+  [[nodiscard]] double mean_heel(long a0, long b0) const {
+    auto [a, b] = clamp(a0, b0);
+    const double cnt = pnheel[b] - pnheel[a];
+    if (cnt < 0.5 * static_cast<double>(b0 - a0) || cnt <= 0) return kNaN;
+    return (pheel[b] - pheel[a]) / cnt;
+  }
+  /// Course rate at k, deg/s (1 s central difference); NaN in gaps.
+  [[nodiscard]] double rate(std::size_t k) const {
+    if (k < 5 || k + 5 >= n) return kNaN;
+    return (course[k + 5] - course[k - 5]) / 1.0;
+  }
+};
+
+Grid make_grid(std::span<const CourseSample> in, std::span<const HeelSample> heel) {
+  Grid g;
+  if (in.empty()) return g;
+  g.t_start = in.front().t_s;
+  g.n = static_cast<std::size_t>(std::floor((in.back().t_s - g.t_start) / kDt)) + 1;
+  g.course.assign(g.n, kNaN);
+  g.sog.assign(g.n, kNaN);
+  g.ve.assign(g.n, kNaN);
+  g.vn.assign(g.n, kNaN);
+  g.heel.assign(g.n, kNaN);
+  g.pitch.assign(g.n, kNaN);
+  std::size_t j = 0;
+  double prev_course = kNaN;
+  for (std::size_t k = 0; k < g.n; ++k) {
+    const double t = g.t(k) + 1e-9;
+    while (j + 1 < in.size() && in[j + 1].t_s <= t) ++j;
+    const CourseSample& s = in[j];
+    if (s.t_s > t || t - s.t_s > 1.0) continue;
+    const double c = std::isfinite(s.heading_deg) ? s.heading_deg : s.cog_deg;
+    if (std::isfinite(c) && std::isfinite(s.sog_m_s)) {
+      const double u = std::isfinite(prev_course) ? prev_course + diff180(c, prev_course) : wrap360(c);
+      g.course[k] = u;
+      prev_course = u;
+    }
+    g.sog[k] = s.sog_m_s;
+    if (std::isfinite(s.cog_deg) && std::isfinite(s.sog_m_s)) {
+      g.ve[k] = s.sog_m_s * std::sin(s.cog_deg * kDeg);
+      g.vn[k] = s.sog_m_s * std::cos(s.cog_deg * kDeg);
+    } else if (std::isfinite(s.sog_m_s) && s.sog_m_s < 0.3) {
+      g.ve[k] = g.vn[k] = 0.0;  // COG meaningless when nearly still
+    }
+  }
+  if (!heel.empty()) {
+    std::size_t h = 0;
+    for (std::size_t k = 0; k < g.n; ++k) {
+      const double t = g.t(k) + 1e-9;
+      while (h + 1 < heel.size() && heel[h + 1].t_s <= t) ++h;
+      if (heel[h].t_s > t || t - heel[h].t_s > 0.5) continue;
+      g.heel[k] = heel[h].heel_deg;
+      g.pitch[k] = heel[h].pitch_deg;
+      g.has_heel = true;
+    }
+  }
+  const auto prefix = [&](std::vector<double>& p, auto f) {
+    p.assign(g.n + 1, 0.0);
+    for (std::size_t k = 0; k < g.n; ++k) p[k + 1] = p[k] + f(k);
+  };
+  const auto ok = [](double v) { return std::isfinite(v); };
+  prefix(g.pc, [&](std::size_t k) { return ok(g.course[k]) ? std::cos(g.course[k] * kDeg) : 0.0; });
+  prefix(g.ps, [&](std::size_t k) { return ok(g.course[k]) ? std::sin(g.course[k] * kDeg) : 0.0; });
+  prefix(g.pn, [&](std::size_t k) { return ok(g.course[k]) ? 1.0 : 0.0; });
+  prefix(g.pu, [&](std::size_t k) { return ok(g.course[k]) ? g.course[k] : 0.0; });
+  prefix(g.psog, [&](std::size_t k) { return ok(g.sog[k]) ? g.sog[k] : 0.0; });
+  prefix(g.pnsog, [&](std::size_t k) { return ok(g.sog[k]) ? 1.0 : 0.0; });
+  prefix(g.pve, [&](std::size_t k) { return ok(g.ve[k]) ? g.ve[k] : 0.0; });
+  prefix(g.pvn, [&](std::size_t k) { return ok(g.vn[k]) ? g.vn[k] : 0.0; });
+  prefix(g.pnv, [&](std::size_t k) { return ok(g.ve[k]) ? 1.0 : 0.0; });
+  prefix(g.pheel, [&](std::size_t k) { return ok(g.heel[k]) ? g.heel[k] : 0.0; });
+  prefix(g.pnheel, [&](std::size_t k) { return ok(g.heel[k]) ? 1.0 : 0.0; });
+  return g;
+}
+
+/// A detected turn before classification.
+struct Turn {
+  long peak = 0;            // tick of largest change
+  double delta = 0.0;       // the change there, deg
+  long ks = 0, ke = 0;      // continuous turn [ks, ke]
+  double total = 0.0;       // unwrapped turning over it, deg (signed)
+  double before = 0.0, after = 0.0;  // mean unwrapped course 20-5 s before / 5-20 s after t0
+  double t0_k = 0.0;        // fractional tick
+  bool penalty = false;
+};
+
+/// The continuous turn through `peak`: course rate of one sign above 2 deg/s, dips < 1 s bridged.
+void extend_turn(const Grid& g, Turn& m) {
+  // Sign: the largest |rate| within 3 s of the peak.
+  double best = 0.0;
+  long at = m.peak;
+  for (long k = m.peak - 30; k <= m.peak + 30; ++k) {
+    if (k < 0 || k >= static_cast<long>(g.n)) continue;
+    const double r = g.rate(static_cast<std::size_t>(k));
+    if (std::isfinite(r) && std::abs(r) > std::abs(best)) best = r, at = k;
+  }
+  const double s = best >= 0 ? 1.0 : -1.0;
+  const auto turning = [&](long k) {
+    if (k < 0 || k >= static_cast<long>(g.n)) return false;
+    const double r = g.rate(static_cast<std::size_t>(k));
+    return std::isfinite(r) && s * r > 2.0;
+  };
+  long a = at, b = at;
+  for (long gap = 0; a > 0 && gap <= 10; --a) gap = turning(a - 1) ? 0 : gap + 1;
+  for (long gap = 0; b + 1 < static_cast<long>(g.n) && gap <= 10; ++b) gap = turning(b + 1) ? 0 : gap + 1;
+  while (a < at && !turning(a)) ++a;
+  while (b > at && !turning(b)) --b;
+  m.ks = std::max(0L, a - 5);
+  m.ke = std::min(static_cast<long>(g.n) - 1, b + 5);
+  const double u0 = g.course[static_cast<std::size_t>(m.ks)], u1 = g.course[static_cast<std::size_t>(m.ke)];
+  m.total = std::isfinite(u0) && std::isfinite(u1) ? u1 - u0 : 0.0;
+}
+
+/// Kind from the wind: where the unwrapped path from the course before crosses the wind.
+ManoeuvreKind classify(double before_deg, double total_deg, double wind_from, bool penalty) {
+  if (penalty) return ManoeuvreKind::kPenalty;
+  const double rb = diff180(before_deg, wind_from);  // 0: head to wind
+  const double lo = std::min(rb, rb + total_deg), hi = std::max(rb, rb + total_deg);
+  const auto crosses = [&](double v) {
+    for (double x = v - 720.0; x <= v + 720.0; x += 360.0)
+      if (x > lo && x < hi) return true;
+    return false;
+  };
+  const bool eye = crosses(0.0), down = crosses(180.0);
+  if (eye && !down) return ManoeuvreKind::kTack;
+  if (down && !eye) return ManoeuvreKind::kGybe;
+  if (eye && down) return ManoeuvreKind::kOther;
+  const double ra = diff180(before_deg + total_deg, wind_from);
+  return std::abs(ra) > std::abs(rb) ? ManoeuvreKind::kBearAway : ManoeuvreKind::kRoundUp;
+}
+
+}  // namespace
+
+const char* to_string(ManoeuvreKind k) {
+  switch (k) {
+    case ManoeuvreKind::kTack: return "tack";
+    case ManoeuvreKind::kGybe: return "gybe";
+    case ManoeuvreKind::kBearAway: return "bear_away";
+    case ManoeuvreKind::kRoundUp: return "round_up";
+    case ManoeuvreKind::kPenalty: return "penalty";
+    case ManoeuvreKind::kOther: return "other";
+  }
+  return "other";
+}
+
+ManoeuvreReport analyse_manoeuvres(std::span<const CourseSample> course,
+                                   std::span<const HeelSample> heel,
+                                   const ManoeuvreOptions& o) {
+  ManoeuvreReport rep;
+  if (course.size() < 2) return rep;
+  const Grid g = make_grid(course, heel);
+  const long n = static_cast<long>(g.n);
+  const long w = std::lround(o.window_s / kDt);
+
+  // 1. Candidates: runs of ticks where the 10 s means before and after differ enough.
+  std::vector<Turn> cands;
+  bool in_run = false;
+  Turn cur;
+  for (long k = w; k + w < n; ++k) {
+    const double b = g.mean_course(k - w, k), a = g.mean_course(k + 1, k + 1 + w);
+    const double sog = g.mean_sog(k - w, k);
+    const double d = std::isfinite(a) && std::isfinite(b) ? std::abs(diff180(a, b)) : 0.0;
+    const bool hit = d >= o.min_turn_deg && std::isfinite(sog) && sog >= o.min_sog_m_s;
+    if (hit) {
+      if (!in_run || d > cur.delta) cur.peak = k, cur.delta = d;
+      in_run = true;
+    } else if (in_run) {
+      cands.push_back(cur);
+      in_run = false;
+    }
+  }
+  if (in_run) cands.push_back(cur);
+
+  // 2. The continuous turn of each; merge those in one turn or within the debounce.
+  for (auto& c : cands) extend_turn(g, c);
+  const long debounce = std::lround(o.debounce_s / kDt);
+  std::vector<Turn> turns;
+  for (const auto& c : cands) {
+    if (!turns.empty()) {
+      Turn& p = turns.back();
+      const bool same_turn = c.peak <= p.ke && c.ks <= p.ke;
+      // Debounce: within 20 s is the same manoeuvre, unless the boat sailed a steady course
+      // (>= 1.5 s without turning) between the two turns: a layline tack then the mark.
+      const bool apart = c.ks - p.ke >= 15;
+      if (same_turn || (c.peak - p.peak < debounce && !apart)) {
+        const bool c_bigger = std::abs(c.total) > std::abs(p.total) ||
+                              (!same_turn && std::abs(c.total) == std::abs(p.total) && c.delta > p.delta);
+        if (same_turn) {
+          p.ks = std::min(p.ks, c.ks);
+          if (c.ke > p.ke) {
+            p.ke = c.ke;
+            const double u0 = g.course[static_cast<std::size_t>(p.ks)], u1 = g.course[static_cast<std::size_t>(p.ke)];
+            if (std::isfinite(u0) && std::isfinite(u1)) p.total = u1 - u0;
+          }
+          if (c.delta > p.delta) p.delta = c.delta;
+        } else if (c_bigger) {
+          p = c;
+        }
+        continue;
+      }
+    }
+    turns.push_back(c);
+  }
+
+  // 3. t0 and the means around it.
+  std::vector<Turn> valid;
+  for (std::size_t i = 0; i < turns.size(); ++i) {
+    Turn& m = turns[i];
+    m.penalty = std::abs(m.total) >= o.penalty_deg;
+    // The steady courses either side: 15 s (the turn angle's 20-5 s about t0 when the turn
+    // takes ~10 s), cut short by the neighbouring manoeuvres' turns.
+    const long span = 150;
+    const long from = i > 0 ? std::max(m.ks - span, turns[i - 1].ke + 1) : m.ks - span;
+    const long to = i + 1 < turns.size() ? std::min(m.ke + 1 + span, turns[i + 1].ks) : m.ke + 1 + span;
+    m.before = g.mean_unwrapped(from, m.ks);
+    m.after = g.mean_unwrapped(m.ke + 1, to);
+    if (!std::isfinite(m.before) || !std::isfinite(m.after)) continue;
+    // Re-anchor the means on the unwrapped turn (the means may sit 360 apart).
+    const double u0 = g.course[static_cast<std::size_t>(m.ks)];
+    if (std::isfinite(u0)) m.before += 360.0 * std::round((u0 - m.before) / 360.0);
+    // The after mean on the same unwrapping as the turn measured through it.
+    const double raw = m.after - m.before;
+    m.after = m.before + raw - 360.0 * std::round((raw - m.total) / 360.0);
+    const double half = m.before + 0.5 * (m.after - m.before);
+    const double s = m.after >= m.before ? 1.0 : -1.0;
+    m.t0_k = static_cast<double>(m.peak);
+    for (long k = std::max(1L, m.ks - 50); k <= std::min(n - 1, m.ke + 50); ++k) {
+      const double u1 = g.course[static_cast<std::size_t>(k)], u0k = g.course[static_cast<std::size_t>(k - 1)];
+      if (!std::isfinite(u1) || !std::isfinite(u0k)) continue;
+      if (s * (u0k - half) < 0 && s * (u1 - half) >= 0) {
+        m.t0_k = static_cast<double>(k - 1) + (half - u0k) / (u1 - u0k);
+        break;
+      }
+    }
+    valid.push_back(m);
+  }
+
+  // 4. The wind: given, or estimated from the turns.
+  const auto bisector = [](const Turn& m) { return wrap360(0.5 * (m.before + m.after)); };
+  std::optional<double> wind = o.wind_from_deg;
+  if (wind) {
+    rep.wind_given = true;
+  } else {
+    std::vector<double> doubled;
+    for (const auto& m : valid) {
+      const double t = std::abs(m.after - m.before);
+      if (!m.penalty && t >= 50.0 && t <= 140.0) doubled.push_back(wrap360(2.0 * bisector(m)));
+    }
+    if (!doubled.empty()) {
+      const double axis = circular_median(doubled) / 2.0;
+      double best_score = -1e300;
+      for (double cand : {axis, wrap360(axis + 180.0)}) {
+        double score = 0.0;
+        for (const auto& m : valid) {
+          const auto k = classify(wrap360(m.before), m.after - m.before, cand, m.penalty);
+          const double t = std::abs(m.after - m.before);
+          if (k == ManoeuvreKind::kTack) score += t - 72.0;
+          if (k == ManoeuvreKind::kGybe) score -= t - 72.0;
+        }
+        if (score > best_score) best_score = score, wind = cand;
+      }
+      // The median of the tacks' bisectors and the gybes' inverted, twice.
+      for (int pass = 0; pass < 2; ++pass) {
+        std::vector<double> b;
+        for (const auto& m : valid) {
+          const auto k = classify(wrap360(m.before), m.after - m.before, *wind, m.penalty);
+          if (k == ManoeuvreKind::kTack) b.push_back(bisector(m));
+          if (k == ManoeuvreKind::kGybe) b.push_back(wrap360(bisector(m) + 180.0));
+        }
+        if (b.empty()) break;
+        wind = circular_median(b);
+      }
+    }
+  }
+  rep.wind_from_deg = wind;
+
+  // 5. Classify and measure.
+  std::vector<double> running;
+  for (const auto& m : valid) {
+    Manoeuvre r;
+    const double total = m.after - m.before;
+    r.kind = wind ? classify(wrap360(m.before), total, *wind, m.penalty)
+                  : (m.penalty ? ManoeuvreKind::kPenalty : ManoeuvreKind::kOther);
+    const long k0 = std::lround(m.t0_k);
+    r.t0_s = g.t_start + m.t0_k * kDt;
+    r.turn_deg = std::abs(total);
+    r.turn_dir = total >= 0 ? 1 : -1;
+    r.course_before_deg = wrap360(m.before);
+    r.course_after_deg = wrap360(m.after);
+    r.bisector_deg = m.penalty ? wrap360(m.before) : bisector(m);
+    const auto at = [&](double s) { return k0 + std::lround(s / kDt); };
+    r.entry_sog_m_s = g.mean_sog(at(-20), at(-10));
+    r.exit_sog_m_s = g.mean_sog(at(15), at(25));
+    r.min_sog_m_s = kNaN;
+    long k_min = k0;
+    for (long k = std::max(0L, at(-5)); k < std::min(n, at(15)); ++k) {
+      const double v = g.sog[static_cast<std::size_t>(k)];
+      if (std::isfinite(v) && !(v >= r.min_sog_m_s)) r.min_sog_m_s = v, k_min = k;
+    }
+    r.speed_loss_m_s = r.entry_sog_m_s - r.min_sog_m_s;
+    r.recovery_s = kNaN;
+    for (long k = k_min; k < std::min(n, at(60)); ++k) {
+      const double v = g.sog[static_cast<std::size_t>(k)];
+      if (std::isfinite(v) && v >= 0.9 * r.entry_sog_m_s) {
+        r.recovery_s = static_cast<double>(k) * kDt + g.t_start - r.t0_s;
+        break;
+      }
+    }
+    // 10 % to 90 % of the turn.
+    double t10 = kNaN, t90 = kNaN;
+    for (long k = std::max(0L, m.ks - 50); k <= std::min(n - 1, m.ke + 50); ++k) {
+      const double u = g.course[static_cast<std::size_t>(k)];
+      if (!std::isfinite(u) || total == 0.0) continue;
+      const double f = (u - m.before) / total;
+      if (f <= 0.1 && !std::isfinite(t90)) t10 = g.t(static_cast<std::size_t>(k));
+      if (f >= 0.9 && !std::isfinite(t90)) t90 = g.t(static_cast<std::size_t>(k));
+    }
+    r.turn_duration_s = t90 - t10;
+    r.max_turn_rate_deg_s = kNaN;
+    for (long k = std::max(0L, at(-10)); k < std::min(n, at(10)); ++k) {
+      const double rr = std::abs(g.rate(static_cast<std::size_t>(k)));
+      if (std::isfinite(rr) && !(rr <= r.max_turn_rate_deg_s)) r.max_turn_rate_deg_s = rr;
+    }
+    r.mean_turn_rate_deg_s = 0.8 * r.turn_deg / r.turn_duration_s;
+    // Distance lost along the mean course, and against the wind.
+    const double ue = std::sin(r.bisector_deg * kDeg), un = std::cos(r.bisector_deg * kDeg);
+    const auto [ee, en] = g.mean_vel(at(-20), at(-10));
+    r.distance_lost_m = (ee * ue + en * un) * 30.0 - g.made_along(at(-10), at(20), ue, un);
+    r.vmg_lost_m = kNaN;
+    if (wind) {
+      const bool up = std::abs(diff180(r.course_before_deg, *wind)) < 90.0;
+      const double wd = up ? *wind : wrap360(*wind + 180.0);
+      const double we = std::sin(wd * kDeg), wn = std::cos(wd * kDeg);
+      r.vmg_lost_m = (ee * we + en * wn) * 30.0 - g.made_along(at(-10), at(20), we, wn);
+    }
+    // Heel and pitch.
+    r.heel_peak_deg = r.heel_peak_windward_deg = r.heel_peak_leeward_deg = kNaN;
+    r.heel_zero_s = r.exit_heel_deg = r.pitch_min_deg = r.pitch_max_deg = r.pitch_mean_deg = kNaN;
+    if (g.has_heel) {
+      const double hb = g.mean_heel(at(-20), at(-5)), ha = g.mean_heel(at(5), at(20));
+      const double side = ha >= 0 ? 1.0 : -1.0;  // the exit tack's leeward side
+      double best_zero = 1e9;
+      for (long k = std::max(1L, at(-10)); k < std::min(n, at(10)); ++k) {
+        const double h = g.heel[static_cast<std::size_t>(k)], hp = g.heel[static_cast<std::size_t>(k - 1)];
+        if (!std::isfinite(h)) continue;
+        if (!(std::abs(h) <= std::abs(r.heel_peak_deg))) r.heel_peak_deg = h;
+        if (!(h * side <= r.heel_peak_leeward_deg)) r.heel_peak_leeward_deg = h * side;
+        if (!(-h * side <= r.heel_peak_windward_deg)) r.heel_peak_windward_deg = -h * side;
+        if (std::isfinite(hp) && (hp < 0) != (h < 0)) {
+          const double tz = g.t(static_cast<std::size_t>(k)) - r.t0_s;
+          if (std::abs(tz) < std::abs(best_zero)) best_zero = tz;
+        }
+      }
+      if (best_zero < 1e8) r.heel_zero_s = best_zero;
+      r.exit_heel_deg = g.mean_heel(at(15), at(25));
+      double ps = 0.0, pc = 0.0;
+      for (long k = std::max(0L, at(-5)); k < std::min(n, at(10)); ++k) {
+        const double p = g.pitch[static_cast<std::size_t>(k)];
+        if (!std::isfinite(p)) continue;
+        if (!(p >= r.pitch_min_deg)) r.pitch_min_deg = p;
+        if (!(p <= r.pitch_max_deg)) r.pitch_max_deg = p;
+        ps += p, pc += 1.0;
+      }
+      if (pc > 0) r.pitch_mean_deg = ps / pc;
+      if ((r.kind == ManoeuvreKind::kTack || r.kind == ManoeuvreKind::kGybe) &&
+          std::isfinite(hb) && std::isfinite(ha))
+        r.heel_flip_agrees = (hb < 0) != (ha < 0) && std::abs(hb) > 1.0 && std::abs(ha) > 1.0;
+    }
+    // Unsteady entry.
+    double res = 0.0;
+    const double mc = g.mean_course(at(-20), at(-5), &res);
+    r.entry_course_sd_deg = std::isfinite(mc) ? std::sqrt(-2.0 * std::log(std::max(res, 1e-12))) / kDeg : kNaN;
+    double vmin = 1e9, vmax = -1e9;
+    for (long k = std::max(0L, at(-20)); k < std::min(n, at(-10)); ++k) {
+      const double v = g.sog[static_cast<std::size_t>(k)];
+      if (std::isfinite(v)) vmin = std::min(vmin, v), vmax = std::max(vmax, v);
+    }
+    r.unsteady_entry = r.entry_course_sd_deg > 8.0 ||
+                       (vmax >= vmin && (vmax - vmin) > 0.2 * r.entry_sog_m_s);
+    // The wind estimate as it stood after each tack or gybe.
+    if (!rep.wind_given && (r.kind == ManoeuvreKind::kTack || r.kind == ManoeuvreKind::kGybe)) {
+      running.push_back(r.kind == ManoeuvreKind::kTack ? r.bisector_deg
+                                                        : wrap360(r.bisector_deg + 180.0));
+      WindPoint wp;
+      wp.t_s = r.t0_s;
+      wp.from_deg = circular_median(running);
+      std::vector<double> dev;
+      for (double b : running) dev.push_back(std::abs(diff180(b, wp.from_deg)));
+      std::nth_element(dev.begin(), dev.begin() + static_cast<long>(dev.size() / 2), dev.end());
+      const double mad = dev[dev.size() / 2];
+      wp.n = static_cast<int>(running.size());
+      wp.uncertainty_deg = wp.n > 1 ? 1.25 * 1.4826 * mad / std::sqrt(static_cast<double>(wp.n)) : 90.0;
+      rep.wind_over_time.push_back(wp);
+    }
+    rep.manoeuvres.push_back(r);
+  }
+  if (!rep.wind_given && !rep.wind_over_time.empty())
+    rep.wind_uncertainty_deg = rep.wind_over_time.back().uncertainty_deg;
+  else if (!rep.wind_given && wind)
+    rep.wind_uncertainty_deg = 90.0;
+  return rep;
+}
+
+std::vector<ManoeuvreSummary> summarise(const std::vector<Manoeuvre>& list) {
+  std::vector<ManoeuvreSummary> out;
+  for (auto kind : {ManoeuvreKind::kTack, ManoeuvreKind::kGybe, ManoeuvreKind::kBearAway,
+                    ManoeuvreKind::kRoundUp, ManoeuvreKind::kPenalty, ManoeuvreKind::kOther}) {
+    ManoeuvreSummary s{kind};
+    double sum = 0.0;
+    int n = 0;
+    s.best_lost_m = kNaN;
+    s.worst_lost_m = kNaN;
+    for (const auto& m : list) {
+      if (m.kind != kind) continue;
+      ++s.count;
+      if (!std::isfinite(m.distance_lost_m)) continue;
+      sum += m.distance_lost_m;
+      ++n;
+      if (!(m.distance_lost_m >= s.best_lost_m)) s.best_lost_m = m.distance_lost_m;
+      if (!(m.distance_lost_m <= s.worst_lost_m)) s.worst_lost_m = m.distance_lost_m;
+    }
+    s.mean_lost_m = n ? sum / n : kNaN;
+    if (s.count) out.push_back(s);
+  }
+  return out;
+}
+
+}  // namespace telltale::fusion

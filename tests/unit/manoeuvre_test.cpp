@@ -1,0 +1,187 @@
+// Manoeuvres (issue 21): detection, classification, wind, metrics; the simulator's truth.
+#include "telltale/fusion/manoeuvres.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "telltale/fusion/sim/course.hpp"
+#include "telltale/fusion/sim/manoeuvre_eval.hpp"
+
+using namespace telltale::fusion;
+
+namespace {
+/// A synthetic boat: course `c0` until t_turn, turning at `rate` deg/s by `turn` deg, SOG 4 m/s
+/// halved through the turn and recovering; heel flips side with the tack.
+struct Synth {
+  std::vector<CourseSample> fixes;
+  std::vector<HeelSample> heel;
+};
+Synth turn_at(double c0, double turn, double t_turn, double rate = 20.0, double total_s = 120.0,
+              bool heel_flip = true) {
+  Synth s;
+  const double dur = std::abs(turn) / rate;
+  for (int k = 0; k <= total_s * 10; ++k) {
+    const double t = k * 0.1;
+    const double f = std::clamp((t - t_turn) / dur, 0.0, 1.0);
+    const double c = c0 + turn * f;
+    const double dt = t - t_turn;
+    const double sog = dt < 0 ? 4.0 : 4.0 - 2.0 * std::exp(-std::max(0.0, dt - dur) / 8.0);
+    s.fixes.push_back({t, std::fmod(c + 720.0, 360.0), sog});
+    const double side = heel_flip ? (f < 0.5 ? -1.0 : 1.0) : -1.0;
+    s.heel.push_back({t, 12.0 * side, 1.0});
+  }
+  return s;
+}
+}  // namespace
+
+TEST(Manoeuvre, ATackIsFoundMeasuredAndClassifiedWithAGivenWind) {
+  // Wind from 0: close-hauled 318 deg (port tack... wind on the starboard bow), tack to 042.
+  const Synth s = turn_at(318.0, 84.0, 60.0);
+  ManoeuvreOptions o;
+  o.wind_from_deg = 0.0;
+  const auto rep = analyse_manoeuvres(s.fixes, s.heel, o);
+  ASSERT_EQ(rep.manoeuvres.size(), 1u);
+  const Manoeuvre& m = rep.manoeuvres[0];
+  EXPECT_EQ(m.kind, ManoeuvreKind::kTack);
+  EXPECT_NEAR(m.turn_deg, 84.0, 2.0);
+  EXPECT_EQ(m.turn_dir, 1);
+  EXPECT_NEAR(m.t0_s, 60.0 + 42.0 / 20.0, 0.3) << "t0: the course crosses the bisector (000)";
+  EXPECT_NEAR(m.entry_sog_m_s, 4.0, 1e-6);
+  EXPECT_NEAR(m.min_sog_m_s, 2.0, 0.1);
+  EXPECT_NEAR(m.turn_duration_s, 0.8 * 84.0 / 20.0, 0.4);
+  EXPECT_GT(m.max_turn_rate_deg_s, 15.0);
+  EXPECT_GT(m.distance_lost_m, 5.0);
+  EXPECT_LT(m.distance_lost_m, 60.0);
+  EXPECT_TRUE(std::isfinite(m.vmg_lost_m));
+  ASSERT_TRUE(m.heel_flip_agrees.has_value());
+  EXPECT_TRUE(*m.heel_flip_agrees);
+  EXPECT_NEAR(m.heel_zero_s, 0.0, 0.3);
+  EXPECT_NEAR(m.exit_heel_deg, 12.0, 1e-6);
+  EXPECT_NEAR(m.heel_peak_leeward_deg, 12.0, 1e-6);
+  EXPECT_FALSE(m.unsteady_entry);
+  EXPECT_TRUE(rep.wind_given);
+}
+
+TEST(Manoeuvre, SameTurnIsAGybeBearAwayOrRoundUpDependingOnTheWind) {
+  const Synth s = turn_at(100.0, 60.0, 60.0);
+  const auto kind = [&](double wind) {
+    ManoeuvreOptions o;
+    o.wind_from_deg = wind;
+    o.min_turn_deg = 45.0;
+    const auto rep = analyse_manoeuvres(s.fixes, {}, o);
+    return rep.manoeuvres.empty() ? ManoeuvreKind::kOther : rep.manoeuvres[0].kind;
+  };
+  EXPECT_EQ(kind(310.0), ManoeuvreKind::kGybe);      // downwind 130: crossed
+  EXPECT_EQ(kind(0.0), ManoeuvreKind::kBearAway);    // 100 -> 160 off the wind from 0
+  EXPECT_EQ(kind(250.0), ManoeuvreKind::kRoundUp);   // 150 -> 90 off the wind from 250
+  EXPECT_EQ(kind(130.0), ManoeuvreKind::kTack);
+}
+
+TEST(Manoeuvre, SmallTurnsSlowBoatsAndWobblesAreNotManoeuvres) {
+  EXPECT_TRUE(analyse_manoeuvres(turn_at(0.0, 40.0, 60.0).fixes, {}).manoeuvres.empty());
+  Synth slow = turn_at(0.0, 90.0, 60.0);
+  for (auto& f : slow.fixes) f.sog_m_s = 0.5;
+  EXPECT_TRUE(analyse_manoeuvres(slow.fixes, {}).manoeuvres.empty()) << "drifting, not sailing";
+}
+
+TEST(Manoeuvre, APenaltyTurnIsOneManoeuvreNotTacksAndGybes) {
+  const Synth s = turn_at(45.0, -720.0, 60.0, 20.0, 180.0);
+  ManoeuvreOptions o;
+  o.wind_from_deg = 0.0;
+  const auto rep = analyse_manoeuvres(s.fixes, {}, o);
+  ASSERT_EQ(rep.manoeuvres.size(), 1u);
+  EXPECT_EQ(rep.manoeuvres[0].kind, ManoeuvreKind::kPenalty);
+  EXPECT_NEAR(rep.manoeuvres[0].turn_deg, 720.0, 15.0);
+}
+
+TEST(Manoeuvre, HeelThatDoesNotFlipIsFlaggedNotOverruled) {
+  ManoeuvreOptions o;
+  o.wind_from_deg = 0.0;
+  const auto rep = analyse_manoeuvres(turn_at(318.0, 84.0, 60.0, 20.0, 120.0, false).fixes,
+                                      turn_at(318.0, 84.0, 60.0, 20.0, 120.0, false).heel, o);
+  ASSERT_EQ(rep.manoeuvres.size(), 1u);
+  EXPECT_EQ(rep.manoeuvres[0].kind, ManoeuvreKind::kTack);
+  ASSERT_TRUE(rep.manoeuvres[0].heel_flip_agrees.has_value());
+  EXPECT_FALSE(*rep.manoeuvres[0].heel_flip_agrees);
+}
+
+TEST(Manoeuvre, WindIsEstimatedFromTheTacksAndGivenWindOverridesIt) {
+  sim::CourseParams p;
+  sim::CourseSim course(3, p);
+  std::vector<CourseSample> fixes;
+  for (int k = 0; k <= 20 * 600; ++k) {
+    const auto s = course.at(k * 0.1);
+    fixes.push_back({s.t_s, s.cog_deg, s.sog_m_s});
+  }
+  const auto rep = analyse_manoeuvres(fixes, {});
+  ASSERT_TRUE(rep.wind_from_deg.has_value());
+  EXPECT_FALSE(rep.wind_given);
+  EXPECT_LT(std::abs(*rep.wind_from_deg - 255.0), 5.0);
+  EXPECT_GT(rep.wind_uncertainty_deg, 0.0);
+  EXPECT_LT(rep.wind_uncertainty_deg, 5.0);
+  ASSERT_FALSE(rep.wind_over_time.empty());
+  EXPECT_EQ(rep.wind_over_time.back().n,
+            static_cast<int>(std::count_if(rep.manoeuvres.begin(), rep.manoeuvres.end(), [](auto& m) {
+              return m.kind == ManoeuvreKind::kTack || m.kind == ManoeuvreKind::kGybe;
+            })));
+  ManoeuvreOptions o;
+  o.wind_from_deg = 200.0;
+  const auto given = analyse_manoeuvres(fixes, {}, o);
+  EXPECT_TRUE(given.wind_given);
+  EXPECT_DOUBLE_EQ(*given.wind_from_deg, 200.0);
+  const auto summary = summarise(rep.manoeuvres);
+  ASSERT_FALSE(summary.empty());
+  EXPECT_EQ(summary[0].kind, ManoeuvreKind::kTack);
+  EXPECT_LE(summary[0].best_lost_m, summary[0].mean_lost_m);
+  EXPECT_LE(summary[0].mean_lost_m, summary[0].worst_lost_m);
+}
+
+TEST(CourseTruth, TheSimulatorLogsItsTacksGybesRoundingsAndDrills) {
+  sim::CourseParams p;
+  p.drills = true;
+  sim::CourseSim course(2, p);
+  for (int k = 0; k <= 30 * 600; ++k) course.at(k * 0.1);
+  int tacks = 0, gybes = 0, penalty = 0, bear = 0, up = 0;
+  for (const auto& m : course.manoeuvres()) {
+    if (m.kind == sim::TruthKind::kTack) {
+      ++tacks;
+      EXPECT_NEAR(std::abs(m.turn_deg), 84.0, 3.0);
+    }
+    if (m.kind == sim::TruthKind::kGybe) {
+      ++gybes;
+      EXPECT_NEAR(std::abs(m.turn_deg), 60.0, 3.0);
+    }
+    if (m.kind == sim::TruthKind::kPenalty) {
+      ++penalty;
+      EXPECT_NEAR(std::abs(m.turn_deg), 720.0, 10.0);
+    }
+    bear += m.kind == sim::TruthKind::kBearAway;
+    up += m.kind == sim::TruthKind::kRoundUp;
+  }
+  // Every tack and gybe of the race is in the log, but one run into a mark is logged as the
+  // rounding it merges with.
+  EXPECT_LE(tacks + gybes, course.tacks());
+  EXPECT_GE(tacks + gybes, course.tacks() - 2);
+  EXPECT_GE(gybes, 2);
+  EXPECT_EQ(penalty, 1);
+  EXPECT_EQ(bear, 1);
+  EXPECT_EQ(up, 1);
+}
+
+// The issue's targets are printed by `fusion_cli manoeuvre-eval`; here, what it meets today
+// (detection threshold 60 deg misses the simulator's 60 deg gybes: see the report).
+TEST(ManoeuvreEval, TenSeedsAgainstTheSimulatorTruth) {
+  const auto e = sim::evaluate_manoeuvres(1, 10, 40.0);
+  EXPECT_GE(e.tack.recall(), 0.98);
+  EXPECT_GE(e.tack.precision(), 0.98);
+  EXPECT_GE(e.gybe.precision(), 0.98);
+  EXPECT_LT(e.wind_err_max_deg, 5.0);
+  EXPECT_EQ(e.bear_away.recall(), 1.0);
+  EXPECT_EQ(e.round_up.recall(), 1.0);
+  ManoeuvreOptions o;
+  o.min_turn_deg = 45.0;
+  const auto low = sim::evaluate_manoeuvres(1, 10, 40.0, o);
+  EXPECT_GE(low.gybe.recall(), 0.95);
+  EXPECT_GE(low.gybe.precision(), 0.98);
+}
