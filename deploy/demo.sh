@@ -51,7 +51,7 @@ pids+=($!)
 url=$(grep -o 'http://[^ ]*' "$log/shore")
 echo "Telltale demo on DDS domain $TELLTALE_DOMAIN: shore + 4 boats + 1 wearable" \
   "($(grep -o 'dds_security=[a-z]*' "$log/shore"))"
-echo "Dashboard: ${url}#token=${token}"
+echo "Dashboard (the fleet map): ${url}#token=${token}&view=map"
 echo "Coach token: ${token}   (curl -H 'Authorization: Bearer ${token}' ${url}api/v1/boats)"
 echo "Ctrl-C to stop."
 wait -n "${pids[@]}" || true

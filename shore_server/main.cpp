@@ -5,6 +5,7 @@
 #include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <functional>
 #include <map>
 #include <mutex>
@@ -34,7 +35,7 @@ bool valid_boat(const std::string& id) { return valid_id(id); }
 struct Options {
   telltale::dds::DdsOptions dds;
   HttpConfig http;
-  StoreConfig store{"telltale.db"};
+  StoreConfig store{""};  ///< empty: default_db_path()
   std::string coach_token;
   std::vector<std::string> analyst_tokens;
   std::vector<std::string> athlete_tokens;  ///< BOAT_ID:TOKEN
@@ -113,12 +114,31 @@ void add_tokens(const Options& o, TokenStore& tokens) {
   }
 }
 
+/// The database when --db is not given: $XDG_DATA_HOME/telltale/telltale.db, else
+/// ~/.local/share/telltale/telltale.db (the folder created), else ./telltale.db without a home.
+std::string default_db_path() {
+  std::filesystem::path dir;
+  if (const char* xdg = std::getenv("XDG_DATA_HOME"); xdg && *xdg == '/') {
+    dir = std::filesystem::path(xdg) / "telltale";
+  } else if (const char* home = std::getenv("HOME"); home && *home == '/') {
+    dir = std::filesystem::path(home) / ".local" / "share" / "telltale";
+  } else {
+    return "telltale.db";
+  }
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw std::runtime_error("cannot create " + dir.string() + ": " + ec.message());
+  return (dir / "telltale.db").string();
+}
+
 void run(Options o, telltale::ShutdownSignal& shutdown) {
+  if (o.store.path.empty()) o.store.path = default_db_path();
   TokenStore tokens;
   if (o.coach_token.empty()) {
     if (const char* env = std::getenv("TELLTALE_COACH_TOKEN"); env && *env) o.coach_token = env;
   }
-  if (o.coach_token.empty()) {
+  const bool generated_token = o.coach_token.empty();
+  if (generated_token) {
     o.coach_token = random_token();
     std::printf("shore_server coach token (generated): %s\n", o.coach_token.c_str());
   }
@@ -191,6 +211,12 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
   std::printf("shore_server ready: http://%s:%d/ domain=%d db=%s dds_security=%s\n",
               o.http.bind_address.c_str(), port, dds.domain(), o.store.path.c_str(),
               dds.secured() ? "on" : "off");
+  // The link that logs a browser in (the token is exchanged for a cookie and leaves the address
+  // bar): printed when the token was generated here, so a first run is one click from the map.
+  if (generated_token)
+    std::printf("shore_server dashboard: http://%s:%d/#token=%s&view=map\n",
+                o.http.bind_address == "0.0.0.0" ? "127.0.0.1" : o.http.bind_address.c_str(), port,
+                o.coach_token.c_str());
   std::fflush(stdout);
 
   // Stale sweep: a boat silent for stale_ms is marked stale even if DDS never says so. Each boat
@@ -243,8 +269,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--bind", o.http.bind_address, "HTTP listen address (localhost by default)")
       ->capture_default_str();
-  app.add_option("--db", o.store.path, "SQLite database file (created if missing)")
-      ->capture_default_str();
+  app.add_option("--db", o.store.path,
+                 "SQLite database file (created if missing); default: "
+                 "$XDG_DATA_HOME/telltale/telltale.db, else ~/.local/share/telltale/telltale.db");
   app.add_option("--coach-token", o.coach_token,
                  "coach token (default: $TELLTALE_COACH_TOKEN, else a generated one, printed)");
   app.add_option("--analyst-token", o.analyst_tokens,

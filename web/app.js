@@ -53,7 +53,9 @@ async function login() {
   const m = /(?:^#|&)token=([^&]+)/.exec(location.hash);
   if (!m) return;
   const token = decodeURIComponent(m[1]);
-  history.replaceState(null, '', `${location.pathname}${location.search}#/fleet`);
+  // `&view=map` (the link the shore prints) opens that view once logged in.
+  const v = /&view=([a-z]+)/.exec(location.hash);
+  history.replaceState(null, '', `${location.pathname}${location.search}#/${v ? v[1] : 'fleet'}`);
   const res = await fetch('/api/v1/login', { method: 'POST', headers: { Authorization: `Bearer ${token}` } });
   if (!res.ok) {
     showMessage('That token was refused. Ask the coach for a new link.');

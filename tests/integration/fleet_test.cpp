@@ -206,5 +206,28 @@ TEST_F(FleetTest, CleanShutdownKeepsTheRecording) {
   EXPECT_GT(stored, published / 2);
 }
 
+
+// A first run needs no flags: the database goes in the user's data folder and the printed link
+// logs a browser in (and opens the fleet map).
+TEST(FirstRun, ShoreWithNoFlagsPrintsALoginLinkAndKeepsItsDatabaseInTheDataFolder) {
+  const std::string home = make_temp_dir();
+  Process shore({bin_dir() + "/shore_server", "--http-port", "0", "--domain",
+                 std::to_string(unique_domain())},
+                {"HOME=" + home, "XDG_DATA_HOME=", "TELLTALE_COACH_TOKEN="});
+  const auto link = shore.wait_for_line("shore_server dashboard: ", std::chrono::seconds(20));
+  ASSERT_TRUE(link) << shore.output();
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(*link, m,
+                                std::regex(R"(http://127\.0\.0\.1:(\d+)/#token=([A-Za-z0-9_-]+)&view=map)")))
+      << *link;
+  httplib::Client c("127.0.0.1", std::stoi(m[1]));
+  auto login = c.Post("/api/v1/login", {{"Authorization", "Bearer " + m[2].str()}}, "", "text/plain");
+  ASSERT_TRUE(login);
+  EXPECT_EQ(login->status, 200);
+  EXPECT_TRUE(std::filesystem::exists(home + "/.local/share/telltale/telltale.db")) << shore.output();
+  EXPECT_EQ(shore.stop(SIGINT), 0);
+  std::filesystem::remove_all(home);
+}
+
 }  // namespace
 }  // namespace telltale::testing

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <stdexcept>
 #include <thread>
@@ -27,7 +28,16 @@ Process::Process(std::vector<std::string> argv, std::vector<std::string> env) {
   for (auto& a : argv) args.push_back(a.data());
   args.push_back(nullptr);
   std::vector<char*> envp;
-  for (char** e = environ; *e; ++e) envp.push_back(*e);
+  // An extra entry replaces the inherited one of the same name (getenv finds the first).
+  const auto overridden = [&](const char* entry) {
+    for (const auto& e : env) {
+      const auto eq = e.find('=');
+      if (eq != std::string::npos && std::strncmp(entry, e.data(), eq + 1) == 0) return true;
+    }
+    return false;
+  };
+  for (char** e = environ; *e; ++e)
+    if (!overridden(*e)) envp.push_back(*e);
   for (auto& e : env) envp.push_back(e.data());
   envp.push_back(nullptr);
   int fds[2];
