@@ -1,5 +1,6 @@
 #include "http_api.hpp"
 #include "track_routes.hpp"
+#include "manoeuvre_routes.hpp"
 
 #include <httplib.h>
 
@@ -256,6 +257,7 @@ struct HttpApi::Impl {
     });
     register_rest_routes(server, ctx);
     register_track_routes(server, ctx);
+    register_manoeuvre_routes(server, ctx);
     if (!config.web_dir.empty() && !server.set_mount_point("/", config.web_dir))
       throw std::runtime_error("web directory not found: " + config.web_dir);
   }

@@ -1,0 +1,149 @@
+// Manoeuvres in the REST API (see manoeuvre_routes.hpp).
+#include "manoeuvre_routes.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "json_views.hpp"
+#include "route_helpers.hpp"
+#include "store.hpp"
+#include "telltale/fusion/manoeuvres.hpp"
+
+namespace telltale::shore {
+
+using nlohmann::json;
+
+namespace {
+
+std::string num(double v, int decimals = 3) {
+  if (!std::isfinite(v)) return "";
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+
+std::uint64_t to_ns(std::uint64_t base_ns, double t_s) {
+  return base_ns + static_cast<std::uint64_t>(std::llround(std::max(0.0, t_s) * 1e9));
+}
+
+}  // namespace
+
+void register_manoeuvre_routes(httplib::Server& server, ShoreContext& ctx) {
+  server.Get(R"(/api/v1/sessions/([^/]+)/manoeuvres)", [&ctx](const httplib::Request& req,
+                                                             httplib::Response& res) {
+    const Principal p = who(ctx, req);
+    allow_params(req, {"format", "wind_from_deg"});
+    bool csv = false;
+    if (const std::string* f = param(req, "format")) {
+      if (*f == "csv") csv = true;
+      else if (*f != "json") throw HttpError(400, "format must be json or csv");
+    }
+    fusion::ManoeuvreOptions opt;
+    if (const std::string* w = param(req, "wind_from_deg")) {
+      const auto n = parse_int(*w, 0, 359);
+      if (!n) throw HttpError(400, "wind_from_deg must be a whole number of degrees in 0..359");
+      opt.wind_from_deg = static_cast<double>(*n);
+    }
+    const std::int64_t id = path_number(req, "session");
+    const auto s = ctx.store.session(id);
+    if (!s) throw HttpError(404, "unknown session " + std::to_string(id));
+    require_boat(p, s->boat_id);
+    // Times in seconds from the session's start (double keeps sub-microsecond precision).
+    const std::uint64_t base = s->start_ns;
+    const auto rel = [base](std::uint64_t t) {
+      return t >= base ? static_cast<double>(t - base) * 1e-9 : -static_cast<double>(base - t) * 1e-9;
+    };
+    std::vector<fusion::CourseSample> fixes;
+    ctx.store.visit_fixes(s->boat_id, s->start_ns, s->end_ns, [&](const FixSample& f) {
+      fixes.push_back({rel(f.t_utc_ns), f.cog_deg, f.sog_m_s});
+      return true;
+    });
+    std::vector<fusion::HeelSample> heel;
+    ctx.store.visit_attitude(s->boat_id, s->start_ns, s->end_ns, [&](const AttitudeRow& r) {
+      heel.push_back({rel(r.t_utc_ns), r.heel_deg, r.pitch_deg});
+      return true;
+    });
+    const fusion::ManoeuvreReport rep = fusion::analyse_manoeuvres(fixes, heel, opt);
+    if (csv) {
+      std::string out =
+          "kind,t_utc,turn_deg,turn_dir,distance_lost_m,vmg_lost_m,heel_peak_deg,"
+          "heel_peak_windward_deg,heel_peak_leeward_deg,heel_zero_s,exit_heel_deg,entry_sog_m_s,"
+          "min_sog_m_s,exit_sog_m_s,speed_loss_m_s,turn_duration_s,recovery_s,"
+          "max_turn_rate_deg_s,mean_turn_rate_deg_s,pitch_min_deg,pitch_max_deg,pitch_mean_deg,"
+          "course_before_deg,course_after_deg,unsteady_entry,heel_flip_agrees\n";
+      for (const auto& m : rep.manoeuvres) {
+        out += std::string(fusion::to_string(m.kind)) + "," + iso8601(to_ns(base, m.t0_s)) + "," +
+               num(m.turn_deg, 1) + "," + std::to_string(m.turn_dir) + "," +
+               num(m.distance_lost_m, 2) + "," + num(m.vmg_lost_m, 2) + "," +
+               num(m.heel_peak_deg, 1) + "," + num(m.heel_peak_windward_deg, 1) + "," +
+               num(m.heel_peak_leeward_deg, 1) + "," + num(m.heel_zero_s, 2) + "," +
+               num(m.exit_heel_deg, 1) + "," + num(m.entry_sog_m_s) + "," + num(m.min_sog_m_s) +
+               "," + num(m.exit_sog_m_s) + "," + num(m.speed_loss_m_s) + "," +
+               num(m.turn_duration_s, 2) + "," + num(m.recovery_s, 2) + "," +
+               num(m.max_turn_rate_deg_s, 1) + "," + num(m.mean_turn_rate_deg_s, 1) + "," +
+               num(m.pitch_min_deg, 1) + "," + num(m.pitch_max_deg, 1) + "," +
+               num(m.pitch_mean_deg, 1) + "," + num(m.course_before_deg, 1) + "," +
+               num(m.course_after_deg, 1) + "," + (m.unsteady_entry ? "1" : "0") + "," +
+               (m.heel_flip_agrees ? (*m.heel_flip_agrees ? "1" : "0") : "") + "\n";
+      }
+      res.set_content(out, "text/csv");
+      return;
+    }
+    json list = json::array();
+    for (const auto& m : rep.manoeuvres) {
+      list.push_back({{"kind", fusion::to_string(m.kind)},
+                      {"t_utc", iso8601(to_ns(base, m.t0_s))},
+                      {"turn_deg", finite_or_null(m.turn_deg)},
+                      {"turn_dir", m.turn_dir},
+                      {"distance_lost_m", finite_or_null(m.distance_lost_m)},
+                      {"vmg_lost_m", finite_or_null(m.vmg_lost_m)},
+                      {"heel_peak_deg", finite_or_null(m.heel_peak_deg)},
+                      {"heel_peak_windward_deg", finite_or_null(m.heel_peak_windward_deg)},
+                      {"heel_peak_leeward_deg", finite_or_null(m.heel_peak_leeward_deg)},
+                      {"heel_zero_s", finite_or_null(m.heel_zero_s)},
+                      {"exit_heel_deg", finite_or_null(m.exit_heel_deg)},
+                      {"entry_sog_m_s", finite_or_null(m.entry_sog_m_s)},
+                      {"min_sog_m_s", finite_or_null(m.min_sog_m_s)},
+                      {"exit_sog_m_s", finite_or_null(m.exit_sog_m_s)},
+                      {"speed_loss_m_s", finite_or_null(m.speed_loss_m_s)},
+                      {"turn_duration_s", finite_or_null(m.turn_duration_s)},
+                      {"recovery_s", finite_or_null(m.recovery_s)},
+                      {"max_turn_rate_deg_s", finite_or_null(m.max_turn_rate_deg_s)},
+                      {"mean_turn_rate_deg_s", finite_or_null(m.mean_turn_rate_deg_s)},
+                      {"pitch_min_deg", finite_or_null(m.pitch_min_deg)},
+                      {"pitch_max_deg", finite_or_null(m.pitch_max_deg)},
+                      {"pitch_mean_deg", finite_or_null(m.pitch_mean_deg)},
+                      {"course_before_deg", finite_or_null(m.course_before_deg)},
+                      {"course_after_deg", finite_or_null(m.course_after_deg)},
+                      {"unsteady_entry", m.unsteady_entry},
+                      {"heel_flip_agrees",
+                       m.heel_flip_agrees ? json(*m.heel_flip_agrees) : json(nullptr)}});
+    }
+    json summary = json::array();
+    for (const auto& k : fusion::summarise(rep.manoeuvres))
+      summary.push_back({{"kind", fusion::to_string(k.kind)},
+                         {"count", k.count},
+                         {"mean_distance_lost_m", finite_or_null(k.mean_lost_m)},
+                         {"best_distance_lost_m", finite_or_null(k.best_lost_m)},
+                         {"worst_distance_lost_m", finite_or_null(k.worst_lost_m)}});
+    json wind_t = json::array();
+    for (const auto& w : rep.wind_over_time)
+      wind_t.push_back({{"t_utc", iso8601(to_ns(base, w.t_s))},
+                        {"from_deg", w.from_deg},
+                        {"uncertainty_deg", w.uncertainty_deg},
+                        {"n", w.n}});
+    res.set_content(
+        to_json_text({{"session_id", s->id},
+                      {"boat_id", s->boat_id},
+                      {"wind", {{"from_deg", rep.wind_from_deg ? json(*rep.wind_from_deg) : json(nullptr)},
+                                {"given", rep.wind_given},
+                                {"uncertainty_deg", rep.wind_from_deg ? json(rep.wind_uncertainty_deg) : json(nullptr)},
+                                {"over_time", std::move(wind_t)}}},
+                      {"manoeuvres", std::move(list)},
+                      {"summary", std::move(summary)}}),
+        "application/json");
+  });
+}
+
+}  // namespace telltale::shore
