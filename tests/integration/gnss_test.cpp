@@ -98,30 +98,6 @@ class Feeder {
   std::thread thread_;
 };
 
-int free_udp_port() {
-  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
-  socklen_t len = sizeof a;
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
-  ::close(fd);
-  return ntohs(a.sin_port);
-}
-
-int free_tcp_port() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
-  socklen_t len = sizeof a;
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
-  ::close(fd);
-  return ntohs(a.sin_port);
-}
-
 struct Pty {
   int master = -1, slave = -1;
   std::string name;
@@ -200,7 +176,7 @@ TEST_F(GnssTest, NmeaOnAPtyBringsThePositionJumpsAndGarbageCountedNeverShown) {
 }
 
 TEST_F(GnssTest, NmeaOverUdpBringsThePosition) {
-  const int port = free_udp_port();
+  const int port = free_loopback_port(SOCK_DGRAM);
   start_boat("gnss_udp", {"--gnss", "nmea:udp:" + std::to_string(port)});
   const int tx = ::socket(AF_INET, SOCK_DGRAM, 0);
   sockaddr_in to{};
@@ -227,7 +203,7 @@ TEST_F(GnssTest, ARealGpsdFedByAPtyBringsThePosition) {
   ASSERT_FALSE(gpsd.empty()) << "gpsd is not installed (deploy/packages.txt lists it)";
   Pty pty;
   ASSERT_FALSE(pty.name.empty());
-  const int port = free_tcp_port();
+  const int port = free_loopback_port(SOCK_STREAM);
   // -N foreground, -n poll the device without waiting for a client, -S our port; gpsd listens on
   // loopback only unless -G is given. Its control socket goes in the test's folder.
   Process gpsd_proc({gpsd, "-N", "-n", "-S", std::to_string(port), "-F", dir_ + "/gpsd.sock",

@@ -43,6 +43,9 @@ class Process {
 
 /// A DDS domain id for this test process (0..232), unique among concurrently running tests.
 int unique_domain();
+/// A loopback port free at the time of the call (the OS picks it; bound and released), for a
+/// child that must be told its port: SOCK_DGRAM or SOCK_STREAM.
+int free_loopback_port(int socket_type);
 /// A fresh temporary directory, removed by the caller.
 std::string make_temp_dir();
 /// Directory of the project's binaries (build/bin).

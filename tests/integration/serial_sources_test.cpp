@@ -26,18 +26,6 @@ using namespace std::chrono_literals;
 constexpr double kG = 9.80665;
 constexpr double kDeg = M_PI / 180.0;
 
-int free_udp_port() {
-  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
-  socklen_t len = sizeof a;
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
-  ::close(fd);
-  return ntohs(a.sin_port);
-}
-
 std::string nmea(const std::string& body) {
   unsigned char cs = 0;
   for (char c : body) cs ^= static_cast<unsigned char>(c);
@@ -58,7 +46,7 @@ TEST_F(SerialTest, WitMotionOverPtyAndNmeaOverUdp) {
   tcgetattr(slave, &raw);
   cfmakeraw(&raw);
   tcsetattr(slave, TCSANOW, &raw);
-  const int port = free_udp_port();
+  const int port = free_loopback_port(SOCK_DGRAM);
   Process& boat = start_boat(
       "serial1", {"--source", std::string("witmotion:") + name + "@115200", "--heading",
                   "nmea:udp:" + std::to_string(port), "--log-dir", dir_ + "/log"});

@@ -302,6 +302,22 @@ void fill_disk(const std::filesystem::path& path) {
   ::close(fd);
 }
 
+/// A 1 MB tmpfs at `dir` in this process's private mount namespace, unmounted at scope exit: a
+/// disk that really fills up.
+struct SmallTmpfs {
+  explicit SmallTmpfs(const std::filesystem::path& dir) : path(dir) {
+    std::filesystem::create_directories(dir);
+    mounted = private_mounts() && ::mount("tmpfs", dir.c_str(), "tmpfs", 0, "size=1m,mode=0755") == 0;
+  }
+  ~SmallTmpfs() {
+    if (mounted) ::umount2(path.c_str(), MNT_DETACH);
+  }
+  SmallTmpfs(const SmallTmpfs&) = delete;
+  SmallTmpfs& operator=(const SmallTmpfs&) = delete;
+  std::filesystem::path path;
+  bool mounted = false;
+};
+
 // Given a shore whose disk fills up (a real small tmpfs), then commits back off exponentially
 // instead of retrying the whole backlog every commit interval, the backlog stays bounded (later
 // samples refused and counted, never acknowledged), health() says so; when space returns
@@ -309,13 +325,9 @@ void fill_disk(const std::filesystem::path& path) {
 // not save are named on stderr.
 TEST_F(StoreTest, FullDiskBacksOffBoundsTheBacklogAndSaysWhatIsLost) {
   const auto mnt = dir_ / "full";
-  std::filesystem::create_directories(mnt);
-  if (!private_mounts() || ::mount("tmpfs", mnt.c_str(), "tmpfs", 0, "size=1m,mode=0755") != 0)
+  const SmallTmpfs tmpfs(mnt);
+  if (!tmpfs.mounted)
     FAIL() << "needs root and mount namespaces (a fault test fails, never skips, without them)";
-  struct Unmount {
-    std::filesystem::path p;
-    ~Unmount() { ::umount2(p.c_str(), MNT_DETACH); }
-  } unmount{mnt};
   auto c = config();
   c.path = (mnt / "s.db").string();
   c.max_backlog = 3000;
@@ -367,13 +379,9 @@ TEST_F(StoreTest, FullDiskBacksOffBoundsTheBacklogAndSaysWhatIsLost) {
 // retried like attitude, and all of them are stored once space comes back.
 TEST_F(StoreTest, FullDiskKeepsWearablesAndFixesAndStoresThemLater) {
   const auto mnt = dir_ / "full";
-  std::filesystem::create_directories(mnt);
-  if (!private_mounts() || ::mount("tmpfs", mnt.c_str(), "tmpfs", 0, "size=1m,mode=0755") != 0)
+  const SmallTmpfs tmpfs(mnt);
+  if (!tmpfs.mounted)
     FAIL() << "needs root and mount namespaces (a fault test fails, never skips, without them)";
-  struct Unmount {
-    std::filesystem::path p;
-    ~Unmount() { ::umount2(p.c_str(), MNT_DETACH); }
-  } unmount{mnt};
   auto c = config();
   c.path = (mnt / "s.db").string();
   c.max_retry_interval = std::chrono::milliseconds(200);
