@@ -315,7 +315,7 @@ FixSample from_wire(const msg::BoatFix& m) {
       f.fix = "invalid";  // an enum value off the contract: refused by check()
   }
   f.satellites = m.satellites();
-  f.hdop = m.hdop();
+  f.hdop = static_cast<double>(m.hdop());
   f.boot_id = m.boot_id();
   return f;
 }

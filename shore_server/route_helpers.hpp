@@ -30,7 +30,8 @@ inline void require_boat(const Principal& p, const std::string& boat_id) {
 
 /// The query parameters a route accepts; any other is a 400 (a typo must not be ignored).
 inline void allow_params(const httplib::Request& req, std::initializer_list<const char*> allowed) {
-  for (const auto& [name, value] : req.params) {
+  for (const auto& kv : req.params) {
+    const std::string& name = kv.first;  // a plain name: clang 14 cannot capture a binding
     if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return name == a; }))
       throw HttpError(400, "unknown parameter '" + name + "'");
     if (req.get_param_value_count(name) > 1)
