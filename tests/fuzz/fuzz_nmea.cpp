@@ -1,6 +1,7 @@
-// libFuzzer target: NMEA 0183 heading input (boat_node/sensors/nmea.hpp). The bytes go through the
-// line assembler once whole and once cut into pieces (serial reads end anywhere), then every line
-// through the parser; the bytes are also parsed as one line directly.
+// libFuzzer target: NMEA 0183 heading and GNSS input (boat_node/sensors/nmea.hpp, nmea_gnss.hpp).
+// The bytes go through the line assembler once whole and once cut into pieces (serial reads end
+// anywhere), then every line through both parsers and the GNSS epochs into the gate; the bytes
+// are also parsed as one line directly.
 //
 // Invariants beyond "no crash": the cut stream gives the same lines and counters as the whole one;
 // a line starts with '$', holds no CR, LF or second '$' and is at most kNmeaMaxLine long; a parsed
@@ -13,7 +14,9 @@
 #include <vector>
 
 #include "fuzz_support.hpp"
+#include "gnss_gate.hpp"
 #include "nmea.hpp"
+#include "nmea_gnss.hpp"
 
 namespace {
 
@@ -77,6 +80,44 @@ void parse_and_check(std::string_view line, const NmeaParseOptions& options) {
   check_round_trip(r.heading);
 }
 
+void check_gnss(const telltale::sensors::NmeaGnss& g) {
+  FUZZ_CHECK(std::isnan(g.lat_deg) == std::isnan(g.lon_deg));
+  FUZZ_CHECK(std::isnan(g.lat_deg) || std::fabs(g.lat_deg) <= 90.0);
+  FUZZ_CHECK(std::isnan(g.lon_deg) || std::fabs(g.lon_deg) <= 180.0);
+  FUZZ_CHECK(std::isnan(g.sog_m_s) || (std::isfinite(g.sog_m_s) && g.sog_m_s >= 0.0));
+  FUZZ_CHECK(in_range_or_nan(g.cog_deg));
+  FUZZ_CHECK(std::isnan(g.time_of_day_s) || (g.time_of_day_s >= 0.0 && g.time_of_day_s < 86401.0));
+  FUZZ_CHECK(g.talker[2] == '\0');
+}
+
+/// Every line through the GNSS parser, the epochs into the gate: what comes out is on contract.
+void gnss_pipeline(const std::vector<std::string>& lines, const NmeaParseOptions& options) {
+  telltale::sensors::GnssEpochAssembler epochs;
+  telltale::boat::GnssGate gate;
+  double t = 0.0;
+  const auto gate_check = [&](const telltale::sensors::GnssReading& r) {
+    if (r.fix != telltale::sensors::GnssFixKind::kNone)
+      FUZZ_CHECK(std::isfinite(r.lat_deg) && std::isfinite(r.lon_deg));
+    const auto f = gate.on_epoch(r, t, 1796215200ull * 1000000000ull);
+    if (!f) return;
+    if (f->fix == telltale::sensors::GnssFixKind::kNone) {
+      FUZZ_CHECK(std::isnan(f->lat_deg) && std::isnan(f->lon_deg) && std::isnan(f->sog_m_s));
+    } else {
+      FUZZ_CHECK(std::fabs(f->lat_deg) <= 90.0 && std::fabs(f->lon_deg) <= 180.0);
+      FUZZ_CHECK(!(f->sog_m_s > 30.0));
+      FUZZ_CHECK(std::isnan(f->cog_deg) || f->sog_m_s >= 0.3);
+    }
+  };
+  for (const std::string& l : lines) {
+    t += 0.01;
+    const auto r = telltale::sensors::parse_nmea_gnss(l, options);
+    if (r.status != NmeaStatus::kOk) continue;
+    check_gnss(r.gnss);
+    if (auto done = epochs.add(r.gnss, t)) gate_check(*done);
+  }
+  if (auto done = epochs.flush_if_quiet(t + 1.0)) gate_check(*done);
+}
+
 struct Assembled {
   std::vector<std::string> lines;
   NmeaLineAssembler::Stats stats;
@@ -107,6 +148,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string_view bytes = in.rest();
 
   parse_and_check(bytes, options);
+  if (const auto g = telltale::sensors::parse_nmea_gnss(bytes, options); g.status == NmeaStatus::kOk)
+    check_gnss(g.gnss);
 
   const Assembled whole = assemble(bytes, 0, datagram);
   const Assembled cut = assemble(bytes, static_cast<std::uint8_t>(seed | 1), datagram);
@@ -121,5 +164,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     FUZZ_CHECK(l.find('$', 1) == std::string::npos);
     parse_and_check(l, options);
   }
+  gnss_pipeline(whole.lines, options);
   return 0;
 }
