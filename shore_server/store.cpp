@@ -558,6 +558,16 @@ void Store::writer_loop() {
     // have no backfill, so a batch dropped here would be lost for good.
     bool failed = false;
     const bool work = !wearable.empty() || !fixes.empty() || !batch.empty();
+    // Attitude first: its commit is what the boats' receipts and the crash window are about.
+    if (!batch.empty()) {
+      const std::size_t n = batch.size();
+      if (commit(batch)) {
+        std::lock_guard lock(mutex_);
+        processed_ += n;
+      } else {
+        failed = true;
+      }
+    }
     if (!wearable.empty() && !commit_wearable(wearable)) {
       failed = true;
       requeue(wearable, wearable_queue_, dropped_wearable_);
@@ -574,15 +584,6 @@ void Store::writer_loop() {
       }
     }
     fixes.clear();
-    if (!batch.empty()) {
-      const std::size_t n = batch.size();
-      if (commit(batch)) {
-        std::lock_guard lock(mutex_);
-        processed_ += n;
-      } else {
-        failed = true;
-      }
-    }
     if (work) {
       std::lock_guard lock(mutex_);
       if (!failed) {

@@ -47,9 +47,11 @@ struct Grid {
   [[nodiscard]] double t(std::size_t k) const { return t_start + static_cast<double>(k) * kDt; }
   [[nodiscard]] long idx(double t_s) const { return std::lround((t_s - t_start) / kDt); }
   [[nodiscard]] std::pair<std::size_t, std::size_t> clamp(long a, long b) const {
-    a = std::max(0L, a);
-    b = std::min(static_cast<long>(n), b);
-    if (b < a) b = a;
+    // Both ends inside [0, n]: a window that starts after the last tick (a manoeuvre near the
+    // end of the data) is empty, never read past the prefix sums (ASan caught it).
+    const long last = static_cast<long>(n);
+    a = std::clamp(a, 0L, last);
+    b = std::clamp(b, a, last);
     return {static_cast<std::size_t>(a), static_cast<std::size_t>(b)};
   }
   /// Circular mean course over ticks [a, b) (deg in [0, 360)) and its mean resultant length;

@@ -78,6 +78,17 @@ TEST(Manoeuvre, SameTurnIsAGybeBearAwayOrRoundUpDependingOnTheWind) {
   EXPECT_EQ(kind(130.0), ManoeuvreKind::kTack);
 }
 
+// A turn in the last seconds of the data: its after-windows lie past the end and must read as
+// empty (the AddressSanitizer build read past the prefix sums here).
+TEST(Manoeuvre, ATurnAtTheVeryEndOfTheDataIsHandledWithoutReadingPastIt) {
+  for (double end_s : {75.0, 76.0, 78.0, 80.0, 90.0}) {
+    const auto s = turn_at(318.0, 84.0, 60.0, 20.0, end_s);
+    const auto rep = analyse_manoeuvres(s.fixes, s.heel);
+    EXPECT_EQ(rep.manoeuvres.size(), 1u) << "a turn with 13 s or more of data after it, end " << end_s;
+    for (const auto& m : rep.manoeuvres) EXPECT_TRUE(std::isnan(m.exit_sog_m_s) || m.exit_sog_m_s >= 0.0);
+  }
+}
+
 TEST(Manoeuvre, SmallTurnsSlowBoatsAndWobblesAreNotManoeuvres) {
   EXPECT_TRUE(analyse_manoeuvres(turn_at(0.0, 40.0, 60.0).fixes, {}).manoeuvres.empty());
   Synth slow = turn_at(0.0, 90.0, 60.0);
