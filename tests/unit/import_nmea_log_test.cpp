@@ -1,0 +1,93 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "import_support.hpp"
+
+namespace telltale::shore::import {
+namespace {
+
+using namespace test;
+
+/// "$" + body + "*hh".
+std::string s(const std::string& body) {
+  unsigned sum = 0;
+  for (char c : body) sum ^= static_cast<unsigned char>(c);
+  char tail[8];
+  std::snprintf(tail, sizeof tail, "*%02X", sum);
+  return "$" + body + tail;
+}
+
+// 2026-02-08 10:56:40 UTC
+constexpr std::uint64_t kT0 = 1770548200ULL * 1000000000ULL;
+
+TEST(ImportNmeaLog, EpochsWithHeadingHeelAndPitch) {
+  const std::string log =
+      s("GPRMC,105640.00,A,3930.0000,N,00230.0000,E,10.0,045.0,080226,,,A") + "\r\n" +
+      s("GPGGA,105640.00,3930.0000,N,00230.0000,E,1,08,0.9,5.0,M,50.0,M,,") + "\r\n" +
+      s("HCHDT,047.5,T") + "\r\n" + s("IIXDR,A,-5.5,D,ROLL,A,2.5,D,PTCH") + "\r\n" +
+      "garbage line\r\n" + s("GPRMC,105641.00,A,3930.0010,N,00230.0010,E,10.0,045.0,080226,,,A") +
+      "\r\n" + s("IIXDR,A,7.0,D,heel,A,1.0,D,Trim") + "\r\n" + s("WIMWV,045,R,12.0,N,A") + "\r\n" +
+      // No checksum: accepted in a log.
+      "$GPRMC,105642.00,A,3930.0020,N,00230.0020,E,10.0,045.0,080226,,,A\n";
+  Collect sink;
+  const auto r = run(Format::kNmea, log, sink);
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.message;
+  ASSERT_EQ(sink.points.size(), 3u);
+  const auto& a = sink.points[0];
+  EXPECT_EQ(a.t_utc_ns, kT0);
+  EXPECT_NEAR(a.lat_deg, 39.5, 1e-9);
+  EXPECT_NEAR(a.lon_deg, 2.5, 1e-9);
+  EXPECT_NEAR(a.sog_m_s, 10.0 * 1852.0 / 3600.0, 1e-9);
+  EXPECT_DOUBLE_EQ(a.cog_deg, 45.0);
+  EXPECT_DOUBLE_EQ(a.heading_deg, 47.5);
+  EXPECT_DOUBLE_EQ(a.heel_deg, -5.5);
+  EXPECT_DOUBLE_EQ(a.pitch_deg, 2.5);
+  EXPECT_EQ(sink.points[1].t_utc_ns, kT0 + 1000000000ULL);
+  EXPECT_DOUBLE_EQ(sink.points[1].heel_deg, 7.0);
+  EXPECT_DOUBLE_EQ(sink.points[1].pitch_deg, 1.0);
+  EXPECT_TRUE(std::isnan(sink.points[2].heel_deg));  // nothing new in its epoch
+  EXPECT_EQ(r.skipped, 1u);                          // the garbage line
+}
+
+TEST(ImportNmeaLog, SignalKMultiplexedLogTakesTheDateFromItsStamps) {
+  // No RMC: GGA and GLL carry only the time of day; the date comes from the ms stamps.
+  const std::string log =
+      "1770548200000;A;" + s("GPGGA,105640.00,3930.0000,N,00230.0000,E,1,08,0.9,5.0,M,50.0,M,,") +
+      "\n1770548200100;A;" + s("HEHDM,100.0,M") + "\n1770548201000;A;" +
+      s("GPGLL,3930.0010,N,00230.0010,E,105641.00,A,A") + "\n1770548201050;A;" +
+      s("GPVTG,045.0,T,,M,5.0,N,9.3,K,A") + "\n";
+  ImportOptions o;
+  o.declination_deg = 2.0;
+  Collect sink;
+  const auto r = run(Format::kNmea, log, sink, o);
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.message;
+  ASSERT_EQ(sink.points.size(), 2u);
+  EXPECT_EQ(sink.points[0].t_utc_ns, kT0);
+  EXPECT_DOUBLE_EQ(sink.points[0].heading_deg, 102.0);
+  EXPECT_EQ(sink.points[1].t_utc_ns, kT0 + 1000000000ULL);
+  EXPECT_NEAR(sink.points[1].sog_m_s, 5.0 * 1852.0 / 3600.0, 1e-9);
+}
+
+TEST(ImportNmeaLog, NoDateIsAnError) {
+  Collect sink;
+  const auto r = run(Format::kNmea,
+                     s("GPGGA,105640.00,3930.0000,N,00230.0000,E,1,08,0.9,5.0,M,50.0,M,,") + "\n",
+                     sink);
+  EXPECT_EQ(r.status, ParseStatus::kError);
+  EXPECT_NE(r.message.find("no position with a date"), std::string::npos) << r.message;
+}
+
+TEST(ImportNmeaLog, MidnightRollsTheDateOver) {
+  const std::string log =
+      s("GPRMC,235959.00,A,3930.0000,N,00230.0000,E,1.0,045.0,080226,,,A") + "\n" +
+      s("GPGGA,000000.00,3930.0000,N,00230.0000,E,1,08,0.9,5.0,M,50.0,M,,") + "\n";
+  Collect sink;
+  ASSERT_EQ(run(Format::kNmea, log, sink).status, ParseStatus::kOk);
+  ASSERT_EQ(sink.points.size(), 2u);
+  EXPECT_EQ(sink.points[1].t_utc_ns - sink.points[0].t_utc_ns, 1000000000ULL);
+}
+
+}  // namespace
+}  // namespace telltale::shore::import
