@@ -33,6 +33,7 @@
 #include "session_log.hpp"
 #include "shutdown.hpp"
 #include "telltale/fusion/alarm_engine.hpp"
+#include "telltale/fusion/attitude_speed.hpp"
 #include "telltale/fusion/attitude_telltale.hpp"
 #include "telltale/fusion/led_panel.hpp"
 #include "telltale/fusion/mounting.hpp"
@@ -300,6 +301,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   fix_msg.boot_id(boot_id);
   std::uint64_t fix_seq = 0;
   std::vector<telltale::boat::GnssFix> fixes;
+  telltale::fusion::GroundSpeedHold ground_speed;
   double next_course_s = 0.0;
   const auto publish_fix = [&](const telltale::boat::GnssFix& f, unsigned long long t_utc_ns) {
     fix_msg.seq(++fix_seq);
@@ -339,13 +341,25 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       ++bad_samples;
       continue;
     }
-    filter.update(mounting.apply(*sample));
-
-    // GNSS: the receiver's fixes as they come; the simulated course at 10 Hz on the sample clock.
+    // GNSS: the receiver's fixes as they come, and their speed and course for the attitude
+    // filter (it takes the boat's own acceleration in turns and speed changes off the specific
+    // force), held on the sample clock from the sample they arrived with. The simulated course
+    // is not fed to the filter: it is another boat than the simulated IMU's dinghy.
     if (gnss) {
       gnss->take(fixes);
-      for (const auto& f : fixes) publish_fix(f, telltale::utc_now_ns());
-    } else if (course && t + 1e-9 >= next_course_s) {
+      for (const auto& f : fixes) {
+        publish_fix(f, telltale::utc_now_ns());
+        const bool no_fix = f.fix == telltale::sensors::GnssFixKind::kNone;
+        ground_speed.on_fix(t, no_fix ? std::numeric_limits<double>::quiet_NaN() : f.sog_m_s,
+                            f.cog_deg);
+      }
+      filter.set_speed(ground_speed.speed_m_s(t), ground_speed.rate_m_s2(t),
+                       ground_speed.cog_rate_rad_s(t));
+    }
+    filter.update(mounting.apply(*sample));
+
+    // The simulated course at 10 Hz on the sample clock.
+    if (!gnss && course && t + 1e-9 >= next_course_s) {
       next_course_s = t + 0.1;
       const unsigned long long t_ns = start_utc_ns + static_cast<unsigned long long>(t * 1e9);
       if (auto f = course_gate.on_epoch(course->at(t, t_ns), t, t_ns)) publish_fix(*f, t_ns);

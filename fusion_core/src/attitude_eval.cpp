@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "telltale/fusion/attitude_speed.hpp"
 #include "telltale/fusion/sim/scenario.hpp"
 
 namespace telltale::fusion {
@@ -45,10 +46,16 @@ std::vector<TiltErrorStats> evaluate_on_scenario(const std::vector<std::string>&
   std::vector<double> se_p(n, 0.0);
   ImuSample imu;
   sim::AttitudeTruth truth;
+  GroundSpeedHold speed;  // the boat node's way: the last GNSS speed, held with an age limit
   while (sc->next(imu, truth)) {
     const bool scored = truth.t_s >= sc->warmup_s();
+    if (const auto& fix = sc->gnss_fix()) speed.on_fix(fix->t_s, fix->sog_m_s, fix->cog_deg);
+    const double v = speed.speed_m_s(imu.t_s);
+    const double dv = speed.rate_m_s2(imu.t_s);
+    const double dcog = speed.cog_rate_rad_s(imu.t_s);
     for (std::size_t i = 0; i < n; ++i) {
       if (!filters[i]) continue;
+      filters[i]->set_speed(v, dv, dcog);
       filters[i]->update(imu);
       if (!scored) continue;
       const AttitudeOutput o = filters[i]->output();

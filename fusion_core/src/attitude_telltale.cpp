@@ -63,9 +63,12 @@ void TelltaleAttitudeFilter::initialise(const ImuSample& s) {
   double heel = 0.0;
   double pitch = 0.0;
   tilt_from_accel(s.acc_body_m_s2, heel, pitch);
-  const double last_t_s = state_.last_t_s;
+  const State kept = state_;  // the inputs held across a restart: the clock and the speed
   state_ = State{};
-  state_.last_t_s = last_t_s;
+  state_.last_t_s = kept.last_t_s;
+  state_.speed_m_s = kept.speed_m_s;
+  state_.speed_rate_m_s2 = kept.speed_rate_m_s2;
+  state_.yaw_rate_cog_rad_s = kept.yaw_rate_cog_rad_s;
   state_.q_gyro = Eigen::AngleAxisd(-pitch, Eigen::Vector3d::UnitY()) *
                   Eigen::AngleAxisd(heel, Eigen::Vector3d::UnitX());
   const Eigen::Matrix3d r = state_.q_gyro.toRotationMatrix();
@@ -81,6 +84,18 @@ void TelltaleAttitudeFilter::initialise(const ImuSample& s) {
   state_.acc_rest_lp_m_s2 = s.acc_body_m_s2;
   state_.initialised = true;
   state_.up_body = r.transpose() * state_.up_i;
+}
+
+void TelltaleAttitudeFilter::set_speed(double speed_m_s, double speed_rate_m_s2,
+                                       double cog_rate_rad_s) {
+  // Filters never throw: anything but a finite speed >= 0 is "unknown", a speed rate that is
+  // not finite is 0, a course rate that is not finite is unknown.
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  state_.speed_m_s =
+      speed_m_s >= 0.0 && speed_m_s < std::numeric_limits<double>::infinity() ? speed_m_s : kNaN;
+  state_.speed_rate_m_s2 = std::isfinite(speed_rate_m_s2) ? speed_rate_m_s2 : 0.0;
+  // The course turns clockwise (compass), the frame's yaw counter-clockwise.
+  state_.yaw_rate_cog_rad_s = std::isfinite(cog_rate_rad_s) ? -cog_rate_rad_s : kNaN;
 }
 
 AttitudeOutput TelltaleAttitudeFilter::output() const {
@@ -170,8 +185,39 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // motion-bias model needs filtered the same way. A saturated sample is fed as it is: it is
   // still the best bound on the acceleration, and leaving the strongest samples out would bias
   // the mean toward the other side (a shake's hard stops and gentle starts would leave a tilt).
+  Eigen::Vector3d f = s.acc_body_m_s2;
+  if (st.speed_m_s >= 0.0) {
+    // The boat's own acceleration, taken off the specific force when its speed is known. Its
+    // velocity is horizontal along the bow's horizontal direction hb = (e_x - u_x u) / |.| (u:
+    // the vertical in the body, from the last update); the velocity turns with the yaw rate
+    // about the vertical, w_up = omega . u, so a = (dv/dt) hb + v w_up (u x hb), and
+    // u x e_x = (0, u_z, -u_y). Pitching and rolling do not turn a horizontal velocity: only
+    // w_up enters (the body-frame omega x (v, 0, 0) would also count the bow's pitching as a
+    // vertical acceleration of the whole boat). In a tack (0.8 rad/s at 1.5 m/s) this is
+    // 1.2 m/s^2 to one side for 2-4 s: 7 deg of false heel that the low-pass cannot average.
+    const Eigen::Vector3d& u = st.up_body;
+    const double n2 = 1.0 - u.x() * u.x();
+    if (n2 > 0.25) {  // the bow within 60 deg of horizontal (else its direction means nothing)
+      const double inv_n = 1.0 / std::sqrt(n2);
+      double w_up = gyro.dot(u);
+      if (st.yaw_rate_cog_rad_s == st.yaw_rate_cog_rad_s) {
+        // The gyro's error about the vertical is its bias there (variance u^T P u); the course
+        // rate's is cog_rate_sigma. Their variance-weighted mean (the Kalman update of one
+        // measurement of the other).
+        const double vg = u.dot(st.bias_cov * u);
+        const double vc = p.cog_rate_sigma_rad_s * p.cog_rate_sigma_rad_s;
+        w_up += vg / (vg + vc) * (st.yaw_rate_cog_rad_s - w_up);
+      }
+      const double turn = st.speed_m_s * w_up;
+      const double along = st.speed_rate_m_s2;
+      const Eigen::Vector3d a_body(along * (1.0 - u.x() * u.x()),
+                                   -along * u.x() * u.y() + turn * u.z(),
+                                   -along * u.x() * u.z() - turn * u.y());
+      f -= inv_n * a_body;
+    }
+  }
   Eigen::Matrix<double, 3, 5> x;
-  x.col(0) = r * s.acc_body_m_s2;
+  x.col(0) = r * f;
   x.block<3, 3>(0, 1) = r;
   x.col(4) = r * st.bias_rad_s;
   // The time constant trades the gyro against the accelerometer. Over tau a horizontal bias

@@ -53,6 +53,7 @@ RigidMotion SmoothTrajectory::motion(double t) {
   m.acc_world_m_s2 = (velocity_world(t - 2 * h) - 8.0 * velocity_world(t - h) +
                       8.0 * velocity_world(t + h) - velocity_world(t + 2 * h)) /
                      (12.0 * h);
+  m.vel_world_m_s = velocity_world(t);
   return m;
 }
 

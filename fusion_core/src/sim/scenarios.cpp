@@ -1,5 +1,6 @@
 // The simulated scenarios: trajectories as smooth functions of time (or a pendulum's dynamics),
 // a sensor at a lever arm, and the MEMS error model.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <string>
@@ -323,7 +324,7 @@ class LateStartTrajectory final : public Trajectory {
 // ---------------------------------------------------------------------------------------------
 ImuScenario::ImuScenario(std::unique_ptr<Trajectory> trajectory, const Eigen::Vector3d& lever_arm,
                          double rate_hz, double duration_s, double warmup_s, std::uint64_t seed,
-                         const ScenarioOptions& options)
+                         const ScenarioOptions& options, bool has_gnss)
     : trajectory_(std::move(trajectory)),
       lever_arm_(lever_arm),
       rate_hz_(rate_hz),
@@ -331,7 +332,9 @@ ImuScenario::ImuScenario(std::unique_ptr<Trajectory> trajectory, const Eigen::Ve
       warmup_s_(warmup_s),
       options_(options),
       errors_(options.errors, seed),
-      timing_rng_(seed * 31 + 7) {}
+      timing_rng_(seed * 31 + 7),
+      has_gnss_(has_gnss && options.gnss_rate_hz > 0.0),
+      gnss_rng_(seed * 131 + 17) {}
 
 bool ImuScenario::next(ImuSample& imu, AttitudeTruth& truth) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -372,6 +375,27 @@ bool ImuScenario::next(ImuSample& imu, AttitudeTruth& truth) {
     truth.acc_true_m_s2 = acc_mean;
   }
   last_att_ = m.att;
+  gnss_fix_.reset();
+  if (has_gnss_) {
+    // The receiver measures at its own epochs (the first IMU sample at or after each), and the
+    // fix arrives gnss_latency_s later.
+    if (t + 1e-9 >= next_gnss_epoch_s_) {
+      std::normal_distribution<double> noise(0.0, options_.gnss_speed_sigma_m_s);
+      // World x east, y north (ENU).
+      const double east = m.vel_world_m_s.x() + noise(gnss_rng_);
+      const double north = m.vel_world_m_s.y() + noise(gnss_rng_);
+      const double cog = std::atan2(east, north) * (180.0 / M_PI);
+      gnss_pending_.push_back({t, std::hypot(east, north), cog < 0.0 ? cog + 360.0 : cog});
+      next_gnss_epoch_s_ += 1.0 / options_.gnss_rate_hz;
+      if (next_gnss_epoch_s_ <= t) next_gnss_epoch_s_ = t + 1.0 / options_.gnss_rate_hz;
+    }
+    while (!gnss_pending_.empty() &&
+           gnss_pending_.front().t_s + options_.gnss_latency_s <= t + 1e-9) {
+      gnss_fix_ = gnss_pending_.front();
+      gnss_fix_->t_s = t;
+      gnss_pending_.pop_front();
+    }
+  }
   imu.t_s = t;
   errors_.apply(t - last_t_s_, rate_hz_, truth.gyro_true_rad_s, truth.acc_true_m_s2,
                 imu.gyro_body_rad_s, imu.acc_body_m_s2);
@@ -436,7 +460,7 @@ std::unique_ptr<ImuScenario> make_scenario(std::string_view name, std::uint64_t 
     constexpr double kAshore = 10.0;
     return std::make_unique<ImuScenario>(std::make_unique<DinghyTrajectory>(seed, kAshore),
                                          DinghyTrajectory::lever_arm(), rate_hz, duration_s,
-                                         kAshore, seed, options);
+                                         kAshore, seed, options, true);
   }
   if (name.starts_with("yaw-")) {
     const std::string rate(name.substr(4));
@@ -457,7 +481,7 @@ std::unique_ptr<ImuScenario> make_scenario(std::string_view name, std::uint64_t 
     return std::make_unique<ImuScenario>(
         std::make_unique<LateStartTrajectory>(std::make_unique<DinghyTrajectory>(seed, 10.0),
                                               offset),
-        DinghyTrajectory::lever_arm(), rate_hz, duration_s, warmup, seed, options);
+        DinghyTrajectory::lever_arm(), rate_hz, duration_s, warmup, seed, options, true);
   }
   return nullptr;
 }

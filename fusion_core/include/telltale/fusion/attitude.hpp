@@ -52,6 +52,13 @@ class AttitudeFilter {
   /// NaN/Inf or non-increasing time are rejected and counted in the filter's Diagnostics.
   virtual void update(const ImuSample& sample) = 0;
   [[nodiscard]] virtual AttitudeOutput output() const = 0;
+  /// The boat's speed (m/s, forward, horizontal), its rate of change (m/s^2) and the rate of its
+  /// course over ground (rad/s, clockwise +, as the compass turns), held for the updates that
+  /// follow until the next call; NaN speed = unknown (the default), NaN speed rate = 0, NaN
+  /// course rate = unknown. Filters that cannot use them ignore them (the default); see
+  /// TelltaleAttitudeFilter::set_speed.
+  virtual void set_speed(double /*speed_m_s*/, double /*speed_rate_m_s2*/,
+                         double /*cog_rate_rad_s*/) {}
 };
 
 /// Outcome of gate_sample.

@@ -21,15 +21,22 @@
 ///   - fast start: for the first tau_acc_s the low-pass is the mean of everything seen since the
 ///     start (the best estimate of a constant from a growing window), so a filter started under
 ///     way converges in seconds; the same after a gap too long to integrate;
+///   - the boat's own acceleration, when its speed is known (set_speed, from GNSS): a boat
+///     turning at w about the vertical at speed v accelerates at w v toward the inside of the
+///     turn, and speeding up at dv/dt along its heading. A tack's few seconds of that are one
+///     direction in I for longer than the low-pass can average out (it would read as heel);
+///     known, it is taken off the specific force before the low-pass;
 ///   - non-uniform time steps, dropped samples, saturated samples, NaN/Inf.
 ///
 /// Call order: update() once per sample, time strictly increasing; read output() afterwards.
 /// Cannot observe: the gyro bias about the vertical (heading drift; irrelevant to heel/pitch),
 /// an accelerometer offset (it becomes a tilt error of offset/g rad), a linear acceleration that
-/// is sustained in one earth direction for longer than ~tau_acc_s (its mean is a tilt).
+/// is sustained in one earth direction for longer than ~tau_acc_s (its mean is a tilt) unless it
+/// is the turn and speed change of a boat whose speed is given.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <limits>
 
 #include "telltale/fusion/attitude.hpp"
 
@@ -74,6 +81,12 @@ struct TelltaleAttitudeParams {
   /// the best mean); a rotation at w rad/s moves the vertical by w * delay, so a wrong delay
   /// costs at most 0.25 deg at 100 deg/s. Set it to the boat's sensor's figure when known.
   double sensor_delay_s = 2.5e-3;
+  /// The error of a GNSS course rate (set_speed) as the low-pass sees it, against which the
+  /// gyro's rate about the vertical is weighed when its bias there is not known: 0.05 m/s of
+  /// velocity noise is 1.1 deg of course at 2.5 m/s, sqrt(2) * 1.1 / tau_acc_s = 0.5 deg/s over
+  /// the low-pass's window, and the bow and the track part by a few degrees of leeway that
+  /// changes over a tack: 1 deg/s.
+  double cog_rate_sigma_rad_s = 1.0 * M_PI / 180.0;
 };
 
 class TelltaleAttitudeFilter final : public AttitudeFilter {
@@ -107,6 +120,10 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
     Eigen::Vector3d rate_rad_s = Eigen::Vector3d::Zero();
     bool initialised = false;
     bool updated = false;  ///< an update followed the first sample
+    /// The boat's speed as last given by set_speed (NaN: unknown) and its rate of change.
+    double speed_m_s = std::numeric_limits<double>::quiet_NaN();
+    double speed_rate_m_s2 = 0.0;
+    double yaw_rate_cog_rad_s = std::numeric_limits<double>::quiet_NaN();  ///< - cog rate
   };
   struct Diagnostics {
     unsigned rejected_non_finite = 0;
@@ -119,6 +136,21 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
 
   explicit TelltaleAttitudeFilter(Params params = {});
   void update(const ImuSample& sample) override;
+  /// The boat's speed over ground (m/s; through the water is better when known, see below), its
+  /// rate of change (m/s^2) and the rate of the course over ground (rad/s, clockwise +), used by
+  /// every update until the next call. NaN speed = unknown: the filter then behaves exactly as
+  /// without it; NaN speed rate = 0; NaN course rate = unknown (the gyro's rate is used). The
+  /// model: the velocity is horizontal, along the bow's horizontal direction (no leeway), so the
+  /// boat's acceleration is dv/dt along the bow plus (turn rate about the vertical) x v. The
+  /// turn rate is the gyro's about the vertical, weighed against the course rate by their
+  /// variances: the gyro's bias about the vertical cannot be learnt in motion, so a node started
+  /// under way knows it only to bias_sigma_init (5.8 deg/s: 0.25 m/s^2 of false turn at
+  /// 2.5 m/s), and there the course rate is better; once a rest has measured the bias, the gyro
+  /// (no latency, no noise) is. In a current c the turn term of a speed over ground is off by
+  /// w x c (0.5 m/s of current against 2.5 m/s of boat speed: a fifth). The lever arm from the
+  /// boat's centre to the sensor is not modelled (its centripetal part points along the arm and
+  /// a turn starting and ending cancels its tangential part).
+  void set_speed(double speed_m_s, double speed_rate_m_s2, double cog_rate_rad_s) override;
   /// Computed on demand from the state (update() does not pay for the two atan2).
   [[nodiscard]] AttitudeOutput output() const override;
   [[nodiscard]] const State& state() const { return state_; }

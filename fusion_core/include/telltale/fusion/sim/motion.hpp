@@ -16,6 +16,7 @@ struct RigidMotion {
   Eigen::Vector3d omega_body_rad_s = Eigen::Vector3d::Zero();   ///< angular rate, body frame
   Eigen::Vector3d alpha_body_rad_s2 = Eigen::Vector3d::Zero();  ///< angular acceleration, body
   Eigen::Vector3d acc_world_m_s2 = Eigen::Vector3d::Zero();     ///< acceleration of the origin
+  Eigen::Vector3d vel_world_m_s = Eigen::Vector3d::Zero();      ///< velocity of the origin
 };
 
 /// Specific force at the sensor (lever arm r, body frame): the acceleration of the sensor point

@@ -25,10 +25,15 @@
 ///     from the end of the rest.
 ///   underway-5, underway-15: the dinghy joined 100..120 s into its script (sailing in waves,
 ///     instrument on the bow, no rest before the first sample), 60 s; scored from 5 s or 15 s.
+/// The dinghy and underway scenarios also have a GNSS receiver (gnss_fix()): speed
+/// and course over ground of the boat's centre at ScenarioOptions::gnss_rate_hz, with noise and
+/// latency.
 /// Sensor: ImuErrorModel with the L3G4200D/LSM303DLH defaults of imu_errors.hpp.
 
 #include <cstdint>
+#include <deque>
 #include <memory>
+#include <optional>
 #include <random>
 #include <string>
 #include <string_view>
@@ -60,15 +65,32 @@ struct ScenarioOptions {
   double jitter_s = 0.0;          ///< uniform +- jitter on every time stamp (< 0.5 / rate)
   double drop_probability = 0.0;  ///< chance that a sample is lost (non-uniform sampling)
   double g_m_s2 = 9.80665;
+  /// The GNSS receiver of the scenarios that have one: epochs per second, the white noise of
+  /// its velocity, east and north (a u-blox M8's 0.05 m/s), and the time from its epoch to the
+  /// fix's arrival beside the IMU samples (navigation solution and transfer, ~0.1 s).
+  double gnss_rate_hz = 5.0;
+  double gnss_speed_sigma_m_s = 0.05;
+  double gnss_latency_s = 0.1;
+};
+
+/// A GNSS fix as it reaches the boat: the IMU sample time it arrived with, the speed and course
+/// over ground of the trajectory's origin at the epoch (from its horizontal velocity plus white
+/// noise of gnss_speed_sigma_m_s on each of east and north).
+struct GnssSpeedFix {
+  double t_s = 0.0;
+  double sog_m_s = 0.0;
+  double cog_deg = 0.0;  ///< true, clockwise from north
 };
 
 class ImuScenario {
  public:
   ImuScenario(std::unique_ptr<Trajectory> trajectory, const Eigen::Vector3d& lever_arm_body_m,
               double rate_hz, double duration_s, double warmup_s, std::uint64_t seed,
-              const ScenarioOptions& options);
+              const ScenarioOptions& options, bool has_gnss = false);
   /// Produces the next sample and its truth; false once duration_s is reached (never if endless).
   bool next(ImuSample& imu, AttitudeTruth& truth);
+  /// The GNSS fix that arrived with the last sample, if one did (only scenarios with a receiver).
+  [[nodiscard]] const std::optional<GnssSpeedFix>& gnss_fix() const { return gnss_fix_; }
   [[nodiscard]] double rate_hz() const { return rate_hz_; }
   /// Start-up rest of the scenario: score accuracy after it (filters are initialising).
   [[nodiscard]] double warmup_s() const { return warmup_s_; }
@@ -85,6 +107,11 @@ class ImuScenario {
   std::uint64_t k_ = 0;
   double last_t_s_ = 0.0;
   Eigen::Quaterniond last_att_ = Eigen::Quaterniond::Identity();
+  bool has_gnss_ = false;
+  std::mt19937_64 gnss_rng_;  ///< its own: the IMU samples are the same with or without GNSS
+  double next_gnss_epoch_s_ = 0.0;
+  std::deque<GnssSpeedFix> gnss_pending_;  ///< epochs measured, not yet arrived (t_s = epoch)
+  std::optional<GnssSpeedFix> gnss_fix_;
 };
 
 [[nodiscard]] const std::vector<std::string>& scenario_names();
