@@ -11,7 +11,8 @@ build="$root/build-fuzz"
 seconds=${1:-45}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(fuzz_csv fuzz_nmea fuzz_witmotion fuzz_session_log fuzz_rest fuzz_ingest)
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_csv fuzz_nmea fuzz_witmotion fuzz_session_log fuzz_rest fuzz_ingest
+  fuzz_import_vakaros_csv fuzz_import_vkx fuzz_import_vtk fuzz_import_nmea_log fuzz_import_gpx)
 "$root/deploy/bootstrap.sh"
 
 start=$(date +%s)

@@ -113,7 +113,7 @@ ParseResult parse_gpx(std::istream& in, const ImportOptions& options, ImportSink
       continue;
     }
     const bool end_tag = token[0] == '/';
-    const bool self_closing = token.back() == '/';
+    const bool self_closing = !end_tag && token.size() > 1 && token.back() == '/';
     std::string_view body(token);
     if (end_tag) body.remove_prefix(1);
     if (self_closing) body.remove_suffix(1);

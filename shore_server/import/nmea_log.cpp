@@ -126,7 +126,7 @@ class Epochs {
         if (t - stamp_s > 43200.0) --days;
         if (stamp_s - t > 43200.0) ++days;
       }
-      if (days < 0) {
+      if (days < 0 || (days == 0 && tod_ < 1.0)) {  // no date yet (or the epoch itself)
         ++r_.skipped;
       } else {
         p_.t_utc_ns = static_cast<std::uint64_t>(days) * 86400ULL * 1'000'000'000ULL +

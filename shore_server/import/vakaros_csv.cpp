@@ -152,6 +152,8 @@ ParseResult parse_vakaros_csv(std::istream& in, const ImportOptions& options, Im
                    value(kHdg, -360, 720, "hdg_true", p.heading_deg),
                    value(kHeel, -180, 180, "heel", heel), value(kPitch, -90, 90, "trim", pitch)})
       if (e) return fail(line_no, *e);
+    if (std::isnan(p.lat_deg) != std::isnan(p.lon_deg))
+      return fail(line_no, "a latitude without a longitude or the reverse");
     p.sog_m_s = sog_kn * kKnotToMS;
     p.cog_deg = wrap360(p.cog_deg);
     p.heading_deg = wrap360(p.heading_deg);
