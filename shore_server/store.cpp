@@ -688,6 +688,25 @@ bool Store::commit(std::vector<AttitudeSample>& batch) {
   }
 }
 
+void Store::write_transaction(const std::function<void(sqlite3*)>& work) {
+  std::lock_guard db_lock(db_mutex_);
+  exec(db_, "BEGIN IMMEDIATE");
+  try {
+    work(db_);
+    exec(db_, "COMMIT");
+  } catch (...) {
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    open_sessions_.clear();
+    throw;
+  }
+  open_sessions_.clear();
+}
+
+void Store::read(const std::function<void(sqlite3*)>& work) {
+  std::lock_guard lock(reader_mutex_);
+  work(reader_);
+}
+
 void Store::extend_session(const std::string& boat_id, std::uint64_t t_ns) {
   const auto gap = static_cast<std::uint64_t>(
       std::chrono::duration_cast<std::chrono::nanoseconds>(config_.session_gap).count());

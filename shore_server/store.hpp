@@ -192,6 +192,15 @@ class Store {
   };
   [[nodiscard]] std::vector<DuplicateId> duplicate_ids() const;
 
+  /// Runs `work` on the writer connection inside one transaction (BEGIN IMMEDIATE), the live
+  /// writer waiting meanwhile: committed when `work` returns, rolled back when it throws (the
+  /// exception goes on). The cached open sessions are re-read from disk afterwards, as `work` may
+  /// have changed sessions. For imports: a whole file is stored, or nothing of it.
+  void write_transaction(const std::function<void(sqlite3*)>& work);
+  /// Runs `work` on the read-only connection.
+  void read(const std::function<void(sqlite3*)>& work);
+  [[nodiscard]] std::chrono::seconds session_gap() const { return config_.session_gap; }
+
   [[nodiscard]] std::uint64_t committed() const;
   /// GNSS fixes written (re-sent duplicates included: INSERT OR IGNORE counts them too).
   [[nodiscard]] std::uint64_t fixes_committed() const;

@@ -1,0 +1,452 @@
+#include "import_store.hpp"
+
+#include <openssl/evp.h>
+#include <sqlite3.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+
+#include "detect.hpp"
+
+namespace telltale::shore::import {
+namespace {
+
+constexpr const char* kSchema = R"sql(
+CREATE TABLE IF NOT EXISTS imports (
+  id INTEGER PRIMARY KEY AUTOINCREMENT,
+  boat_id TEXT NOT NULL,
+  format TEXT NOT NULL DEFAULT '',
+  device TEXT NOT NULL DEFAULT '',
+  file_name TEXT NOT NULL,
+  sha256 TEXT NOT NULL DEFAULT '',
+  bytes INTEGER NOT NULL DEFAULT 0,
+  state TEXT NOT NULL,
+  points INTEGER NOT NULL DEFAULT 0,
+  samples_added INTEGER NOT NULL DEFAULT 0,
+  fixes_added INTEGER NOT NULL DEFAULT 0,
+  events INTEGER NOT NULL DEFAULT 0,
+  skipped INTEGER NOT NULL DEFAULT 0,
+  start_ns INTEGER NOT NULL DEFAULT 0,
+  end_ns INTEGER NOT NULL DEFAULT 0,
+  error TEXT NOT NULL DEFAULT '',
+  partial TEXT NOT NULL DEFAULT '',
+  duplicate_of INTEGER NOT NULL DEFAULT 0,
+  created_ns INTEGER NOT NULL
+);
+CREATE INDEX IF NOT EXISTS imports_by_content ON imports (sha256, boat_id);
+CREATE TABLE IF NOT EXISTS import_sessions (
+  import_id INTEGER NOT NULL,
+  session_id INTEGER NOT NULL,
+  PRIMARY KEY (import_id, session_id)
+) WITHOUT ROWID;
+CREATE INDEX IF NOT EXISTS import_sessions_by_session ON import_sessions (session_id);
+CREATE TABLE IF NOT EXISTS import_events (
+  import_id INTEGER NOT NULL,
+  boat_id TEXT NOT NULL,
+  t_utc_ns INTEGER NOT NULL,
+  kind TEXT NOT NULL,
+  detail TEXT NOT NULL
+);
+)sql";
+
+/// A prepared statement; throws StoreError on failure.
+class Sql {
+ public:
+  Sql(sqlite3* db, const char* sql) : db_(db) {
+    if (sqlite3_prepare_v2(db, sql, -1, &st_, nullptr) != SQLITE_OK)
+      throw StoreError(sqlite3_errmsg(db));
+  }
+  ~Sql() { sqlite3_finalize(st_); }
+  Sql(const Sql&) = delete;
+  Sql& operator=(const Sql&) = delete;
+  Sql& i(int k, std::int64_t v) {
+    sqlite3_bind_int64(st_, k, v);
+    return *this;
+  }
+  Sql& u(int k, std::uint64_t v) { return i(k, static_cast<std::int64_t>(v)); }
+  Sql& d(int k, double v) {
+    if (std::isfinite(v)) {
+      sqlite3_bind_double(st_, k, v);
+    } else {
+      sqlite3_bind_null(st_, k);
+    }
+    return *this;
+  }
+  Sql& s(int k, const std::string& v) {
+    sqlite3_bind_text(st_, k, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT);
+    return *this;
+  }
+  bool step() {
+    const int rc = sqlite3_step(st_);
+    if (rc == SQLITE_ROW) return true;
+    if (rc == SQLITE_DONE) return false;
+    throw StoreError(sqlite3_errmsg(db_));
+  }
+  /// Steps a write and resets for the next one; returns the rows it changed.
+  int run() {
+    step();
+    const int n = sqlite3_changes(db_);
+    sqlite3_reset(st_);
+    return n;
+  }
+  void reset() {
+    sqlite3_reset(st_);
+    sqlite3_clear_bindings(st_);
+  }
+  std::int64_t col_i(int c) const { return sqlite3_column_int64(st_, c); }
+  std::uint64_t col_u(int c) const { return static_cast<std::uint64_t>(col_i(c)); }
+  std::string col_s(int c) const {
+    const auto* p = sqlite3_column_text(st_, c);
+    return p ? reinterpret_cast<const char*>(p) : "";
+  }
+
+ private:
+  sqlite3* db_;
+  sqlite3_stmt* st_ = nullptr;
+};
+
+void exec(sqlite3* db, const char* sql) {
+  char* err = nullptr;
+  if (sqlite3_exec(db, sql, nullptr, nullptr, &err) != SQLITE_OK) {
+    std::string msg = err ? err : "unknown error";
+    sqlite3_free(err);
+    throw StoreError(msg);
+  }
+}
+
+std::uint64_t now_ns() {
+  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                        std::chrono::system_clock::now().time_since_epoch())
+                                        .count());
+}
+
+/// Thrown inside the transaction to roll it back with the parser's message.
+struct ParseFailure : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// Writes the parser's points and events into the open transaction.
+class StoreSink : public ImportSink {
+ public:
+  StoreSink(sqlite3* db, std::int64_t import_id, const std::string& boat_id, std::uint64_t gap_ns,
+            std::istream& in, const std::function<void(std::uint64_t)>& progress)
+      : db_(db),
+        import_id_(import_id),
+        boat_(boat_id),
+        gap_ns_(gap_ns),
+        in_(in),
+        progress_(progress),
+        attitude_(db,
+                  "INSERT OR IGNORE INTO attitude (boat_id, t_utc_ns, seq, heel_deg, pitch_deg, "
+                  "heading_deg, boot_id) VALUES (?1, ?2, 0, ?3, ?4, ?5, 0)"),
+        fix_(db,
+             "INSERT OR IGNORE INTO fixes (boat_id, t_utc_ns, seq, gnss_utc_ns, lat_deg, lon_deg, "
+             "sog_m_s, cog_deg, fix, satellites, hdop, boot_id) "
+             "VALUES (?1, ?2, 0, ?2, ?3, ?4, ?5, ?6, '3d', 0, NULL, 0)"),
+        event_(db,
+               "INSERT INTO import_events (import_id, boat_id, t_utc_ns, kind, detail) "
+               "VALUES (?1, ?2, ?3, ?4, ?5)") {
+    attitude_.s(1, boat_);
+    fix_.s(1, boat_);
+    event_.i(1, import_id_).s(2, boat_);
+  }
+
+  void point(const ImportPoint& p) override {
+    std::uint64_t added = 0;
+    if (std::isfinite(p.heel_deg) && std::isfinite(p.pitch_deg)) {
+      attitude_.u(2, p.t_utc_ns).d(3, p.heel_deg).d(4, p.pitch_deg).d(5, p.heading_deg);
+      added = static_cast<std::uint64_t>(attitude_.run());
+      samples_added += added;
+    }
+    if (std::isfinite(p.lat_deg) && std::isfinite(p.lon_deg)) {
+      fix_.u(2, p.t_utc_ns).d(3, p.lat_deg).d(4, p.lon_deg).d(5, p.sog_m_s).d(6, p.cog_deg);
+      fixes_added += static_cast<std::uint64_t>(fix_.run());
+    }
+    extend(p.t_utc_ns, added);
+    if (++points_ % 4096 == 0 && progress_) progress_(static_cast<std::uint64_t>(in_.tellg()));
+  }
+  void event(const ImportEvent& e) override {
+    event_.u(3, e.t_utc_ns).s(4, e.kind).s(5, e.detail);
+    event_.run();
+  }
+  void device(std::string_view d) override { device_name = std::string(d.substr(0, 200)); }
+
+  /// Joins each span of the file to the boat's sessions and links them to the import.
+  std::vector<std::int64_t> sessions() {
+    std::vector<std::int64_t> out;
+    const std::uint64_t received = now_ns();
+    for (const Span& sp : spans_) {
+      Sql q(db_,
+            "SELECT id, start_ns, end_ns, samples FROM sessions WHERE boat_id = ?1 AND "
+            "start_ns <= ?3 + ?4 AND end_ns + ?4 >= ?2 ORDER BY id");
+      q.s(1, boat_).u(2, sp.start).u(3, sp.end).u(4, gap_ns_);
+      std::int64_t keep = 0;
+      std::uint64_t start = sp.start, end = sp.end;
+      std::int64_t samples = static_cast<std::int64_t>(sp.added);
+      std::vector<std::int64_t> gone;
+      while (q.step()) {
+        if (keep == 0) {
+          keep = q.col_i(0);
+        } else {
+          gone.push_back(q.col_i(0));
+        }
+        start = std::min(start, q.col_u(1));
+        end = std::max(end, q.col_u(2));
+        samples += q.col_i(3);
+      }
+      if (keep == 0) {
+        Sql ins(db_,
+                "INSERT INTO sessions (boat_id, start_ns, end_ns, samples, received_ns) "
+                "VALUES (?1, ?2, ?3, ?4, ?5)");
+        ins.s(1, boat_).u(2, start).u(3, end).i(4, samples).u(5, received);
+        ins.run();
+        keep = sqlite3_last_insert_rowid(db_);
+      } else {
+        Sql up(db_,
+               "UPDATE sessions SET start_ns = ?2, end_ns = ?3, samples = ?4, "
+               "received_ns = MAX(received_ns, ?5) WHERE id = ?1");
+        up.i(1, keep).u(2, start).u(3, end).i(4, samples).u(5, received);
+        up.run();
+        for (std::int64_t g : gone) {
+          // Sessions this span bridged: one session now; earlier imports follow it.
+          Sql move(db_, "UPDATE OR IGNORE import_sessions SET session_id = ?2 WHERE session_id = ?1");
+          move.i(1, g).i(2, keep);
+          move.run();
+          Sql drop_links(db_, "DELETE FROM import_sessions WHERE session_id = ?1");
+          drop_links.i(1, g);
+          drop_links.run();
+          Sql drop(db_, "DELETE FROM sessions WHERE id = ?1");
+          drop.i(1, g);
+          drop.run();
+          std::erase(out, g);
+        }
+      }
+      Sql link(db_, "INSERT OR IGNORE INTO import_sessions (import_id, session_id) VALUES (?1, ?2)");
+      link.i(1, import_id_).i(2, keep);
+      link.run();
+      if (std::find(out.begin(), out.end(), keep) == out.end()) out.push_back(keep);
+    }
+    return out;
+  }
+
+  std::uint64_t samples_added = 0, fixes_added = 0;
+  std::uint64_t start_ns = 0, end_ns = 0;
+  std::string device_name;
+
+ private:
+  struct Span {
+    std::uint64_t start, end, added;
+  };
+  void extend(std::uint64_t t, std::uint64_t added) {
+    start_ns = start_ns == 0 ? t : std::min(start_ns, t);
+    end_ns = std::max(end_ns, t);
+    if (!spans_.empty()) {
+      Span& s = spans_.back();
+      if (t + gap_ns_ >= s.start && t <= s.end + gap_ns_) {
+        s.start = std::min(s.start, t);
+        s.end = std::max(s.end, t);
+        s.added += added;
+        return;
+      }
+    }
+    // A pause longer than the gap (or a jump back in time): a new span. Spans are few (one per
+    // pause), and the session step joins any that overlap.
+    spans_.push_back({t, t, added});
+  }
+
+  sqlite3* db_;
+  std::int64_t import_id_;
+  std::string boat_;
+  std::uint64_t gap_ns_;
+  std::istream& in_;
+  const std::function<void(std::uint64_t)>& progress_;
+  Sql attitude_, fix_, event_;
+  std::uint64_t points_ = 0;
+  std::vector<Span> spans_;
+};
+
+}  // namespace
+
+std::string sha256_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + path);
+  EVP_MD_CTX* ctx = EVP_MD_CTX_new();
+  if (!ctx || EVP_DigestInit_ex(ctx, EVP_sha256(), nullptr) != 1) {
+    EVP_MD_CTX_free(ctx);
+    throw std::runtime_error("SHA-256 unavailable");
+  }
+  std::vector<char> buf(1 << 16);
+  while (in) {
+    in.read(buf.data(), static_cast<std::streamsize>(buf.size()));
+    if (in.gcount() > 0) EVP_DigestUpdate(ctx, buf.data(), static_cast<std::size_t>(in.gcount()));
+  }
+  unsigned char md[EVP_MAX_MD_SIZE];
+  unsigned int n = 0;
+  EVP_DigestFinal_ex(ctx, md, &n);
+  EVP_MD_CTX_free(ctx);
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out;
+  for (unsigned i = 0; i < n; ++i) {
+    out.push_back(kHex[md[i] >> 4]);
+    out.push_back(kHex[md[i] & 15]);
+  }
+  return out;
+}
+
+ImportStore::ImportStore(Store& store) : store_(store) {
+  store_.write_transaction([](sqlite3* db) { exec(db, kSchema); });
+}
+
+std::int64_t ImportStore::begin(const std::string& boat_id, const std::string& file_name,
+                                std::uint64_t bytes) {
+  std::int64_t id = 0;
+  store_.write_transaction([&](sqlite3* db) {
+    Sql ins(db,
+            "INSERT INTO imports (boat_id, file_name, bytes, state, created_ns) "
+            "VALUES (?1, ?2, ?3, 'running', ?4)");
+    ins.s(1, boat_id).s(2, file_name).u(3, bytes).u(4, now_ns());
+    ins.run();
+    id = sqlite3_last_insert_rowid(db);
+  });
+  return id;
+}
+
+void ImportStore::finish(const ImportRecord& r) {
+  store_.write_transaction([&](sqlite3* db) {
+    Sql up(db,
+           "UPDATE imports SET format = ?2, device = ?3, sha256 = ?4, state = ?5, points = ?6, "
+           "samples_added = ?7, fixes_added = ?8, events = ?9, skipped = ?10, start_ns = ?11, "
+           "end_ns = ?12, error = ?13, partial = ?14, duplicate_of = ?15 WHERE id = ?1");
+    up.i(1, r.id).s(2, r.format).s(3, r.device).s(4, r.sha256).s(5, r.state).u(6, r.points);
+    up.u(7, r.samples_added).u(8, r.fixes_added).u(9, r.events).u(10, r.skipped);
+    up.u(11, r.start_ns).u(12, r.end_ns).s(13, r.error).s(14, r.partial).i(15, r.duplicate_of);
+    up.run();
+  });
+}
+
+ImportRecord ImportStore::run(std::int64_t id, const ImportRequest& req,
+                              const std::function<void(std::uint64_t)>& progress) {
+  ImportRecord r;
+  r.id = id;
+  r.boat_id = req.boat_id;
+  r.file_name = req.file_name;
+  try {
+    r.sha256 = sha256_file(req.path);
+    std::ifstream in(req.path, std::ios::binary);
+    if (!in) throw std::runtime_error("cannot read the uploaded file");
+    in.seekg(0, std::ios::end);
+    r.bytes = static_cast<std::uint64_t>(in.tellg());
+    in.seekg(0);
+    std::optional<Format> format = req.format;
+    if (!format) {
+      std::string head(kDetectBytes, '\0');
+      in.read(head.data(), static_cast<std::streamsize>(head.size()));
+      head.resize(static_cast<std::size_t>(in.gcount()));
+      in.clear();
+      in.seekg(0);
+      format = detect_format(head);
+      if (!format)
+        throw ParseFailure(
+            "the file is none of the formats Telltale reads (vakaros_csv, vkx, vtk, nmea, gpx); "
+            "give format= if it is one of them");
+    }
+    r.format = format_name(*format);
+    const auto gap_ns = static_cast<std::uint64_t>(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(store_.session_gap()).count());
+    store_.write_transaction([&](sqlite3* db) {
+      // The same content for the same boat: nothing to do (checked in the transaction, so two
+      // uploads of one file at once store it once).
+      Sql dup(db,
+              "SELECT id FROM imports WHERE sha256 = ?1 AND boat_id = ?2 AND state = 'done' AND "
+              "duplicate_of = 0 AND id <> ?3 ORDER BY id LIMIT 1");
+      dup.s(1, r.sha256).s(2, r.boat_id).i(3, id);
+      if (dup.step()) {
+        r.duplicate_of = dup.col_i(0);
+        Sql same(db, "SELECT points, device, partial, start_ns, end_ns FROM imports WHERE id = ?1");
+        same.i(1, r.duplicate_of);
+        if (same.step()) {
+          r.points = same.col_u(0);
+          r.device = same.col_s(1);
+          r.partial = same.col_s(2);
+          r.start_ns = same.col_u(3);
+          r.end_ns = same.col_u(4);
+        }
+        Sql links(db,
+                  "INSERT OR IGNORE INTO import_sessions (import_id, session_id) SELECT ?1, "
+                  "session_id FROM import_sessions WHERE import_id = ?2");
+        links.i(1, id).i(2, r.duplicate_of);
+        links.run();
+        return;
+      }
+      StoreSink sink(db, id, r.boat_id, gap_ns, in, progress);
+      const ParseResult pr = parse_log(*format, in, req.options, sink);
+      if (pr.status == ParseStatus::kError) throw ParseFailure(pr.message);
+      if (pr.status == ParseStatus::kPartial) r.partial = pr.message;
+      r.points = pr.points;
+      r.events = pr.events;
+      r.skipped = pr.skipped;
+      r.samples_added = sink.samples_added;
+      r.fixes_added = sink.fixes_added;
+      r.start_ns = sink.start_ns;
+      r.end_ns = sink.end_ns;
+      r.device = sink.device_name;
+      r.sessions = sink.sessions();
+    });
+    if (r.duplicate_of != 0) {
+      if (auto first = get(r.duplicate_of)) r.sessions = first->sessions;
+    }
+    r.state = "done";
+  } catch (const ParseFailure& e) {
+    r.state = "failed";
+    r.error = std::string(r.format.empty() ? "" : r.format + ": ") + e.what();
+  } catch (const std::exception& e) {
+    r.state = "failed";
+    r.error = e.what();
+  }
+  r.bytes_read = r.bytes;
+  if (progress) progress(r.bytes);
+  finish(r);
+  return r;
+}
+
+std::optional<ImportRecord> ImportStore::get(std::int64_t id) {
+  std::optional<ImportRecord> out;
+  store_.read([&](sqlite3* db) {
+    Sql q(db,
+          "SELECT boat_id, state, format, device, file_name, sha256, bytes, points, samples_added, "
+          "fixes_added, events, skipped, start_ns, end_ns, error, partial, duplicate_of "
+          "FROM imports WHERE id = ?1");
+    q.i(1, id);
+    if (!q.step()) return;
+    ImportRecord r;
+    r.id = id;
+    r.boat_id = q.col_s(0);
+    r.state = q.col_s(1);
+    r.format = q.col_s(2);
+    r.device = q.col_s(3);
+    r.file_name = q.col_s(4);
+    r.sha256 = q.col_s(5);
+    r.bytes = q.col_u(6);
+    r.bytes_read = r.state == "running" ? 0 : r.bytes;
+    r.points = q.col_u(7);
+    r.samples_added = q.col_u(8);
+    r.fixes_added = q.col_u(9);
+    r.events = q.col_u(10);
+    r.skipped = q.col_u(11);
+    r.start_ns = q.col_u(12);
+    r.end_ns = q.col_u(13);
+    r.error = q.col_s(14);
+    r.partial = q.col_s(15);
+    r.duplicate_of = q.col_i(16);
+    Sql s(db, "SELECT session_id FROM import_sessions WHERE import_id = ?1 ORDER BY session_id");
+    s.i(1, id);
+    while (s.step()) r.sessions.push_back(s.col_i(0));
+    out = std::move(r);
+  });
+  return out;
+}
+
+}  // namespace telltale::shore::import
