@@ -1,15 +1,19 @@
 #include "http_api.hpp"
 #include "track_routes.hpp"
 #include "manoeuvre_routes.hpp"
+#include "import_routes.hpp"
 
 #include <httplib.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <thread>
+#include <unistd.h>
 
 #include "http_guard.hpp"
 #include "json_views.hpp"
@@ -51,6 +55,7 @@ struct HttpApi::Impl {
   GuardedServer server;
   std::atomic<bool> stop_requested{false};
   std::atomic<bool> served{false};  ///< serve() has returned
+  std::unique_ptr<import::ImportService> imports;
 
   Impl(HttpConfig c, ShoreContext context)
       : config(std::move(c)), ctx(context), server(guard_limits(config)) {}
@@ -78,7 +83,7 @@ struct HttpApi::Impl {
     server.set_keep_alive_max_count(10000);
     server.set_read_timeout(5, 0);
     server.set_write_timeout(5, 0);
-    server.set_payload_max_length(config.max_body_bytes);
+    server.set_payload_max_length(std::max(config.max_body_bytes, config.max_import_bytes));
 
     server.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
       // Bodies: a length we accept, said up front; nothing else is read. Refused at once, and the
@@ -97,11 +102,14 @@ struct HttpApi::Impl {
           json_error(res, 400, "Content-Length must be a whole number of bytes");
           return httplib::Server::HandlerResponse::Handled;
         }
-        if (static_cast<std::uint64_t>(*n) > config.max_body_bytes) {
+        // An imported log may be larger than any other body (it is spooled to disk).
+        const std::size_t limit = req.method == "POST" && req.path == "/api/v1/imports"
+                                      ? config.max_import_bytes
+                                      : config.max_body_bytes;
+        if (static_cast<std::uint64_t>(*n) > limit) {
           GuardedServer::close_after_response();
           json_error(res, 413,
-                     "request body too large (at most " + std::to_string(config.max_body_bytes) +
-                         " bytes)");
+                     "request body too large (at most " + std::to_string(limit) + " bytes)");
           return httplib::Server::HandlerResponse::Handled;
         }
       }
@@ -258,6 +266,16 @@ struct HttpApi::Impl {
     register_rest_routes(server, ctx);
     register_track_routes(server, ctx);
     register_manoeuvre_routes(server, ctx);
+    const std::filesystem::path spool =
+        config.import_spool_dir.empty()
+            ? std::filesystem::temp_directory_path() /
+                  ("telltale-imports-" + std::to_string(::getpid()))
+            : std::filesystem::path(config.import_spool_dir);
+    imports = std::make_unique<import::ImportService>(
+        ctx.store, spool, [this](const import::ImportRecord& r) {
+          ctx.hub.publish_event("import", to_json_text(import_json(r)), r.boat_id);
+        });
+    register_import_routes(server, ctx, *imports, config.max_import_bytes);
     if (!config.web_dir.empty() && !server.set_mount_point("/", config.web_dir))
       throw std::runtime_error("web directory not found: " + config.web_dir);
   }

@@ -27,6 +27,10 @@ struct HttpConfig {
   std::size_t max_stream_clients = 64;
   std::size_t rest_threads = 8;  ///< workers beyond the ones the streams may hold
   std::size_t max_body_bytes = 1 << 20;
+  /// Largest file POST /api/v1/imports takes (every other route keeps max_body_bytes).
+  std::size_t max_import_bytes = std::size_t{256} << 20;
+  /// Where uploads wait for their import; empty: a folder in the system's temporary directory.
+  std::string import_spool_dir;
   /// Pool threads beyond streams and REST workers: idle keep-alive and slow connections may hold
   /// these before the server tightens its limits (http_guard.hpp).
   std::size_t spare_threads = 32;

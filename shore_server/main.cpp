@@ -287,6 +287,10 @@ int main(int argc, char** argv) {
   app.add_option("--web-dir", o.http.web_dir, "dashboard files")->capture_default_str();
   app.add_option("--max-streams", o.http.max_stream_clients, "live-stream clients at most")
       ->capture_default_str();
+  app.add_option_function<std::size_t>(
+         "--max-import-mb", [&o](std::size_t mb) { o.http.max_import_bytes = mb << 20; },
+         "largest log file POST /api/v1/imports takes, MB (default 256)")
+      ->check(CLI::Range(1, 65536));
   app.add_option("--rest-threads", o.http.rest_threads, "HTTP workers besides the streams")
       ->capture_default_str();
   app.add_option("--stream-interval-ms", o.stream_interval_ms,

@@ -314,6 +314,14 @@ std::int64_t ImportStore::begin(const std::string& boat_id, const std::string& f
   return id;
 }
 
+void ImportStore::fail_unfinished() {
+  store_.write_transaction([](sqlite3* db) {
+    exec(db,
+         "UPDATE imports SET state = 'failed', error = 'the shore stopped before the import "
+         "finished: nothing of it was stored; upload the file again' WHERE state = 'running'");
+  });
+}
+
 void ImportStore::finish(const ImportRecord& r) {
   store_.write_transaction([&](sqlite3* db) {
     Sql up(db,

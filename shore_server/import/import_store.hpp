@@ -72,6 +72,8 @@ class ImportStore {
   /// read. Returns the finished record (done or failed); never throws for bad content.
   ImportRecord run(std::int64_t id, const ImportRequest& request,
                    const std::function<void(std::uint64_t)>& progress = {});
+  /// Marks imports still running (a shore stopped in the middle) as failed.
+  void fail_unfinished();
   /// An import as recorded; nullopt if there is no such id.
   [[nodiscard]] std::optional<ImportRecord> get(std::int64_t id);
 

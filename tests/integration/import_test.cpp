@@ -1,0 +1,179 @@
+// Imports over real HTTP against a real shore_server: upload, progress and result, the sessions
+// listed, exported and read back as GPX, re-import as a no-op, a cut file storing nothing, the
+// roles, the limits and the live stream's import events.
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <thread>
+
+#include "shore_fixture.hpp"
+
+namespace telltale::testing {
+namespace {
+
+constexpr const char* kAnalyst = "import-analyst";
+constexpr const char* kAthlete = "import-athlete";
+constexpr long kT0s = 1795300000;
+
+/// An Atlas CSV (UTC offset +01:00) of `n` rows at 2 Hz.
+std::string atlas_csv(std::size_t n) {
+  std::string out = "timestamp,latitude,longitude,sog_kts,cog,hdg_true,heel,trim\r\n";
+  char line[160];
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::time_t secs = kT0s + 3600 + static_cast<std::time_t>(i / 2);
+    std::tm tm{};
+    gmtime_r(&secs, &tm);
+    std::snprintf(line, sizeof line,
+                  "%04d-%02d-%02dT%02d:%02d:%02d.%03d+01:00,%.7f,%.7f,5.0,45.0,47.0,%.1f,6.0\r\n",
+                  tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec,
+                  i % 2 ? 500 : 0, 39.5 + 1e-6 * static_cast<double>(i),
+                  2.5 + 1e-6 * static_cast<double>(i), 10.0 * std::sin(0.05 * static_cast<double>(i)));
+    out += line;
+  }
+  return out;
+}
+
+class ImportTest : public ShoreFixture {
+ protected:
+  std::vector<std::string> shore_flags() const override {
+    return {"--analyst-token", kAnalyst, "--athlete-token", std::string("ILCA-9:") + kAthlete,
+            "--max-import-mb", "1"};
+  }
+  httplib::Result upload(const std::string& query, const std::string& body,
+                         const std::string& token = kCoachToken) const {
+    auto c = client();
+    return c.Post("/api/v1/imports?" + query, bearer(token), body, "application/octet-stream");
+  }
+  /// Waits for the import to finish; its last state.
+  nlohmann::json finished(std::int64_t id) const {
+    nlohmann::json j;
+    eventually(
+        [&] {
+          j = get_json("/api/v1/imports/" + std::to_string(id));
+          return j.is_object() && j["state"] != "running";
+        },
+        std::chrono::seconds(20));
+    return j;
+  }
+};
+
+TEST_F(ImportTest, AtlasCsvBecomesAReviewableSessionAndReimportChangesNothing) {
+  // The live stream, to see the import's events.
+  std::atomic<bool> saw_running{false}, saw_done{false}, stop{false};
+  std::thread stream([&] {
+    httplib::Client c("127.0.0.1", port_);
+    c.set_read_timeout(30);
+    std::string buf;
+    c.Get("/api/v1/stream", bearer(), [&](const char* data, std::size_t n) {
+      buf.append(data, n);
+      if (buf.find("event: import") != std::string::npos) {
+        if (buf.find("\"state\":\"running\"") != std::string::npos) saw_running = true;
+        if (buf.find("\"state\":\"done\"") != std::string::npos) saw_done = true;
+      }
+      return !stop.load();
+    });
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+
+  const std::string csv = atlas_csv(1200);  // 10 minutes
+  auto res = upload("boat=ILCA-7&name=race1.csv", csv, kAnalyst);
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 202) << res->body;
+  const auto id = nlohmann::json::parse(res->body)["id"].get<std::int64_t>();
+  EXPECT_EQ(res->get_header_value("Location"), "/api/v1/imports/" + std::to_string(id));
+  const auto done = finished(id);
+  ASSERT_EQ(done["state"], "done") << done.dump();
+  EXPECT_EQ(done["format"], "vakaros_csv");
+  EXPECT_EQ(done["file_name"], "race1.csv");
+  EXPECT_EQ(done["points"], 1200);
+  EXPECT_EQ(done["samples_added"], 1200);
+  EXPECT_EQ(done["bytes_read"], csv.size());
+  ASSERT_EQ(done["sessions"].size(), 1u);
+  const auto session = done["sessions"][0].get<std::int64_t>();
+
+  const auto sessions = get_json("/api/v1/sessions?boat=ILCA-7");
+  ASSERT_TRUE(sessions.is_array());
+  ASSERT_EQ(sessions.size(), 1u);
+  EXPECT_EQ(sessions[0]["id"], session);
+  auto c = client();
+  auto exported = c.Get("/api/v1/sessions/" + std::to_string(session) + "/export?format=csv", bearer());
+  ASSERT_TRUE(exported);
+  ASSERT_EQ(exported->status, 200);
+  EXPECT_EQ(std::count(exported->body.begin(), exported->body.end(), '\n'), 1201);
+  auto gpx = c.Get("/api/v1/sessions/" + std::to_string(session) + "/gpx", bearer());
+  ASSERT_TRUE(gpx);
+  EXPECT_EQ(gpx->status, 200);
+  EXPECT_NE(gpx->body.find("<trkpt"), std::string::npos);
+
+  // The same file again: nothing new, the same session.
+  res = upload("boat=ILCA-7&name=copy.csv", csv);
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 202);
+  const auto again = finished(nlohmann::json::parse(res->body)["id"].get<std::int64_t>());
+  EXPECT_EQ(again["state"], "done");
+  EXPECT_EQ(again["duplicate_of"], id);
+  EXPECT_EQ(again["samples_added"], 0);
+  EXPECT_EQ(again["sessions"], done["sessions"]);
+  EXPECT_EQ(get_json("/api/v1/sessions?boat=ILCA-7").size(), 1u);
+
+  EXPECT_TRUE(eventually([&] { return saw_running.load() && saw_done.load(); },
+                         std::chrono::seconds(5)));
+  stop = true;
+  shore_.reset();  // ends the stream
+  stream.join();
+}
+
+TEST_F(ImportTest, CutFileFailsNamingTheLineAndStoresNothing) {
+  std::string csv = atlas_csv(100);
+  csv.resize(csv.size() - 20);
+  auto res = upload("boat=ILCA-8", csv);
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 202);
+  const auto r = finished(nlohmann::json::parse(res->body)["id"].get<std::int64_t>());
+  EXPECT_EQ(r["state"], "failed");
+  EXPECT_NE(r["error"].get<std::string>().find("line 101"), std::string::npos) << r.dump();
+  EXPECT_EQ(get_json("/api/v1/sessions?boat=ILCA-8").size(), 0u);
+}
+
+TEST_F(ImportTest, RolesParametersAndLimits) {
+  const std::string csv = atlas_csv(10);
+  auto res = upload("boat=ILCA-9", csv, kAthlete);
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 403);
+  auto c = client();
+  res = c.Post("/api/v1/imports?boat=ILCA-9", csv, "text/csv");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 401);
+  for (const std::string q : {"", "boat=bad%20id", "boat=B&format=fit", "boat=B&tz=Europe/Paris",
+                              "boat=B&heel_offset=x", "boat=B&pitch_offset=99", "boat=B&color=red"}) {
+    res = upload(q, csv);
+    ASSERT_TRUE(res);
+    EXPECT_EQ(res->status, 400) << q << ": " << res->body;
+    EXPECT_NE(res->body.find("\"error\""), std::string::npos);
+  }
+  res = upload("boat=B", "");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 400);
+  res = upload("boat=B", std::string((1 << 20) + 1, 'x'));
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 413);
+  // The old Atlas dialect with the time zone given; a forced format.
+  const std::string old =
+      "timestamp,latitude,longitude,sog_kts,cog,hdg_true,roll,pitch\n"
+      "2026-11-22T11:00:00.000,41.73877,12.24574,3.0,113.1,125.4,-1.7,4.6\n";
+  res = upload("boat=B&tz=%2B01:00&format=vakaros_csv&pitch_offset=6", old);
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 202) << res->body;
+  const auto r = finished(nlohmann::json::parse(res->body)["id"].get<std::int64_t>());
+  EXPECT_EQ(r["state"], "done") << r.dump();
+  EXPECT_EQ(r["start"], "2026-11-22T10:00:00.000Z");
+  // Athletes see their own boat's imports only.
+  auto mine = c.Get("/api/v1/imports/" + std::to_string(r["id"].get<int>()), bearer(kAthlete));
+  ASSERT_TRUE(mine);
+  EXPECT_EQ(mine->status, 403);
+  EXPECT_EQ(c.Get("/api/v1/imports/999", bearer())->status, 404);
+}
+
+}  // namespace
+}  // namespace telltale::testing
