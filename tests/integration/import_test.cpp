@@ -4,7 +4,10 @@
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <csignal>
 #include <ctime>
+#include <filesystem>
+#include <fstream>
 #include <thread>
 
 #include "shore_fixture.hpp"
@@ -173,6 +176,32 @@ TEST_F(ImportTest, RolesParametersAndLimits) {
   ASSERT_TRUE(mine);
   EXPECT_EQ(mine->status, 403);
   EXPECT_EQ(c.Get("/api/v1/imports/999", bearer())->status, 404);
+}
+
+TEST_F(ImportTest, CommandLineUploaderImportsAFolder) {
+  const std::string folder = dir_ + "/logs";
+  std::filesystem::create_directories(folder + "/day2");
+  std::string cut = atlas_csv(30);
+  cut.resize(cut.size() - 20);
+  std::ofstream(folder + "/a_good.csv", std::ios::binary) << atlas_csv(40);
+  std::ofstream(folder + "/day2/b_cut.csv", std::ios::binary) << cut;
+  Process cli({bin_dir() + "/telltale_import", folder, "--shore",
+               "http://127.0.0.1:" + std::to_string(port_), "--boat", "ILCA-3"},
+              {std::string("TELLTALE_TOKEN=") + kCoachToken});
+  ASSERT_TRUE(cli.wait_for_line("2 files, 1 imported, 1 failed", std::chrono::seconds(30)))
+      << cli.output();
+  EXPECT_TRUE(eventually([&] { return !cli.running(); }, std::chrono::seconds(10)));
+  EXPECT_EQ(cli.stop(SIGTERM), 1);
+  EXPECT_NE(cli.output().find("a_good.csv: done, vakaros_csv, 40 points, sessions "),
+            std::string::npos)
+      << cli.output();
+  EXPECT_NE(cli.output().find("b_cut.csv: failed: vakaros_csv: line 31"), std::string::npos)
+      << cli.output();
+  EXPECT_EQ(get_json("/api/v1/sessions?boat=ILCA-3").size(), 1u);
+  // No token: one line, a non-zero exit.
+  Process none({bin_dir() + "/telltale_import", folder, "--boat", "ILCA-3"});
+  EXPECT_TRUE(eventually([&] { return !none.running(); }, std::chrono::seconds(10)));
+  EXPECT_EQ(none.stop(SIGTERM), 2);
 }
 
 }  // namespace
