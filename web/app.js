@@ -4,11 +4,13 @@
 //   #/boat/ID          one boat: live charts, alarms, alarm rules editor (coach)
 //   #/review?boat=ID&session=N&vs=M   session review, overlay, export
 //   #/wearables        athletes: steps, cadence, gait, pose, dead-reckoned track
+//   #/import           log files from other instruments, dropped or picked, uploaded with progress
 // Login: open the page at /#token=TOKEN once; the token is exchanged for an HttpOnly cookie and
 // removed from the address bar.
 import { api, has, loadCapabilities } from './js/api.js';
 import { mountBoat } from './js/boat.js';
 import { mountFleet } from './js/fleet.js';
+import { mountImport } from './js/import.js';
 import { mountMap } from './js/map.js';
 import { Live } from './js/live.js';
 import { mountReview } from './js/review.js';
@@ -23,7 +25,8 @@ const live = new Live();
 let role = sessionStorage.getItem('telltale.role') ?? 'unknown';
 let unmount = () => {};
 
-const ROUTES = { fleet: mountFleet, map: mountMap, boat: mountBoat, review: mountReview, wearables: mountWearables };
+const ROUTES = { fleet: mountFleet, map: mountMap, boat: mountBoat, review: mountReview, wearables: mountWearables,
+  import: mountImport };
 
 function showMessage(text) {
   message.textContent = text;

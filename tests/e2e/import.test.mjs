@@ -1,0 +1,74 @@
+// Import view: log files dropped on the dashboard are uploaded with a progress bar, imported by
+// the shore, and open as sessions in review; a cut file shows its error.
+import assert from 'node:assert/strict';
+import { after, before, test } from 'node:test';
+import { domainFor, eventually, login, screenshots, startBrowser, startFleet } from './harness.mjs';
+
+let fleet;
+let browser;
+let page;
+
+before(async () => {
+  fleet = await startFleet({ domain: domainFor(5) });
+  browser = await startBrowser();
+  page = await browser.page();
+});
+
+after(async () => {
+  await browser?.close();
+  await fleet?.stop();
+});
+
+// An Atlas CSV (UTC offset +01:00) of `n` rows at 2 Hz, heeling to and fro, tacking once.
+function atlasCsv(n, t0 = Date.UTC(2026, 10, 22, 10, 0, 0)) {
+  const rows = ['timestamp,latitude,longitude,sog_kts,cog,hdg_true,heel,trim'];
+  for (let i = 0; i < n; i++) {
+    const local = new Date(t0 + i * 500 + 3600e3).toISOString().replace('Z', '+01:00');
+    const cog = i < n / 2 ? 45 : 315;
+    const a = (Math.min(i, n / 2) * 1.5e-5) / Math.SQRT2; // along the first leg, then the second
+    const b = (Math.max(0, i - n / 2) * 1.5e-5) / Math.SQRT2;
+    rows.push([local, (39.5 + a + b).toFixed(7), (2.5 + a - b).toFixed(7), '6.0',
+      cog, cog + 2, (12 * Math.sin(i / 40) * (i < n / 2 ? 1 : -1)).toFixed(1), '6.0'].join(','));
+  }
+  return `${rows.join('\r\n')}\r\n`;
+}
+
+async function drop(files) {
+  const dt = await page.evaluateHandle((list) => {
+    const d = new DataTransfer();
+    for (const f of list) d.items.add(new File([f.text], f.name, { type: 'text/csv' }));
+    return d;
+  }, files);
+  await page.dispatchEvent('.drop-zone', 'dragenter', { dataTransfer: dt });
+  await page.dispatchEvent('.drop-zone', 'drop', { dataTransfer: dt });
+}
+
+test('import view: dropped files upload with progress and open in review', async () => {
+  await login(page, fleet, '#/import');
+  await page.waitForSelector('.drop-zone');
+  await page.fill('#import-boat', 'ILCA-4');
+  await page.fill('#import-pitch', '6');
+  const csv = atlasCsv(2400); // 20 minutes
+  const cut = atlasCsv(50).slice(0, -25);
+  await drop([{ name: 'race1.csv', text: csv }, { name: 'cut.csv', text: cut }]);
+  const row = (name) => page.locator('.import-item', { has: page.locator('.import-name', { hasText: name }) });
+  await eventually(async () => (await row('race1.csv').getAttribute('data-state')) === 'done',
+    { timeoutMs: 15000, what: 'race1.csv imported' });
+  await eventually(async () => (await row('cut.csv').getAttribute('data-state')) === 'failed',
+    { timeoutMs: 15000, what: 'cut.csv refused' });
+  assert.match(await row('race1.csv').locator('.import-status').textContent(), /vakaros_csv, 2400 points/);
+  assert.match(await row('cut.csv').locator('.import-status').textContent(), /line 51/);
+  assert.equal(Number(await row('race1.csv').locator('progress').getAttribute('value')), 1);
+  await screenshots(page, 'import');
+
+  // The same as the shore says, and the session reviews like a live one.
+  const sessions = await fleet.json('/sessions?boat=ILCA-4');
+  assert.equal(sessions.length, 1);
+  assert.equal(sessions[0].samples, 2400);
+  await row('race1.csv').locator('a').first().click();
+  await page.waitForSelector('[data-view="review"]');
+  await eventually(async () => (await page.locator('.review-body').count()) > 0, { timeoutMs: 10000, what: 'review' });
+  await page.waitForTimeout(1500);
+  await screenshots(page, 'import-review');
+  assert.deepEqual(browser.problems, []);
+});
