@@ -56,7 +56,8 @@ void register_import_routes(httplib::Server& server, ShoreContext& ctx,
                                      const httplib::ContentReader& content) {
     const Principal p = who(ctx, req);
     if (p.role == Role::kAthlete) throw HttpError(403, "only a coach or an analyst may import");
-    allow_params(req, {"boat", "format", "tz", "heel_offset", "pitch_offset", "declination", "name"});
+    allow_params(req, {"boat", "format", "tz", "heel_offset", "pitch_offset", "declination", "date",
+                       "name"});
     import::ImportRequest r;
     const std::string* boat = param(req, "boat");
     if (!boat) throw HttpError(400, "boat is required: the boat the file belongs to");
@@ -72,6 +73,12 @@ void register_import_routes(httplib::Server& server, ShoreContext& ctx,
         throw HttpError(400,
                         "tz must be a UTC offset such as +01:00, -0700 or UTC (zone names are not "
                         "read yet)");
+    }
+    if (const std::string* d = param(req, "date")) {
+      bool zone = false;
+      const auto t = import::parse_iso_time(*d + "T00:00:00Z", std::nullopt, &zone);
+      if (d->size() != 10 || !t) throw HttpError(400, "date must be YYYY-MM-DD");
+      r.options.date_days = static_cast<std::int64_t>(*t / 86'400'000'000'000ULL);
     }
     r.options.heel_offset_deg = angle_param(req, "heel_offset", 45.0);
     r.options.pitch_offset_deg = angle_param(req, "pitch_offset", 45.0);

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// POST /api/v1/imports?boat=ID[&format=NAME][&tz=OFFSET][&heel_offset=DEG][&pitch_offset=DEG]
-/// [&declination=DEG][&name=FILE] with the file as the body (coach and analyst; streamed to the
+/// [&declination=DEG][&date=YYYY-MM-DD][&name=FILE] with the file as the body (coach and analyst; streamed to the
 /// spool folder, at most HttpConfig::max_import_bytes): 202 {"id": N, "state": "running"}.
 /// GET /api/v1/imports/{id}: state (running | done | failed), bytes read of bytes, format,
 /// device, sessions, points, samples and fixes added, events, error, partial reason,

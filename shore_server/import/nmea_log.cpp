@@ -85,7 +85,7 @@ bool split_line(std::string_view line, std::string_view& prefix, std::string_vie
 class Epochs {
  public:
   Epochs(const ImportOptions& options, ImportSink& sink, ParseResult& r)
-      : options_(options), sink_(sink), r_(r) {}
+      : options_(options), sink_(sink), r_(r), days_(options.date_days.value_or(-1)) {}
 
   void line_time(std::uint64_t t_ns) {
     if (t_ns != 0) line_ns_ = t_ns;
@@ -152,7 +152,7 @@ class Epochs {
   const ImportOptions& options_;
   ImportSink& sink_;
   ParseResult& r_;
-  std::int64_t days_ = -1;
+  std::int64_t days_;
   std::uint64_t line_ns_ = 0;
   bool open_ = false;
   double tod_ = 0.0;
@@ -296,7 +296,7 @@ ParseResult parse_nmea_log(std::istream& in, const ImportOptions& options, Impor
   if (r.points == 0) {
     r.status = ParseStatus::kError;
     r.message = "no position with a date in " + std::to_string(lines) +
-                " lines (an NMEA log needs RMC or ZDA, or a time stamp per line)";
+                " lines (an NMEA log needs RMC or ZDA dates, a time stamp per line, or the date given)";
   }
   return r;
 }

@@ -8,7 +8,8 @@
 ///
 /// - Position and time: RMC (date), GGA, GLL, GNS; ZDA gives the date too. The sentences of one
 ///   receiver epoch (one time of day) make one point; its date comes from RMC/ZDA, else from the
-///   line's time stamp. Points before any date is known are skipped (counted).
+///   line's time stamp, else from ImportOptions::date_days. Points before any date is known are
+///   skipped (counted).
 /// - Speed and course: RMC, VTG. Heading: HDT, HDG (true when it states the variation), HDM
 ///   (magnetic: made true with ImportOptions::declination_deg, else left out).
 /// - Heel and pitch: XDR angle transducers named ROLL or HEEL (+ starboard down) and PTCH, PITCH

@@ -45,6 +45,9 @@ struct ImportOptions {
   double pitch_offset_deg = 0.0;  ///< subtracted from every pitch (Atlas trim reads ~+6 at rest)
   /// East positive; used for magnetic headings when the file states no declination. NaN: none.
   double declination_deg = kNaN;
+  /// The UTC date (days since 1970) of an NMEA log that states none (no RMC or ZDA date and no
+  /// time stamps): its times of day are taken on that date. nullopt: such a log is refused.
+  std::optional<std::int64_t> date_days;
 };
 
 /// Receives what a parser reads, in file order.

@@ -30,6 +30,7 @@ struct Options {
   std::string boat;
   std::string format;
   std::string tz;
+  std::string date;
   double heel_offset = 0.0, pitch_offset = 0.0, declination = 0.0;
   bool has_declination = false;
   int timeout_s = 600;
@@ -67,6 +68,7 @@ std::string query(const Options& o, const std::string& name) {
   httplib::Params p{{"boat", o.boat}, {"name", name}};
   if (!o.format.empty()) p.emplace("format", o.format);
   if (!o.tz.empty()) p.emplace("tz", o.tz);
+  if (!o.date.empty()) p.emplace("date", o.date);
   if (o.heel_offset != 0.0) p.emplace("heel_offset", std::to_string(o.heel_offset));
   if (o.pitch_offset != 0.0) p.emplace("pitch_offset", std::to_string(o.pitch_offset));
   if (o.has_declination) p.emplace("declination", std::to_string(o.declination));
@@ -168,6 +170,7 @@ int main(int argc, char** argv) {
   app.add_option("--format", o.format, "force the format instead of reading it from the content")
       ->check(CLI::IsMember({"vakaros_csv", "vkx", "vtk", "nmea", "gpx"}));
   app.add_option("--tz", o.tz, "UTC offset of local times without one (+01:00, -0700, UTC)");
+  app.add_option("--date", o.date, "UTC date (YYYY-MM-DD) of NMEA logs that state none");
   app.add_option("--heel-offset", o.heel_offset, "degrees subtracted from every heel")
       ->check(CLI::Range(-45.0, 45.0));
   app.add_option("--pitch-offset", o.pitch_offset, "degrees subtracted from every pitch")

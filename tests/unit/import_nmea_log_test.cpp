@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 
 #include "import_support.hpp"
 
@@ -87,6 +89,35 @@ TEST(ImportNmeaLog, MidnightRollsTheDateOver) {
   ASSERT_EQ(run(Format::kNmea, log, sink).status, ParseStatus::kOk);
   ASSERT_EQ(sink.points.size(), 2u);
   EXPECT_EQ(sink.points[1].t_utc_ns - sink.points[0].t_utc_ns, 1000000000ULL);
+}
+
+TEST(ImportNmeaLog, RealSignalKSampleLog) {
+  // A real yacht's instruments (tests/data/signalk_plaka/README.md): GLL positions, VTG, wind,
+  // depth, empty heading sentences, ZDA without a date.
+  std::ifstream f(std::string(TELLTALE_TEST_DATA_DIR) + "/signalk_plaka/plaka_head.log");
+  ASSERT_TRUE(f);
+  std::stringstream bytes;
+  bytes << f.rdbuf();
+  Collect refused;
+  const auto no_date = run(Format::kNmea, bytes.str(), refused);
+  EXPECT_EQ(no_date.status, ParseStatus::kError);
+  EXPECT_NE(no_date.message.find("or the date given"), std::string::npos) << no_date.message;
+
+  ImportOptions o;
+  o.date_days = *days_from_civil(2014, 8, 15);
+  Collect sink;
+  const auto r = run(Format::kNmea, bytes.str(), sink, o);
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.message;
+  ASSERT_EQ(sink.points.size(), 4u);  // 09:55:59, 09:56:01, :03, :05 (the ZDA/GLL epochs)
+  const std::uint64_t t0 = 1408096559ULL * 1000000000ULL;  // 2014-08-15T09:55:59Z
+  for (std::size_t i = 0; i < 4; ++i)
+    EXPECT_EQ(sink.points[i].t_utc_ns, t0 + 2 * i * 1000000000ULL);
+  EXPECT_NEAR(sink.points[0].lat_deg, 60.0 + 5.071 / 60.0, 1e-9);
+  EXPECT_NEAR(sink.points[0].lon_deg, 23.0 + 32.346 / 60.0, 1e-9);
+  EXPECT_NEAR(sink.points[0].sog_m_s, 5.80 * 1852.0 / 3600.0, 1e-9);  // the VTG after it
+  EXPECT_DOUBLE_EQ(sink.points[0].cog_deg, 225.18);
+  EXPECT_TRUE(std::isnan(sink.points[0].heading_deg));  // the log's HDT and HDM are empty
+  EXPECT_GT(r.skipped, 20u);  // VHW, VPW, VWT, DBT, XTE, GSV, ... are not ours
 }
 
 }  // namespace
