@@ -440,10 +440,12 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       const auto& diag = filter.diagnostics();
       if (diag.rejected_non_finite) h |= telltale::msg::SENSOR_NON_FINITE;
       if (diag.gyro_saturated || diag.acc_saturated) h |= telltale::msg::SENSOR_SATURATED;
-      // The log's trouble first: it is what loses data for good (the text is cut at 128).
+      // The log's trouble first: it is what loses data for good (the text is cut at 128). The
+      // bit is what the shore's dashboard shows as a badge; the text says how much is at risk.
       const auto log_health = log.health();
+      if (log_health.failing()) h |= telltale::msg::SENSOR_LOG_FAILING;
       std::string text;
-      if (log_health.pending_records > 0 || log_health.dropped_records > 0) {
+      if (log_health.failing()) {
         text = "SESSION LOG FAILING (" + log_health.last_error +
                "): " + std::to_string(log_health.pending_records) + " held in memory";
         if (log_health.dropped_records > 0)

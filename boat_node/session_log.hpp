@@ -57,10 +57,14 @@ struct SessionLogConfig {
 
 /// What the log could not do (all zero/empty when every record is on disk).
 struct SessionLogHealth {
-  std::uint64_t pending_records = 0;  ///< appended, not on disk yet (writes failing)
+  std::uint64_t pending_records = 0;  ///< appended, not on disk yet (buffered, or held while
+                                      ///< writes fail)
   std::uint64_t dropped_records = 0;  ///< given up: beyond max_pending_bytes while failing
   std::uint64_t write_errors = 0;     ///< failed write attempts since start
   std::string last_error;             ///< of the latest failed write, empty once writes succeed
+  /// The latest write failed, or records were given up: what is held is at risk. Records merely
+  /// buffered between two flushes are not a failure.
+  [[nodiscard]] bool failing() const { return !last_error.empty() || dropped_records > 0; }
 };
 
 class SessionLog {

@@ -13,6 +13,15 @@ void evict_oldest(Map& m) {
     if (it->second.last_arrival < oldest->second.last_arrival) oldest = it;
   if (oldest != m.end()) m.erase(oldest);
 }
+
+/// A boat's view as a reader sees it at `now`: conditions that lapse with time (a fresh fix, a
+/// second node under the same id) are judged now, not at the last sample.
+BoatView as_seen_at(const BoatView& b, SteadyTime now) {
+  BoatView v = b;
+  v.fix_fresh = v.fix && now - v.fix_arrival < kFixFreshFor;
+  if (v.duplicate_id && now - v.duplicate_seen > kDuplicateClearAfter) v.duplicate_id = false;
+  return v;
+}
 }  // namespace
 
 BoatView FleetModel::update(const AttitudeSample& sample, SteadyTime arrival,
@@ -34,6 +43,16 @@ BoatView FleetModel::update(const AttitudeSample& sample, SteadyTime arrival,
     b.window_min_offset_ms = std::min(b.window_min_offset_ms, offset_ms);
     b.clock_offset_ms = std::min(b.clock_offset_ms, b.window_min_offset_ms);
   }
+  if (b.samples_received > 0 && sample.boot_id != b.last.boot_id) {
+    if (sample.boot_id == b.previous_boot_id && arrival - b.boot_switch < kDuplicateSwitchWindow) {
+      b.duplicate_id = true;
+      b.duplicate_boot_id = b.last.boot_id;
+      b.duplicate_seen = arrival;
+    }
+    b.previous_boot_id = b.last.boot_id;
+    b.boot_switch = arrival;
+  }
+  if (b.duplicate_id && arrival - b.duplicate_seen > kDuplicateClearAfter) b.duplicate_id = false;
   b.last = sample;
   b.last_arrival = arrival;
   b.arrival_utc_ns = arrival_utc_ns;
@@ -72,14 +91,6 @@ std::vector<BoatView> FleetModel::sweep(SteadyTime now) {
   return went_stale;
 }
 
-std::optional<BoatView> FleetModel::mark_stale(const std::string& boat_id) {
-  std::lock_guard lock(mutex_);
-  auto it = boats_.find(boat_id);
-  if (it == boats_.end() || it->second.stale) return std::nullopt;
-  it->second.stale = true;
-  return it->second;
-}
-
 std::optional<BoatView> FleetModel::set_alarm_state(const std::string& boat_id,
                                                     const std::string& state) {
   std::lock_guard lock(mutex_);
@@ -115,10 +126,7 @@ std::vector<BoatView> FleetModel::boats() const {
   std::vector<BoatView> out;
   out.reserve(boats_.size());
   const auto now = std::chrono::steady_clock::now();
-  for (const auto& [id, b] : boats_) {
-    out.push_back(b);
-    out.back().fix_fresh = b.fix && now - b.fix_arrival < kFixFreshFor;
-  }
+  for (const auto& [id, b] : boats_) out.push_back(as_seen_at(b, now));
   return out;
 }
 
@@ -126,9 +134,7 @@ std::optional<BoatView> FleetModel::boat(const std::string& boat_id) const {
   std::lock_guard lock(mutex_);
   auto it = boats_.find(boat_id);
   if (it == boats_.end()) return std::nullopt;
-  BoatView v = it->second;
-  v.fix_fresh = v.fix && std::chrono::steady_clock::now() - v.fix_arrival < kFixFreshFor;
-  return v;
+  return as_seen_at(it->second, std::chrono::steady_clock::now());
 }
 
 AthleteView FleetModel::update(const WearableSample& sample, SteadyTime arrival) {

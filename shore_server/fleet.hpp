@@ -93,7 +93,20 @@ struct BoatView {
   std::optional<FixSample> fix;  ///< the latest GNSS fix (any kind)
   SteadyTime fix_arrival{};
   bool fix_fresh = false;  ///< a fix came within kFixFreshFor (set by boats() / boat())
+  /// Two nodes publishing under this boat's id: live samples of two runs (boot ids) alternate.
+  /// A restart switches run once and never back; two nodes switch back within seconds, over and
+  /// over. Set on the first switch back within kDuplicateSwitchWindow, cleared once no switch
+  /// back has been seen for kDuplicateClearAfter (one node stopped or was renamed).
+  bool duplicate_id = false;
+  std::uint64_t duplicate_boot_id = 0;  ///< the other run seen under this id
+  std::uint64_t previous_boot_id = 0;   ///< the run before the latest switch
+  SteadyTime boot_switch{};             ///< when the run last switched
+  SteadyTime duplicate_seen{};          ///< the latest switch back
 };
+
+/// See BoatView::duplicate_id.
+inline constexpr std::chrono::seconds kDuplicateSwitchWindow{5};
+inline constexpr std::chrono::seconds kDuplicateClearAfter{10};
 
 /// One athlete's latest wearable motion, in wire units.
 struct WearableSample {
@@ -118,7 +131,7 @@ struct AthleteView {
 
 /// Most boats (and, apart, most athletes) the fleet model holds: a new one beyond this evicts the
 /// one silent the longest, so a publisher inventing ids cannot grow the shore without bound.
-inline constexpr std::size_t kMaxFleetEntries = 1000;
+inline constexpr std::size_t kMaxFleetEntries = 4096;
 
 /// A boat whose clock is off by more than this is flagged (clock_suspect in the API).
 inline constexpr double kClockSuspectMs = 100.0;
@@ -136,8 +149,6 @@ class FleetModel {
   std::optional<BoatView> update_fix(const FixSample& fix, SteadyTime arrival);
   /// Marks boats silent for longer than stale_after as stale; returns those that just went stale.
   std::vector<BoatView> sweep(SteadyTime now);
-  /// Forces a boat stale now (DDS deadline missed); its view if it just went stale.
-  std::optional<BoatView> mark_stale(const std::string& boat_id);
 
   /// Sets a boat's alarm state ("normal", "warn", "alarm"); its view if the boat is known.
   std::optional<BoatView> set_alarm_state(const std::string& boat_id, const std::string& state);

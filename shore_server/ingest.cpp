@@ -12,8 +12,8 @@ namespace telltale::shore {
 
 namespace {
 
-constexpr std::array<const char*, kRejectKinds> kRejectNames = {"none", "id", "time", "value",
-                                                                "text"};
+constexpr std::array<const char*, kRejectKinds> kRejectNames = {"none", "id",   "time",
+                                                                "value", "text", "reader_full"};
 constexpr std::array<const char*, kTopics> kTopicNames = {"attitude", "backfill", "status",
                                                           "wearable", "fix"};
 
@@ -206,13 +206,13 @@ Reject check(const std::string& node_id, const NodeStatusInfo& s, std::uint64_t 
   return Reject::kNone;
 }
 
-void IngestCounters::count(Topic topic, Reject reason) {
+void IngestCounters::count(Topic topic, Reject reason, std::uint64_t n) {
   const auto t = static_cast<std::size_t>(topic);
   if (reason == Reject::kNone) {
-    accepted_[t].fetch_add(1, std::memory_order_relaxed);
+    accepted_[t].fetch_add(n, std::memory_order_relaxed);
     return;
   }
-  rejected_[t][static_cast<std::size_t>(reason)].fetch_add(1, std::memory_order_relaxed);
+  rejected_[t][static_cast<std::size_t>(reason)].fetch_add(n, std::memory_order_relaxed);
   std::lock_guard lock(last_mutex_);
   last_rejected_ = std::string(topic_name(topic)) + ": " + reject_name(reason);
 }

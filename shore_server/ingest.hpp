@@ -36,9 +36,11 @@ inline constexpr std::uint64_t kEarliestSampleNs = 946684800ULL * 1000000000ULL;
 /// A sample may be this far ahead of the shore's clock (boat clocks drift; a day is absurd).
 inline constexpr std::uint64_t kMaxAheadNs = 24ULL * 3600ULL * 1000000000ULL;
 
-/// Why a sample was refused.
-enum class Reject : std::uint8_t { kNone, kId, kTime, kValue, kText };
-inline constexpr std::size_t kRejectKinds = 5;
+/// Why a sample was refused. kReaderFull is counted once each time a DDS reader's table of ids
+/// (one instance per id) was found full and the reader replaced: Fast DDS drops a new id's samples
+/// before the door meanwhile, without telling how many (shore_dds.hpp).
+enum class Reject : std::uint8_t { kNone, kId, kTime, kValue, kText, kReaderFull };
+inline constexpr std::size_t kRejectKinds = 6;
 [[nodiscard]] const char* reject_name(Reject r);
 
 /// The topics the shore reads.
@@ -66,7 +68,7 @@ inline constexpr std::size_t kTopics = 5;
 /// What the door let in and kept out, per topic and reason.
 class IngestCounters {
  public:
-  void count(Topic topic, Reject reason);
+  void count(Topic topic, Reject reason, std::uint64_t n = 1);
   [[nodiscard]] std::uint64_t accepted(Topic topic) const;
   [[nodiscard]] std::uint64_t rejected(Topic topic, Reject reason) const;
   [[nodiscard]] std::uint64_t rejected_total() const;
@@ -103,6 +105,7 @@ class Ingest {
   Reject fix(const msg::BoatFix& m);
 
   [[nodiscard]] const IngestCounters& counters() const { return counters_; }
+  [[nodiscard]] IngestCounters& counters() { return counters_; }
 
  private:
   [[nodiscard]] std::uint64_t now() const;

@@ -5,6 +5,7 @@
 #include <set>
 
 #include "query.hpp"
+#include "telltale.h"
 
 namespace telltale::shore {
 
@@ -26,6 +27,41 @@ std::string to_json_text(const json& j) {
 }
 
 json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json boat_problems(const BoatView& v) {
+  json out = json::array();
+  const auto add = [&](const char* code, const std::string& text) {
+    out.push_back({{"code", code}, {"text", text}});
+  };
+  const std::uint32_t health = v.status ? v.status->sensor_health : 0;
+  // The log first: a boat whose log cannot write loses for good what the link drops meanwhile.
+  if (health & msg::SENSOR_LOG_FAILING) add("log_failing", v.status->health_text);
+  if (v.duplicate_id) {
+    add("duplicate_id", "two nodes publish as '" + v.last.boat_id + "' (runs " +
+                            std::to_string(v.last.boot_id) + " and " +
+                            std::to_string(v.duplicate_boot_id) +
+                            "): give each its own --boat-id; their samples share one session");
+  }
+  if (std::abs(v.clock_offset_ms) > kClockSuspectMs) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "boat clock %+.1f s from the shore's (no time fix?)",
+                  v.clock_offset_ms * 1e-3);
+    add("clock_suspect", buf);
+  }
+  static constexpr std::pair<std::uint32_t, const char*> kSensorBits[] = {
+      {msg::SENSOR_NO_DATA, "no IMU data"},
+      {msg::SENSOR_NON_FINITE, "NaN/Inf samples rejected"},
+      {msg::SENSOR_SATURATED, "IMU saturated"},
+      {msg::SENSOR_TIME_BACKWARDS, "IMU time went backwards"},
+      {msg::SENSOR_BAD_FRAMES, "garbage on a serial line"},
+      {msg::SENSOR_HEADING_DEGRADED, "a heading sensor excluded"},
+  };
+  std::string sensors;
+  for (const auto& [bit, text] : kSensorBits)
+    if (health & bit) sensors += (sensors.empty() ? "" : ", ") + std::string(text);
+  if (!sensors.empty()) add("sensor", sensors);
+  return out;
+}
 
 json boat_object(const BoatView& v) {
   const AttitudeSample& s = v.last;
@@ -77,6 +113,8 @@ json boat_object(const BoatView& v) {
                                             1e-6)
                                      : json(nullptr)}};
   }
+  j["duplicate_id"] = v.duplicate_id;
+  j["problems"] = boat_problems(v);
   if (v.status) {
     j["status"] = {{"software_version", v.status->software_version},
                    {"uptime_s", v.status->uptime_s},

@@ -24,6 +24,11 @@ namespace telltale::shore {
 /// A number, or null when it is not finite.
 [[nodiscard]] nlohmann::json finite_or_null(double v);
 
+/// What a coach should know is wrong with a boat, most serious first: `[{code, text}]` with
+/// code "log_failing" (its session log cannot write), "duplicate_id" (two nodes under one id),
+/// "clock_suspect" (its clock is off the shore's), "sensor" (the IMU's health flags). Empty when
+/// all is well. The dashboard shows each as a badge on the boat's card.
+[[nodiscard]] nlohmann::json boat_problems(const BoatView& view);
 [[nodiscard]] nlohmann::json boat_object(const BoatView& view);
 [[nodiscard]] std::string boat_json(const BoatView& view);
 [[nodiscard]] nlohmann::json rule_object(const AlarmRule& rule);

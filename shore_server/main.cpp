@@ -193,9 +193,6 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
   callbacks.on_status = [&](const std::string& id, const NodeStatusInfo& st) {
     fleet.update_status(id, st);
   };
-  callbacks.on_deadline_missed = [&](const std::string& id) {
-    if (auto v = fleet.mark_stale(id)) hub.publish_sample(id, boat_json(*v));
-  };
   ShoreDds dds(o.dds, callbacks);
   alarms.start({[&](const std::vector<AlarmRule>& rules) { dds.publish_rules(rules); },
                 [&](const AlarmEvent& e) { dds.publish_event(e); }});
@@ -219,7 +216,8 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
                 o.coach_token.c_str());
   std::fflush(stdout);
 
-  // Stale sweep: a boat silent for stale_ms is marked stale even if DDS never says so. Each boat
+  // Stale sweep: a boat silent for stale_ms is marked stale (the shore's own clock, no DDS
+  // deadline: Fast DDS pays for a deadline per instance on every sample). Each boat
   // gets its receipt (what is stored), from which it backfills what is missing: as soon as it
   // moves (a stopping boat waits for it), and every second anyway (receipts are best effort).
   int tick = 0;
@@ -243,6 +241,15 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
       std::set<std::pair<std::string, std::uint64_t>> live_runs;
       for (const auto& a : acks) live_runs.emplace(a.boat_id, a.boot_id);
       std::erase_if(receipt_sent, [&](const auto& e) { return !live_runs.count(e.first); });
+    }
+    try {
+      for (const auto& topic : dds.recycle_full_readers(std::chrono::seconds(10)))
+        std::fprintf(stderr,
+                     "shore_server: the %s reader's table of ids was full (a publisher inventing "
+                     "ids?): replaced, boats still sailing are back with their next sample\n",
+                     topic.c_str());
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "shore_server: cannot replace a full DDS reader: %s\n", e.what());
     }
     if (tick % 300 == 0) {  // every minute: boats and athletes silent for long leave the model
       for (const auto& id :

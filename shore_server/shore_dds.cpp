@@ -1,6 +1,8 @@
 #include "shore_dds.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <set>
 #include <cstdio>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 
@@ -37,49 +39,82 @@ class ShoreDds::Listener : public fdds::DataReaderListener {
   }
 
   void take_all(fdds::DataReader* reader) {
-    fdds::SampleInfo info;
     const std::string& topic = reader->get_topicdescription()->get_name();
     if (topic == dds::kTopicBoatAttitude || topic == dds::kTopicBoatBackfill) {
       const bool backfill = topic == dds::kTopicBoatBackfill;
-      msg::BoatAttitude m;
-      while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
-        if (accept(info, m.boat_id().to_string())) (void)ingest_.attitude(m, backfill);
-      }
+      take<msg::BoatAttitude>(reader, backfill ? Topic::kBackfill : Topic::kAttitude,
+                              [](const auto& m) { return m.boat_id().to_string(); },
+                              [&](const auto& m) { (void)ingest_.attitude(m, backfill); });
     } else if (topic == dds::kTopicWearableMotion) {
-      msg::WearableMotion m;
-      while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
-        if (accept(info, m.athlete_id().to_string())) (void)ingest_.wearable(m);
-      }
+      take<msg::WearableMotion>(reader, Topic::kWearable,
+                                [](const auto& m) { return m.athlete_id().to_string(); },
+                                [&](const auto& m) { (void)ingest_.wearable(m); });
     } else if (topic == dds::kTopicBoatFix) {
-      msg::BoatFix m;
-      while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
-        if (accept(info, m.boat_id().to_string())) (void)ingest_.fix(m);
-      }
+      take<msg::BoatFix>(reader, Topic::kFix, [](const auto& m) { return m.boat_id().to_string(); },
+                         [&](const auto& m) { (void)ingest_.fix(m); });
     } else if (topic == dds::kTopicNodeStatus) {
-      msg::NodeStatus m;
-      while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
-        if (accept(info, m.node_id().to_string())) (void)ingest_.status(m);
-      }
+      take<msg::NodeStatus>(reader, Topic::kStatus,
+                            [](const auto& m) { return m.node_id().to_string(); },
+                            [&](const auto& m) { (void)ingest_.status(m); });
     }
   }
 
-  void on_requested_deadline_missed(fdds::DataReader* reader,
-                                    const fdds::RequestedDeadlineMissedStatus& status) override {
-    if (reader->get_topicdescription()->get_name() != dds::kTopicBoatAttitude ||
-        !cb_.on_deadline_missed)
-      return;
-    msg::BoatAttitude key_holder;
-    if (reader->get_key_value(&key_holder, status.last_instance_handle) ==
-            ReturnCode_t::RETCODE_OK &&
-        contract_id(key_holder.boat_id().to_string()))
-      cb_.on_deadline_missed(key_holder.boat_id().to_string());
+  template <class Msg, class IdOf, class Sink>
+  void take(fdds::DataReader* reader, Topic t, IdOf id_of, Sink sink) {
+    Msg m;
+    fdds::SampleInfo info;
+    while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
+      note_instance(static_cast<std::size_t>(t), reader, info);
+      if (accept(info, id_of(m))) sink(m);
+    }
   }
+
+  // Fast DDS keeps one instance per id and frees it only once no writer holds it; a sample of a
+  // new id beyond the reader's max_instances is dropped before any listener sees it (Fast DDS
+  // 2.9 reports no rejection). So the shore counts the live ids each reader holds, from the
+  // instance handles of what it takes: once they fill the table, the next new boat would be
+  // refused without a word, and the reader is marked for replacement.
+  void note_instance(std::size_t t, fdds::DataReader* reader, const fdds::SampleInfo& info) {
+    InstanceTable& table = tables_[t];
+    std::array<std::uint8_t, 16> key{};
+    const std::uint8_t* handle = info.instance_handle.value;
+    std::copy(handle, handle + key.size(), key.begin());
+    std::lock_guard lock(table.mutex);
+    if (info.instance_state != fdds::ALIVE_INSTANCE_STATE) {
+      table.handles.erase(key);  // no writer holds it any more: Fast DDS may reuse its slot
+      return;
+    }
+    if (!table.handles.insert(key).second) return;
+    const auto limit = reader->get_qos().resource_limits().max_instances;
+    if (limit > 0 && table.handles.size() >= static_cast<std::size_t>(limit)) full_[t].store(true);
+  }
+
+  /// Takes the "reader full" mark of topic `t`, forgetting the ids counted for its reader (the
+  /// caller replaces it with an empty one), and counts it as "reader_full" in /healthz.
+  bool take_full(std::size_t t) {
+    if (!full_[t].exchange(false)) return false;
+    std::lock_guard lock(tables_[t].mutex);
+    tables_[t].handles.clear();
+    ingest_.counters().count(static_cast<Topic>(t), Reject::kReaderFull);
+    return true;
+  }
+
+  /// DDS topic names in the order of ingest.hpp's Topic.
+  static constexpr std::array<const char*, kTopics> kReaderTopics = {
+      dds::kTopicBoatAttitude, dds::kTopicBoatBackfill, dds::kTopicNodeStatus,
+      dds::kTopicWearableMotion, dds::kTopicBoatFix};
 
  private:
   using ReturnCode_t = eprosima::fastrtps::types::ReturnCode_t;
   const FleetCallbacks& cb_;
   Ingest& ingest_;
   WriterCheck* check_;
+  struct InstanceTable {
+    std::mutex mutex;
+    std::set<std::array<std::uint8_t, 16>> handles;
+  };
+  std::array<InstanceTable, kTopics> tables_;
+  std::array<std::atomic<bool>, kTopics> full_{};
 };
 
 ShoreDds::ShoreDds(const dds::DdsOptions& options, FleetCallbacks callbacks)
@@ -95,21 +130,18 @@ ShoreDds::ShoreDds(const dds::DdsOptions& options, FleetCallbacks callbacks)
   }
   listener_ = std::make_unique<Listener>(callbacks_, *ingest_, writer_check_.get());
   participant_ = std::make_unique<dds::Participant>(opts, "shore_server");
-  participant_->reader(
-      participant_->topic(dds::kTopicBoatAttitude, fdds::TypeSupport(new StrictBoatAttitudeType())),
-      "attitude_reader", listener_.get());
-  participant_->reader(
-      participant_->topic(dds::kTopicBoatBackfill, fdds::TypeSupport(new StrictBoatAttitudeType())),
-      "backfill_reader", listener_.get());
-  participant_->reader(participant_->topic(dds::kTopicWearableMotion,
-                                           fdds::TypeSupport(new StrictWearableMotionType())),
-                       "wearable_reader", listener_.get());
-  participant_->reader(
-      participant_->topic(dds::kTopicBoatFix, fdds::TypeSupport(new StrictBoatFixType())),
-      "fix_reader", listener_.get());
-  participant_->reader(
-      participant_->topic(dds::kTopicNodeStatus, fdds::TypeSupport(new StrictNodeStatusType())),
-      "status_reader", listener_.get());
+  const auto add_reader = [&](Topic t, fdds::TopicDataType* type, const char* profile) {
+    ReaderSlot& slot = readers_[static_cast<std::size_t>(t)];
+    slot.topic = participant_->topic(Listener::kReaderTopics[static_cast<std::size_t>(t)],
+                                     fdds::TypeSupport(type));
+    slot.profile = profile;
+    slot.reader = participant_->reader(slot.topic, profile, listener_.get());
+  };
+  add_reader(Topic::kAttitude, new StrictBoatAttitudeType(), "attitude_reader");
+  add_reader(Topic::kBackfill, new StrictBoatAttitudeType(), "backfill_reader");
+  add_reader(Topic::kWearable, new StrictWearableMotionType(), "wearable_reader");
+  add_reader(Topic::kFix, new StrictBoatFixType(), "fix_reader");
+  add_reader(Topic::kStatus, new StrictNodeStatusType(), "status_reader");
   rule_writer_ = participant_->writer(
       participant_->topic(dds::kTopicAlarmRules, fdds::TypeSupport(new msg::AlarmRulePubSubType())),
       "alarm_writer");
@@ -120,6 +152,21 @@ ShoreDds::ShoreDds(const dds::DdsOptions& options, FleetCallbacks callbacks)
   ack_writer_ = participant_->writer(
       participant_->topic(dds::kTopicShoreAck, fdds::TypeSupport(new msg::ShoreAckPubSubType())),
       "ack_writer");
+}
+
+std::vector<std::string> ShoreDds::recycle_full_readers(std::chrono::seconds min_interval) {
+  std::vector<std::string> replaced;
+  const auto now = std::chrono::steady_clock::now();
+  for (std::size_t t = 0; t < kTopics; ++t) {
+    ReaderSlot& slot = readers_[t];
+    if (!slot.reader || now - slot.recycled < min_interval || !listener_->take_full(t)) continue;
+    participant_->delete_reader(slot.reader);
+    slot.reader = nullptr;
+    slot.reader = participant_->reader(slot.topic, slot.profile, listener_.get());
+    slot.recycled = now;
+    replaced.emplace_back(Listener::kReaderTopics[t]);
+  }
+  return replaced;
 }
 
 bool ShoreDds::publish_ack(const std::string& boat_id, std::uint64_t boot_id,

@@ -6,6 +6,7 @@
 /// and the store queue); publishes the alarm rules and events to the boats (reliable, transient
 /// local: a boat that joins late gets them).
 
+#include <array>
 #include <chrono>
 #include <functional>
 #include <map>
@@ -32,12 +33,11 @@ struct FleetCallbacks {
   std::function<void(const WearableSample&)> on_wearable;
   /// A GNSS fix (any kind, "none" included).
   std::function<void(const FixSample&)> on_fix;
-  /// A boat missed its DDS deadline (no sample within the deadline period).
-  std::function<void(const std::string& boat_id)> on_deadline_missed;
 };
 
-/// Receipt instances the shore's ack writer keeps registered at most (its profile allows 2000).
-inline constexpr std::size_t kMaxAckInstances = 1000;
+/// Receipt instances the shore's ack writer keeps registered at most (its profile allows 4096;
+/// a 2000-boat fleet has a run each, and earlier runs delivering from their logs).
+inline constexpr std::size_t kMaxAckInstances = 3000;
 
 class ShoreDds {
  public:
@@ -61,6 +61,14 @@ class ShoreDds {
   /// What the door (ingest.hpp) let in and kept out.
   [[nodiscard]] const IngestCounters& ingest_counters() const { return ingest_->counters(); }
 
+  /// Replaces every reader whose table of ids (instances) filled up, at most once per
+  /// `min_interval` per reader; each replacement is counted as "reader_full" in /healthz. Fast DDS frees an
+  /// instance only once no writer holds it, so ids a publisher invented in a burst would keep a
+  /// new boat out for as long as that publisher lives; a new reader starts empty and the boats
+  /// still sailing are back within a sample. Call from one thread (the shore's sweep); returns
+  /// the topics replaced.
+  std::vector<std::string> recycle_full_readers(std::chrono::seconds min_interval);
+
  private:
   class Listener;
   FleetCallbacks callbacks_;
@@ -68,6 +76,14 @@ class ShoreDds {
   std::unique_ptr<WriterCheck> writer_check_;  ///< secured mode only
   std::unique_ptr<Listener> listener_;
   std::unique_ptr<dds::Participant> participant_;
+  /// The readers, by Topic (ingest.hpp): what recycle_full_readers() replaces.
+  struct ReaderSlot {
+    eprosima::fastdds::dds::Topic* topic = nullptr;
+    const char* profile = "";
+    eprosima::fastdds::dds::DataReader* reader = nullptr;
+    std::chrono::steady_clock::time_point recycled{};
+  };
+  std::array<ReaderSlot, kTopics> readers_{};
   eprosima::fastdds::dds::DataWriter* rule_writer_ = nullptr;
   eprosima::fastdds::dds::DataWriter* event_writer_ = nullptr;
   eprosima::fastdds::dds::DataWriter* ack_writer_ = nullptr;
@@ -75,7 +91,7 @@ class ShoreDds {
   std::vector<std::string> published_rule_ids_;
   /// Receipt instances the ack writer holds, (boat, run) -> last written: at most
   /// kMaxAckInstances, the least recently written unregistered first (the writer's resource limit
-  /// is 2000 instances; without this the 2001st run never got a receipt).
+  /// is 4096 instances; without this the 4097th run never got a receipt).
   std::map<std::pair<std::string, std::uint64_t>, std::chrono::steady_clock::time_point>
       ack_instances_;
   std::uint64_t rule_revision_ = 0;

@@ -151,4 +151,9 @@ fdds::DataReader* Participant::reader(fdds::Topic* t, const std::string& profile
   return r;
 }
 
+void Participant::delete_reader(fdds::DataReader* reader) {
+  if (subscriber_->delete_datareader(reader) != ReturnCode_t::RETCODE_OK)
+    throw DdsError("cannot delete reader on " + reader->get_topicdescription()->get_name());
+}
+
 }  // namespace telltale::dds

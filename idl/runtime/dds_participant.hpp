@@ -92,6 +92,9 @@ class Participant {
                                              const std::string& profile,
                                              eprosima::fastdds::dds::DataReaderListener* listener);
 
+  /// Deletes a reader this participant created (its history and instances go with it).
+  void delete_reader(eprosima::fastdds::dds::DataReader* reader);
+
   [[nodiscard]] int domain() const { return domain_; }
   [[nodiscard]] bool secured() const { return secured_; }
   [[nodiscard]] eprosima::fastdds::dds::DomainParticipant* get() const { return participant_; }

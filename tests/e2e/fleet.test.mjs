@@ -92,6 +92,18 @@ test('fleet view: a boat that goes silent gets the stale marker', async () => {
   await screenshots(page, 'fleet-stale');
 });
 
+test('fleet view: a second node under a boat\'s id gets a badge that says so, gone when it stops', async () => {
+  await fleet.addBoat('ILCA-1', ['--log-dir', `${fleet.dir}/twin_log`], 'ILCA-1-twin');
+  const badge = '.card[data-boat="ILCA-1"] .problem.duplicate_id';
+  await page.waitForSelector(badge, { timeout: 10000 });
+  assert.equal(await page.textContent(badge), 'TWO NODES');
+  assert.match(await page.getAttribute(badge, 'title'), /two nodes publish as 'ILCA-1'/);
+  await screenshots(page, 'fleet-two-nodes');
+  await stop(fleet.boats.get('ILCA-1-twin'));
+  fleet.boats.delete('ILCA-1-twin');
+  await page.waitForSelector(badge, { state: 'detached', timeout: 20000 });
+});
+
 test('boat view: live heel, pitch and heading charts draw and move', async () => {
   await page.evaluate(() => { location.hash = '#/boat/ILCA-1'; });
   await page.waitForSelector('.chart[data-series="heel"] canvas', { timeout: 5000 });

@@ -85,13 +85,15 @@ export async function startFleet({ domain, boats = [] }) {
   const url = (await shore.ready)[1];
   const fleet = {
     url, token, dir, domain, shore: shore.child, boats: new Map(),
-    async addBoat(id, extra = []) {
-      // The boat's session log goes to the run's temp dir, not the current directory.
+    async addBoat(id, extra = [], key = id) {
+      // The boat's session log goes to the run's temp dir, not the current directory (unless
+      // `extra` names one).
+      const log = extra.includes('--log-dir') ? [] : ['--log-dir', join(dir, 'boat_log')];
       const b = start(join(binDir, 'boat_node'), ['--domain', String(domain), '--boat-id', id,
-        '--log-dir', join(dir, 'boat_log'), ...extra],
+        ...log, ...extra],
         /boat_node ready/);
       await b.ready;
-      this.boats.set(id, b.child);
+      this.boats.set(key, b.child);
       return b.child;
     },
     async addAthlete(id, extra = []) {

@@ -115,6 +115,10 @@ TEST_F(BackfillTest, FullLogDiskIsReportedInTheNodeStatus) {
       },
       20s))
       << text;
+  // The card's first badge says so (the dashboard shows `problems`).
+  const auto problems = boats_by_id().at("fl1")["problems"];
+  ASSERT_FALSE(problems.empty());
+  EXPECT_EQ(problems[0]["code"], "log_failing") << problems;
   boat.stop(SIGINT, 15s);
 }
 

@@ -58,6 +58,44 @@ TEST_F(FleetTest, TwoBoatsAppearWithLiveChangingAttitude) {
   }
 }
 
+// Given two boat nodes configured with one id, then the boat's card carries a duplicate_id
+// problem naming both runs and /healthz lists the id; once one node stops, the flag clears.
+TEST_F(FleetTest, TwoNodesWithOneIdAreFlaggedOnTheCardAndInHealthz) {
+  start_boat("twin", {"--log-dir", dir_ + "/log_twin_a"});
+  Process& second = start_boat("twin", {"--log-dir", dir_ + "/log_twin_b"});
+  json card;
+  EXPECT_TRUE(eventually(
+      [&] {
+        const auto boats = boats_by_id();
+        if (!boats.count("twin")) return false;
+        card = boats.at("twin");
+        return card["duplicate_id"].get<bool>();
+      },
+      15s))
+      << card;
+  ASSERT_FALSE(card["problems"].empty()) << card;
+  EXPECT_EQ(card["problems"][0]["code"], "duplicate_id") << card;
+  json health;
+  EXPECT_TRUE(eventually(
+      [&] {
+        auto res = client().Get("/healthz");
+        if (!res || res->status != 200) return false;
+        health = json::parse(res->body);
+        return health.contains("duplicate_boat_ids") &&
+               health["duplicate_boat_ids"][0]["boat_id"] == "twin";
+      },
+      15s))
+      << health;
+  EXPECT_EQ(second.stop(SIGINT), 0);
+  EXPECT_TRUE(eventually(
+      [&] {
+        card = boats_by_id().at("twin");
+        return !card["duplicate_id"].get<bool>() && card["problems"].empty();
+      },
+      20s))
+      << card;
+}
+
 // The live stream pushes samples of every boat; a boat that stops goes stale within 2.5 s.
 TEST_F(FleetTest, StreamDeliversSamplesAndMarksSilentBoatStale) {
   start_boat("charlie");

@@ -5,6 +5,7 @@
 #include <sqlite3.h>
 
 #include <cmath>
+#include <fstream>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <limits>
@@ -253,6 +254,43 @@ TEST_F(HostileSampleTest, IdsTimesAndNaNOffContractAreRefusedAndCounted) {
   EXPECT_GE(rejected("attitude", "id"), bad_ids.size());  // each sent three times
   EXPECT_EQ(rejected("backfill", "time"), bad_times.size());
   EXPECT_EQ(rejected("backfill", "value"), 2u);
+  ASSERT_TRUE(shore_->running());
+}
+
+// Finding 8, the DDS half: Fast DDS frees an instance (one per id) only once no writer holds it, so
+// a publisher that invented as many ids as a reader's table holds kept every new boat out for as
+// long as it lived (the door runs after Fast DDS has taken the id in). The shore now replaces a
+// reader whose table filled. Here the table holds 8 ids, the publisher takes them all and goes
+// quiet, then a real boat starts: it must appear, and the refusals are counted in /healthz.
+class FullReaderTest : public HostileSampleTest {
+ protected:
+  std::vector<std::string> shore_flags() const override {
+    std::ifstream in(dds::resolve_profiles_file(""));
+    std::string xml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string reader = "<data_reader profile_name=\"attitude_reader\">";
+    const auto at = xml.find(reader);
+    const auto limit = xml.find("<max_instances>4096</max_instances>", at);
+    EXPECT_NE(limit, std::string::npos) << "the attitude reader's instance limit moved";
+    if (limit != std::string::npos)
+      xml.replace(limit, std::string("<max_instances>4096</max_instances>").size(),
+                  "<max_instances>8</max_instances>");
+    const std::string path = dir_ + "/small_reader_profiles.xml";
+    std::ofstream(path) << xml;
+    return {"--dds-profiles", path};
+  }
+};
+
+TEST_F(FullReaderTest, IdsInventedToFillTheReaderDoNotLockANewBoatOut) {
+  HostilePublisher pub(domain_);
+  ASSERT_TRUE(pub.wait_matched(10s));
+  const std::uint64_t t0 = now_ns() - 5'000'000'000ULL;
+  for (std::uint64_t id = 0; id < 12; ++id)
+    pub.live(HostilePublisher::attitude("inv" + std::to_string(id), 1, t0 + id));
+  ASSERT_TRUE(eventually([&] { return rejected("attitude", "reader_full") > 0; }, 10s))
+      << healthz().dump(1);
+  start_boat("late1");
+  EXPECT_TRUE(eventually([&] { return boats_by_id().count("late1") == 1; }, 20s))
+      << shore_->output();
   ASSERT_TRUE(shore_->running());
 }
 

@@ -111,6 +111,20 @@ class SessionLogFaults : public SessionLogRuns {
 // Given a log on a small real filesystem, when a ballast file fills the disk for a while and is
 // then removed, then every record appended before, during and after the spell is read back in
 // order (none torn, none off the record grid).
+// Given a healthy disk, records buffered between two flushes are held in memory but the log is
+// not failing (every boat's first status used to read "SESSION LOG FAILING ()" for that).
+TEST_F(SessionLogRuns, BufferedRecordsAreNotAFailure) {
+  SessionLog log({dir_, "ok", 0x5, 100000, 1ULL << 30});
+  LogRecord r;
+  r.seq = 1;
+  r.t_utc_ns = 40'000'000;
+  ASSERT_TRUE(log.append(r));
+  EXPECT_EQ(log.health().pending_records, 1u);
+  EXPECT_FALSE(log.health().failing());
+  ASSERT_TRUE(log.flush());
+  EXPECT_EQ(log.health().pending_records, 0u);
+}
+
 TEST_F(SessionLogFaults, DiskFullSpellLosesNothingAndReportsIt) {
   if (!mount_tmpfs("size=256k,mode=0755")) FAIL() << "needs root and mount namespaces (a fault test fails, never skips, without them)";
   const auto ballast = dir_ / "ballast";
@@ -133,6 +147,7 @@ TEST_F(SessionLogFaults, DiskFullSpellLosesNothingAndReportsIt) {
   // The spell is seen and reported: records held in memory, the error named.
   const SessionLogHealth during = log.health();
   EXPECT_GT(during.pending_records, 0u);
+  EXPECT_TRUE(during.failing());
   EXPECT_GT(during.write_errors, 0u);
   EXPECT_NE(during.last_error.find("No space"), std::string::npos) << during.last_error;
   std::filesystem::remove(ballast);  // the spell ends
@@ -144,6 +159,7 @@ TEST_F(SessionLogFaults, DiskFullSpellLosesNothingAndReportsIt) {
   EXPECT_EQ(log.health().pending_records, 0u);
   EXPECT_EQ(log.health().dropped_records, 0u);
   EXPECT_TRUE(log.health().last_error.empty());
+  EXPECT_FALSE(log.health().failing());
   SessionLogReader reader(dir_, "full", 0xf1);
   const auto back = reader.read(1, 600);
   ASSERT_EQ(back.size(), 600u);

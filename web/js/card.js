@@ -28,7 +28,8 @@ export function createCard(id) {
       el('h2', {}, el('a', { class: 'boat-id', href: `#/boat/${encodeURIComponent(id)}`, text: id })),
       el('span', { class: 'group-tag' }),
       el('span', { class: 'alarm-badge', text: 'OK' }),
-      el('span', { class: 'stale-marker', text: 'SILENT' })),
+      el('span', { class: 'stale-marker', text: 'SILENT' }),
+      el('ul', { class: 'problems', 'aria-label': 'problems' })),
     el('div', { class: 'readouts' },
       el('div', { class: 'readout' }, el('span', { class: 'label', text: 'Heel' }),
         el('span', { class: 'value heel', text: '–' })),
@@ -64,6 +65,7 @@ export function createCard(id) {
     spark,
     badge: root.querySelector('.alarm-badge'),
     group: root.querySelector('.group-tag'),
+    problems: root.querySelector('.problems'),
     meta: root.querySelector('.meta'),
   };
   return root;
@@ -77,6 +79,19 @@ function ledBar(bar, lit, count) {
 }
 
 const BADGE = { normal: 'OK', warn: 'WARN', alarm: 'ALARM' };
+// What the shore says is wrong with the boat (its `problems`), one badge each; the full text is
+// the badge's tooltip. The log first: a failing session log loses for good what the link drops.
+const PROBLEM_LABEL = { log_failing: 'LOG FAILING', duplicate_id: 'TWO NODES', clock_suspect: 'CLOCK',
+  sensor: 'SENSOR' };
+
+function updateProblems(list, problems) {
+  const key = problems.map((p) => `${p.code}\u0000${p.text}`).join('\u0001');
+  if (list.dataset.key === key) return;
+  list.dataset.key = key;
+  list.replaceChildren(...problems.map((p) => el('li', {
+    class: `problem ${p.code}`, title: p.text, dataset: { code: p.code },
+    text: PROBLEM_LABEL[p.code] ?? p.code.toUpperCase() })));
+}
 
 export function updateCard(root, entry, stale) {
   const b = entry.boat;
@@ -85,6 +100,7 @@ export function updateCard(root, entry, stale) {
   root.dataset.stale = String(stale);
   p.badge.textContent = BADGE[b.alarm_state] ?? b.alarm_state;
   p.group.textContent = b.group ?? '';
+  updateProblems(p.problems, b.problems ?? []);
   p.heel.textContent = deg(b.heel_deg);
   p.pitch.textContent = deg(b.pitch_deg);
   const sp = speedText(b.sog_m_s);
