@@ -286,6 +286,8 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   double first_t = std::numeric_limits<double>::quiet_NaN();
   double next_publish_s = 0.0;
   double last_t = -std::numeric_limits<double>::infinity();
+  bool imu_started = false;
+  telltale::fusion::ImuGateCounts imu_gate;
   double calib_heel = 0.0, calib_pitch = 0.0;
   int calib_n = 0;
   bool calibrating = o.calibrate_s > 0;
@@ -329,15 +331,13 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       if (shutdown.wait_for(due - Clock::now())) break;
     }
     const auto now = Clock::now();
-    // Bad input is flagged, never fused: time going backwards, NaN/Inf, saturated values.
-    if (!(sample->t_s > last_t)) {
-      health |= telltale::msg::SENSOR_TIME_BACKWARDS;
-      ++bad_samples;
-      continue;
-    }
-    last_t = sample->t_s;
-    if (!sample->gyro_body_rad_s.allFinite() || !sample->acc_body_m_s2.allFinite()) {
-      health |= telltale::msg::SENSOR_NON_FINITE;
+    // Bad input is flagged, never fused: the one IMU gate (the filter's own, run here for the
+    // health bits) rejects time going backwards and NaN/Inf; saturation is the filter's to flag.
+    const unsigned time_rejections = imu_gate.rejected_time;
+    if (telltale::fusion::gate_imu_sample(*sample, {}, imu_started, last_t, imu_gate).verdict ==
+        telltale::fusion::ImuVerdict::kReject) {
+      health |= imu_gate.rejected_time != time_rejections ? telltale::msg::SENSOR_TIME_BACKWARDS
+                                                          : telltale::msg::SENSOR_NON_FINITE;
       ++bad_samples;
       continue;
     }

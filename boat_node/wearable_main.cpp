@@ -285,7 +285,9 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
     }
     if (Clock::now() >= next_status) {
       next_status += std::chrono::seconds(1);
-      const unsigned bad = handheld ? rejected_non_finite : pdr->diagnostics().rejected_non_finite;
+      const unsigned bad =
+          handheld ? rejected_non_finite
+                   : pdr->diagnostics().rejected_non_finite + pdr->diagnostics().rejected_time;
       status.t_utc_ns(telltale::utc_now_ns());
       status.uptime_s(std::chrono::duration<double>(Clock::now() - start).count());
       status.samples_published(seq);

@@ -11,10 +11,12 @@ constexpr double kRadToDeg = 180.0 / M_PI;
 /// Shared gate of the integrating baselines; on the first sample initialises heel/pitch from the
 /// accelerometer (dt = 0).
 bool accept(const ImuSample& s, EulerTiltState& st, BaselineDiagnostics& d, double& dt) {
-  const SampleGate g =
-      gate_sample(s, st.initialised, st.last_t_s, dt, d.rejected_non_finite, d.rejected_time);
-  if (g == SampleGate::kFirst) tilt_from_accel(s.acc_body_m_s2, st.heel_rad, st.pitch_rad);
-  return g != SampleGate::kReject;
+  // The yardsticks are the paper's: they integrate over gaps and saturation as it did (the gate
+  // only counts them).
+  const ImuGateResult g = gate_imu_sample(s, ImuGateParams{}, st.initialised, st.last_t_s, d);
+  dt = g.dt_s;
+  if (g.verdict == ImuVerdict::kFirst) tilt_from_accel(s.acc_body_m_s2, st.heel_rad, st.pitch_rad);
+  return g.verdict != ImuVerdict::kReject;
 }
 
 AttitudeOutput euler_output(const EulerTiltState& st, double acc_weight) {
@@ -94,14 +96,14 @@ void ConstKalmanAttitudeFilter::step_axis(Axis& a, double rate_deg_s, double acc
 }
 
 void ConstKalmanAttitudeFilter::update(const ImuSample& s) {
-  double dt = 0.0;
-  const SampleGate g = gate_sample(s, state_.initialised, state_.last_t_s, dt,
-                                   diag_.rejected_non_finite, diag_.rejected_time);
-  if (g == SampleGate::kReject) return;
+  const ImuGateResult g =
+      gate_imu_sample(s, ImuGateParams{}, state_.initialised, state_.last_t_s, diag_);
+  if (g.verdict == ImuVerdict::kReject) return;
+  const double dt = g.dt_s;
   double heel_acc = 0.0;
   double pitch_acc = 0.0;
   tilt_from_accel(s.acc_body_m_s2, heel_acc, pitch_acc);
-  if (g == SampleGate::kFirst) {
+  if (g.verdict == ImuVerdict::kFirst) {
     state_.heel.angle_deg = heel_acc * kRadToDeg;
     state_.pitch.angle_deg = pitch_acc * kRadToDeg;
     return;

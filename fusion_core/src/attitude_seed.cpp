@@ -55,11 +55,10 @@ void SeedAttitudeFilter::step_axis(Axis& a, double increment_deg, double acc_deg
 
 void SeedAttitudeFilter::update(const ImuSample& s) {
   // The first sample has no increment (X0 = 0 stands for "no history"): dt = 0.
-  double dt = 0.0;
-  if (gate_sample(s, state_.started, state_.last_t_s, dt, diag_.rejected_non_finite,
-                  diag_.rejected_time) == SampleGate::kReject) {
-    return;
-  }
+  const ImuGateResult g =
+      gate_imu_sample(s, ImuGateParams{}, state_.started, state_.last_t_s, diag_);
+  if (g.verdict == ImuVerdict::kReject) return;
+  const double dt = g.dt_s;
   // Eq 2: da = | |a| - g_c | / g_c from the measured specific force.
   const double da = std::abs(s.acc_body_m_s2.norm() - params_.g_c_m_s2) / params_.g_c_m_s2;
   state_.c = weight_from_da(da, params_);

@@ -54,7 +54,10 @@ Eigen::Vector3d perpendicular(const Eigen::Vector3d& u) {
 
 }  // namespace
 
-TelltaleAttitudeFilter::TelltaleAttitudeFilter(Params params) : params_(params) {}
+TelltaleAttitudeFilter::TelltaleAttitudeFilter(Params params)
+    : params_(params),
+      gate_{params.gyro_range_rad_s, params.acc_range_m_s2, params.saturation_fraction,
+            params.max_gap_s, true} {}
 
 void TelltaleAttitudeFilter::initialise(const ImuSample& s) {
   // Frame I starts level-consistent with the first accelerometer sample (yaw 0):
@@ -129,25 +132,17 @@ AttitudeOutput TelltaleAttitudeFilter::output() const {
 
 void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // --- Should this sample be used? (gating apart from the algebra, STYLE rule 6) ---
-  double dt = 0.0;
-  const SampleGate gate = gate_sample(s, state_.initialised, state_.last_t_s, dt,
-                                      diag_.rejected_non_finite, diag_.rejected_time);
-  if (gate == SampleGate::kReject) return;
-  if (gate == SampleGate::kFirst) {
+  const ImuGateResult g = gate_imu_sample(s, gate_, state_.initialised, state_.last_t_s, diag_);
+  if (g.verdict == ImuVerdict::kReject) return;
+  if (g.verdict == ImuVerdict::kFirst) {
     initialise(s);
     return;
   }
   const Params& p = params_;
-  const double gyro_sat_rad_s = p.saturation_fraction * p.gyro_range_rad_s;
-  const double acc_sat_m_s2 = p.saturation_fraction * p.acc_range_m_s2;
-  const bool gyro_sat = s.gyro_body_rad_s.cwiseAbs().maxCoeff() >= gyro_sat_rad_s;
-  const bool acc_sat = s.acc_body_m_s2.cwiseAbs().maxCoeff() >= acc_sat_m_s2;
-  const bool gap = dt > p.max_gap_s;
-  if (gyro_sat | acc_sat | gap) [[unlikely]] {
-    diag_.gyro_saturated += gyro_sat ? 1u : 0u;
-    diag_.acc_saturated += acc_sat ? 1u : 0u;
-    diag_.gaps += gap ? 1u : 0u;
-  }
+  const double dt = g.dt_s;
+  const bool gyro_sat = g.gyro_saturated;
+  const bool acc_sat = g.acc_saturated;
+  const bool gap = g.gap;
   State& st = state_;
 
   // --- Strapdown integration in frame I. A MEMS gyro sample is the output of its decimation

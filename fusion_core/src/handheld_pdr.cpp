@@ -380,8 +380,10 @@ HandheldPdr::HandheldPdr(Params p, const StepLengthModel& lengths)
 
 
 int HandheldPdr::update(const ImuSample& s, const Eigen::Vector3d& mag_uT) {
-  if (!s.acc_body_m_s2.allFinite() || !s.gyro_body_rad_s.allFinite() || !std::isfinite(s.t_s))
+  if (gate_imu_sample(s, ImuGateParams{}, have_t_, last_t_s_, diag_).verdict ==
+      ImuVerdict::kReject) {
     return 0;
+  }
   att_.update(s);
   const Eigen::Vector3d up = att_.state().up_body;
   bias_.update(s, up, mag_uT);

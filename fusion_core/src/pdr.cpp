@@ -1220,9 +1220,8 @@ bool Pdr::phone_step(const ImuSample& s, const Eigen::Matrix3d& m, StepEvent& ev
 
 const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT) {
   out_.step = false;
-  if (!std::isfinite(raw.t_s) || !raw.acc_body_m_s2.allFinite() ||
-      (have_t_ && !(raw.t_s > last_t_s_))) {
-    ++diag_.rejected_non_finite;
+  static constexpr ImuGateParams kGate{.gyro_required = false};
+  if (gate_imu_sample(raw, kGate, have_t_, last_t_s_, diag_).verdict == ImuVerdict::kReject) {
     return out_;
   }
   ImuSample s = raw;
@@ -1230,8 +1229,6 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
     learn_gyro_bias(s);
     s.gyro_body_rad_s -= gyro_bias_;
   }
-  have_t_ = true;
-  last_t_s_ = s.t_s;
   out_.t_s = s.t_s;
   const bool foot = params_.mount == StepMount::kFoot;
   if (!foot) {

@@ -8,21 +8,13 @@ namespace {
 
 constexpr double kG = 9.80665;
 
-/// Common input gate: finite time and accelerometer, time advancing. Returns dt (0 on the
-/// first sample) or a negative value when the sample must be ignored.
+/// The detectors' use of the one IMU gate (gate_imu_sample): finite time and accelerometer,
+/// time advancing; the gyro may be missing (the detectors that use it check gyro_finite).
+/// Returns dt (0 on the first sample) or a negative value when the sample must be ignored.
 double gate(const ImuSample& s, bool& have_t, double& last_t, StepDiagnostics& diag) {
-  if (!std::isfinite(s.t_s) || !s.acc_body_m_s2.allFinite()) {
-    ++diag.rejected_non_finite;
-    return -1.0;
-  }
-  if (have_t && !(s.t_s > last_t)) {
-    ++diag.rejected_time;
-    return -1.0;
-  }
-  const double dt = have_t ? s.t_s - last_t : 0.0;
-  have_t = true;
-  last_t = s.t_s;
-  return dt;
+  static constexpr ImuGateParams kGate{.gyro_required = false};
+  const ImuGateResult g = gate_imu_sample(s, kGate, have_t, last_t, diag);
+  return g.verdict == ImuVerdict::kReject ? -1.0 : g.dt_s;
 }
 
 }  // namespace

@@ -4,9 +4,15 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "telltale/fusion/attitude.hpp"
 #include "telltale/fusion/attitude_baselines.hpp"
+#include "telltale/fusion/attitude_seed.hpp"
+#include "telltale/fusion/attitude_telltale.hpp"
+#include "telltale/fusion/handheld_pdr.hpp"
+#include "telltale/fusion/pdr.hpp"
+#include "telltale/fusion/steps.hpp"
 
 namespace telltale::fusion {
 namespace {
@@ -136,6 +142,98 @@ INSTANTIATE_TEST_SUITE_P(Attitude, EveryFilter, ::testing::ValuesIn(attitude_fil
                            for (auto& ch : n) ch = (ch == '-') ? '_' : ch;
                            return n;
                          });
+
+// The one IMU gate: NaN/Inf and time not advancing are rejected and counted, the first sample
+// says so, saturation and gaps are flagged and counted, and a NaN gyro passes only where it is
+// optional.
+TEST(ImuGate, RejectsFlagsAndCounts) {
+  ImuGateParams p;
+  p.gyro_range_rad_s = 4.0;
+  p.acc_range_m_s2 = 20.0;
+  bool started = false;
+  double last_t = 0.0;
+  ImuGateCounts n;
+  const Eigen::Vector3d g(0.0, 0.0, kG);
+  EXPECT_EQ(gate_imu_sample({1.0, {0, 0, 0}, g}, p, started, last_t, n).verdict,
+            ImuVerdict::kFirst);
+  const ImuGateResult r = gate_imu_sample({1.01, {0, 0, 0}, g}, p, started, last_t, n);
+  EXPECT_EQ(r.verdict, ImuVerdict::kNext);
+  EXPECT_NEAR(r.dt_s, 0.01, 1e-12);
+  EXPECT_FALSE(r.gap || r.gyro_saturated || r.acc_saturated);
+  EXPECT_EQ(gate_imu_sample({1.01, {0, 0, 0}, g}, p, started, last_t, n).verdict,
+            ImuVerdict::kReject);  // same time
+  EXPECT_EQ(gate_imu_sample({0.5, {0, 0, 0}, g}, p, started, last_t, n).verdict,
+            ImuVerdict::kReject);  // backwards
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(gate_imu_sample({nan, {0, 0, 0}, g}, p, started, last_t, n).verdict,
+            ImuVerdict::kReject);
+  EXPECT_EQ(gate_imu_sample({1.02, {0, 0, 0}, {0, inf, kG}}, p, started, last_t, n).verdict,
+            ImuVerdict::kReject);
+  EXPECT_EQ(gate_imu_sample({1.02, {0, nan, 0}, g}, p, started, last_t, n).verdict,
+            ImuVerdict::kReject);
+  EXPECT_EQ(n.rejected_time, 2u);
+  EXPECT_EQ(n.rejected_non_finite, 3u);
+  const ImuGateResult sat =
+      gate_imu_sample({1.03, {0, 3.95, 0}, {19.7, 0, kG}}, p, started, last_t, n);
+  EXPECT_TRUE(sat.gyro_saturated && sat.acc_saturated);
+  const ImuGateResult gap = gate_imu_sample({2.5, {0, 0, 0}, g}, p, started, last_t, n);
+  EXPECT_TRUE(gap.gap);
+  EXPECT_EQ(gap.verdict, ImuVerdict::kNext);
+  EXPECT_EQ(n.gyro_saturated, 1u);
+  EXPECT_EQ(n.acc_saturated, 1u);
+  EXPECT_EQ(n.gaps, 1u);
+  p.gyro_required = false;
+  const ImuGateResult no_gyro = gate_imu_sample({2.6, {nan, 0, 0}, g}, p, started, last_t, n);
+  EXPECT_EQ(no_gyro.verdict, ImuVerdict::kNext);
+  EXPECT_FALSE(no_gyro.gyro_finite);
+  EXPECT_FALSE(no_gyro.gyro_saturated);
+}
+
+// Every attitude filter, step detector and PDR runs the same gate: the same bad samples are
+// rejected and counted the same way by all of them.
+TEST(ImuGate, EveryFilterAndDetectorCountsTheSame) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<ImuSample> samples;
+  for (int k = 0; k < 50; ++k) samples.push_back({0.01 * k, {0.0, 0.0, 0.0}, {0.0, 0.0, kG}});
+  samples[10].t_s = nan;
+  samples[20].acc_body_m_s2.y() = nan;
+  samples[30].t_s = samples[29].t_s;  // time does not advance
+  samples[40].t_s = 0.1;              // backwards
+  const auto check = [](const ImuGateCounts& d, const std::string& who) {
+    EXPECT_EQ(d.rejected_non_finite, 2u) << who;
+    EXPECT_EQ(d.rejected_time, 2u) << who;
+  };
+  TelltaleAttitudeFilter telltale;
+  SeedAttitudeFilter seed;
+  GyroAttitudeFilter gyro;
+  ConstKalmanAttitudeFilter kalman;
+  for (const auto& s : samples) {
+    telltale.update(s);
+    seed.update(s);
+    gyro.update(s);
+    kalman.update(s);
+  }
+  check(telltale.diagnostics(), "telltale");
+  check(seed.diagnostics(), "seed");
+  check(gyro.diagnostics(), "gyro");
+  check(kalman.diagnostics(), "kalman-const");
+  for (const auto name : step_detector_names()) {
+    auto d = make_step_detector(name, StepMount::kFoot);
+    StepEvent e;
+    for (const auto& s : samples) d->update(s, e);
+    check(d->diagnostics(), std::string(name));
+  }
+  Pdr pdr;
+  HandheldPdr handheld;
+  const Eigen::Vector3d no_mag = Eigen::Vector3d::Constant(nan);
+  for (const auto& s : samples) {
+    pdr.update(s, no_mag);
+    handheld.update(s, no_mag);
+  }
+  check(pdr.diagnostics(), "pdr");
+  check(handheld.diagnostics(), "handheld");
+}
 
 TEST(GyroAttitudeFilter, IntegratesARollRateAndCountsRejections) {
   GyroAttitudeFilter f;

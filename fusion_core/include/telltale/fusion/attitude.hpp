@@ -49,7 +49,8 @@ class AttitudeFilter {
  public:
   virtual ~AttitudeFilter() = default;
   /// Feeds one sample (time strictly increasing; non-uniform spacing allowed). Never throws:
-  /// NaN/Inf or non-increasing time are rejected and counted in the filter's Diagnostics.
+  /// every filter passes the sample through gate_imu_sample (imu_sample.hpp) first, so NaN/Inf
+  /// or non-increasing time are rejected and counted in the filter's Diagnostics.
   virtual void update(const ImuSample& sample) = 0;
   [[nodiscard]] virtual AttitudeOutput output() const = 0;
   /// The boat's speed (m/s, forward, horizontal), its rate of change (m/s^2) and the rate of its
@@ -60,39 +61,6 @@ class AttitudeFilter {
   virtual void set_speed(double /*speed_m_s*/, double /*speed_rate_m_s2*/,
                          double /*cog_rate_rad_s*/) {}
 };
-
-/// Outcome of gate_sample.
-enum class SampleGate { kReject, kFirst, kNext };
-
-/// The one gate every attitude filter applies before using a sample: NaN/Inf anywhere, or a time
-/// not after the last accepted one -> kReject (counted in the given counter). The first accepted
-/// sample -> kFirst (dt_s = 0); later ones -> kNext with dt_s > 0. Accepting advances last_t_s and
-/// sets started. Inline: it runs before every update and a call costs as much as its body.
-[[nodiscard]] inline SampleGate gate_sample(const ImuSample& sample, bool& started,
-                                            double& last_t_s, double& dt_s,
-                                            unsigned& rejected_non_finite,
-                                            unsigned& rejected_time) {
-  dt_s = 0.0;
-  // 0 * x is 0 for a finite x and NaN for NaN or Inf: one sum tests all seven values at once.
-  const double zero =
-      0.0 * sample.t_s + (0.0 * sample.gyro_body_rad_s + 0.0 * sample.acc_body_m_s2).sum();
-  if (zero != 0.0) {
-    ++rejected_non_finite;
-    return SampleGate::kReject;
-  }
-  if (!started) {
-    started = true;
-    last_t_s = sample.t_s;
-    return SampleGate::kFirst;
-  }
-  dt_s = sample.t_s - last_t_s;
-  if (!(dt_s > 0.0)) {
-    ++rejected_time;
-    return SampleGate::kReject;
-  }
-  last_t_s = sample.t_s;
-  return SampleGate::kNext;
-}
 
 /// Heel and pitch (rad) of the gravity direction seen by an accelerometer at rest:
 /// f = g (sin(pitch), cos(pitch) sin(heel), cos(pitch) cos(heel)) inverted.

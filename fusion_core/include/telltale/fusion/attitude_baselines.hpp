@@ -10,10 +10,7 @@
 namespace telltale::fusion {
 
 /// Counters shared by the baselines.
-struct BaselineDiagnostics {
-  unsigned rejected_non_finite = 0;
-  unsigned rejected_time = 0;
-};
+struct BaselineDiagnostics : ImuGateCounts {};
 
 /// Heel/pitch state shared by the integrating baselines.
 struct EulerTiltState {

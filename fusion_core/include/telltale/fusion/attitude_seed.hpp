@@ -61,10 +61,7 @@ class SeedAttitudeFilter final : public AttitudeFilter {
     double pitch_rate_rad_s = 0.0;
     bool started = false;
   };
-  struct Diagnostics {
-    unsigned rejected_non_finite = 0;
-    unsigned rejected_time = 0;
-  };
+  struct Diagnostics : ImuGateCounts {};
 
   explicit SeedAttitudeFilter(Params params = {});
   void update(const ImuSample& sample) override;

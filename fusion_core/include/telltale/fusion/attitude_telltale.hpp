@@ -125,13 +125,10 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
     double speed_rate_m_s2 = 0.0;
     double yaw_rate_cog_rad_s = std::numeric_limits<double>::quiet_NaN();  ///< - cog rate
   };
-  struct Diagnostics {
-    unsigned rejected_non_finite = 0;
-    unsigned rejected_time = 0;
-    unsigned gaps = 0;            ///< dt > max_gap_s (not integrated, the low-pass restarted)
-    unsigned gyro_saturated = 0;  ///< samples with a gyro axis at full scale
-    unsigned acc_saturated = 0;   ///< samples with an accelerometer axis at full scale (not fused)
-    unsigned rest_samples = 0;    ///< samples spent learning the bias at rest
+  /// The gate's counts (gaps: not integrated, the low-pass restarted; accelerometer saturated:
+  /// not used for the bias or rest) and the samples spent learning the bias at rest.
+  struct Diagnostics : ImuGateCounts {
+    unsigned rest_samples = 0;
   };
 
   explicit TelltaleAttitudeFilter(Params params = {});
@@ -161,6 +158,7 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
  private:
   void initialise(const ImuSample& s);
   Params params_;
+  ImuGateParams gate_;  ///< the sensor's ranges and the longest gap, from params_
   State state_;
   Diagnostics diag_;
 };

@@ -265,9 +265,14 @@ class HandheldPdr {
   [[nodiscard]] const Eigen::Vector3d& gyro_bias_rad_s() const { return bias_.bias_rad_s(); }
   [[nodiscard]] double heading_rad() const { return heading_.heading_rad(); }
   [[nodiscard]] const Eigen::Vector3d& up() const { return att_.state().up_body; }
+  /// What the IMU gate (gate_imu_sample) rejected: NaN/Inf anywhere, time not advancing.
+  [[nodiscard]] const ImuGateCounts& diagnostics() const { return diag_; }
 
  private:
   Params params_;
+  ImuGateCounts diag_;
+  bool have_t_ = false;
+  double last_t_s_ = 0.0;
   StepLengthModel lengths_;
   TelltaleAttitudeFilter att_;
   StandBiasLearner bias_;

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <limits>
 
 namespace telltale::fusion {
 
@@ -14,6 +15,84 @@ struct ImuSample {
   Eigen::Vector3d gyro_body_rad_s = Eigen::Vector3d::Zero();  ///< body rate, rad/s, right-hand
   Eigen::Vector3d acc_body_m_s2 = Eigen::Vector3d::Zero();    ///< specific force, m/s^2 (+g up at rest)
 };
+
+/// What one IMU can measure, for gate_imu_sample. Defaults: full scale unknown (nothing counts
+/// as saturated), gaps over 1 s, gyro required.
+struct ImuGateParams {
+  double gyro_range_rad_s = std::numeric_limits<double>::infinity();  ///< full scale
+  double acc_range_m_s2 = std::numeric_limits<double>::infinity();    ///< full scale
+  double saturation_fraction = 0.98;  ///< |reading| >= this * range on an axis -> saturated
+  double max_gap_s = 1.0;             ///< a longer step is a gap (samples were dropped)
+  /// false: a sample whose gyro is NaN/Inf still passes (gyro_finite = false), for detectors that
+  /// can work from the accelerometer alone; the time and the accelerometer are always required.
+  bool gyro_required = true;
+};
+
+/// What the gate counted, one set per filter or detector (their Diagnostics derive from it).
+struct ImuGateCounts {
+  unsigned rejected_non_finite = 0;  ///< NaN/Inf in the time, the accelerometer or a required gyro
+  unsigned rejected_time = 0;        ///< time not after the last accepted sample
+  unsigned gaps = 0;                 ///< accepted after more than max_gap_s
+  unsigned gyro_saturated = 0;       ///< accepted with a gyro axis at full scale
+  unsigned acc_saturated = 0;        ///< accepted with an accelerometer axis at full scale
+};
+
+enum class ImuVerdict { kReject, kFirst, kNext };
+
+/// The gate's verdict on one sample and what the user must know to use it.
+struct ImuGateResult {
+  ImuVerdict verdict = ImuVerdict::kReject;
+  double dt_s = 0.0;  ///< since the last accepted sample (kNext: > 0; otherwise 0)
+  bool gyro_finite = false;
+  bool gyro_saturated = false;
+  bool acc_saturated = false;
+  bool gap = false;  ///< dt_s > max_gap_s: the interval is not to be integrated
+};
+
+/// The one gate every filter and detector applies to an IMU sample before using it ("should I
+/// use this?" apart from "how?"): NaN/Inf in the time, the accelerometer or a required gyro, or a
+/// time not after the last accepted one -> kReject; the first accepted sample -> kFirst; later
+/// ones -> kNext with dt_s > 0, flagged when saturated or after a gap. Accepting advances
+/// last_t_s and sets started (both kept in the caller's State, so a checkpoint carries them);
+/// every outcome but a clean sample is counted. Inline: it runs before every update and a call
+/// would cost as much as its body.
+[[nodiscard]] inline ImuGateResult gate_imu_sample(const ImuSample& sample, const ImuGateParams& p,
+                                                   bool& started, double& last_t_s,
+                                                   ImuGateCounts& counts) {
+  ImuGateResult r;
+  // 0 * x is 0 for a finite x and NaN for NaN or Inf: one sum tests several values at once.
+  const double acc_zero = 0.0 * sample.t_s + (0.0 * sample.acc_body_m_s2).sum();
+  r.gyro_finite = (0.0 * sample.gyro_body_rad_s).sum() == 0.0;
+  if (acc_zero != 0.0 || (p.gyro_required && !r.gyro_finite)) {
+    ++counts.rejected_non_finite;
+    return r;
+  }
+  if (!started) {
+    started = true;
+    last_t_s = sample.t_s;
+    r.verdict = ImuVerdict::kFirst;
+    return r;
+  }
+  const double dt = sample.t_s - last_t_s;
+  if (!(dt > 0.0)) {
+    ++counts.rejected_time;
+    return r;
+  }
+  last_t_s = sample.t_s;
+  r.verdict = ImuVerdict::kNext;
+  r.dt_s = dt;
+  r.gyro_saturated = r.gyro_finite && sample.gyro_body_rad_s.cwiseAbs().maxCoeff() >=
+                                          p.saturation_fraction * p.gyro_range_rad_s;
+  r.acc_saturated =
+      sample.acc_body_m_s2.cwiseAbs().maxCoeff() >= p.saturation_fraction * p.acc_range_m_s2;
+  r.gap = dt > p.max_gap_s;
+  if (r.gyro_saturated | r.acc_saturated | r.gap) [[unlikely]] {
+    counts.gyro_saturated += r.gyro_saturated ? 1u : 0u;
+    counts.acc_saturated += r.acc_saturated ? 1u : 0u;
+    counts.gaps += r.gap ? 1u : 0u;
+  }
+  return r;
+}
 
 /// The body's rotation over one sample interval from the rates at both ends (trapezoidal rate,
 /// exact rotation): q such that v_reference = q v_body_after for a vector expressed in the body

@@ -356,8 +356,8 @@ struct PdrOutput {
 class Pdr {
  public:
   using Params = PdrParams;
-  struct Diagnostics {
-    unsigned rejected_non_finite = 0;
+  /// The IMU gate's counts (gate_imu_sample; the gyro may be missing) and the PDR's own.
+  struct Diagnostics : ImuGateCounts {
     unsigned switches = 0;           ///< pose switches detected by cross-correlation
     unsigned pose_changes = 0;       ///< classified pose changes applied
     unsigned replaced_headings = 0;  ///< steps that used the pre-switch heading

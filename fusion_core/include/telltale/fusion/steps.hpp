@@ -33,12 +33,12 @@ struct StepEvent {
   double interval_s = 0.0;  ///< time since the previous step (0 for the first one)
 };
 
-struct StepDiagnostics {
-  unsigned rejected_non_finite = 0;  ///< samples with NaN/Inf time or accelerometer
-  unsigned rejected_time = 0;        ///< samples whose time did not advance
-  unsigned rejected_timing = 0;      ///< candidate steps refused by the time threshold
-  unsigned rejected_amplitude = 0;   ///< candidate steps refused by the amplitude conditions
-  bool gyro_used = false;            ///< the last accepted sample carried a finite gyro
+/// The gate's counts (gate_imu_sample: NaN/Inf time or accelerometer, time not advancing; a
+/// NaN gyro is not a rejection here) and the detector's own.
+struct StepDiagnostics : ImuGateCounts {
+  unsigned rejected_timing = 0;     ///< candidate steps refused by the time threshold
+  unsigned rejected_amplitude = 0;  ///< candidate steps refused by the amplitude conditions
+  bool gyro_used = false;           ///< the last accepted sample carried a finite gyro
 };
 
 /// Fixed-capacity sliding window over time that keeps the mean of its positive samples and the
