@@ -56,7 +56,7 @@ void AlarmService::publish(const std::vector<AlarmEvent>& changed) {
   }
   for (const auto& boat : boats) {
     if (auto view = fleet_.set_alarm_state(boat, to_string(engine_.level_of(boat))))
-      hub_.publish_sample(boat, boat_json(*view));
+      hub_.publish_sample(boat, [v = std::move(*view)] { return boat_json(v); });
   }
 }
 

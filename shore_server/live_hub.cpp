@@ -35,8 +35,16 @@ void LiveHub::disconnect(const std::shared_ptr<Client>& client) {
   clients_.erase(std::remove(clients_.begin(), clients_.end(), client), clients_.end());
 }
 
-void LiveHub::publish_sample(const std::string& key, const std::string& data) {
-  auto f = frame("sample", data);  // built outside the lock
+const std::string& LiveHub::LazyFrame::text() const {
+  std::call_once(once_, [this] {
+    text_ = *frame("sample", render_());
+    render_ = nullptr;  // what it captured (a boat's view) is not needed any more
+  });
+  return text_;
+}
+
+void LiveHub::publish_sample(const std::string& key, std::function<std::string()> render) {
+  auto f = std::make_shared<const LazyFrame>(std::move(render));
   std::lock_guard lock(mutex_);
   Latest& l = latest_[key];
   l.version = ++version_;
@@ -98,12 +106,16 @@ std::string LiveHub::wait(Client& client, std::chrono::milliseconds timeout, boo
   }
   for (const auto& e : client.events_) out += *e;
   client.events_.clear();
+  // Under the lock only the list of what changed; the frames are rendered and joined after it.
+  std::vector<std::shared_ptr<const LazyFrame>> changed;
   for (const auto& [key, l] : latest_) {
     if (l.version <= client.seen_version_) continue;
     if (client.only_key_ && *client.only_key_ != key) continue;
-    out += *l.frame;
+    changed.push_back(l.frame);
   }
   client.seen_version_ = version_;
+  lock.unlock();
+  for (const auto& f : changed) out += f->text();
   return out;
 }
 

@@ -7,14 +7,19 @@
 /// short lock and wakes nobody. Each client takes, at most once per frame interval (default
 /// 40 ms = the boats' 25 Hz), every key that changed since its previous batch: a slow client skips
 /// intermediate samples, it never queues them. Events (alarms, athletes) are queued per client
-/// (bounded, the oldest dropped and reported as `overflow`) and wake the client at once. Frames
-/// are serialised once per publish and shared between clients.
+/// (bounded, the oldest dropped and reported as `overflow`) and wake the client at once.
+///
+/// A sample's frame is rendered lazily: publishing stores how to render it, and the first client
+/// that sends it renders it (once; later clients share the text), outside the hub's lock. A boat
+/// publishing at 25 Hz to dashboards that take 10 frames a second is rendered 10 times a second,
+/// not 25, and the live worker that publishes never pays for JSON.
 
 #include <chrono>
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -37,8 +42,9 @@ class LiveHub {
   std::shared_ptr<Client> connect(std::optional<std::string> only_key = std::nullopt);
   void disconnect(const std::shared_ptr<Client>& client);
 
-  /// Replaces the latest sample of `key`. `data` is the JSON payload.
-  void publish_sample(const std::string& key, const std::string& data);
+  /// Replaces the latest sample of `key`. `render` makes its JSON payload when a client first
+  /// sends it (on that client's thread; it must not throw).
+  void publish_sample(const std::string& key, std::function<std::string()> render);
   /// Drops the latest sample of `key` (a boat the fleet model forgot).
   void forget(const std::string& key);
   /// Queues an event of SSE type `type` about `key` for every client that may see it.
@@ -54,9 +60,20 @@ class LiveHub {
   [[nodiscard]] std::size_t clients() const;
 
  private:
+  /// A sample's SSE frame, rendered by the first client that needs it.
+  class LazyFrame {
+   public:
+    explicit LazyFrame(std::function<std::string()> render) : render_(std::move(render)) {}
+    const std::string& text() const;
+
+   private:
+    mutable std::function<std::string()> render_;
+    mutable std::once_flag once_;
+    mutable std::string text_;
+  };
   struct Latest {
     std::uint64_t version = 0;
-    std::shared_ptr<const std::string> frame;
+    std::shared_ptr<const LazyFrame> frame;
   };
   [[nodiscard]] bool pending(const Client& c) const;
 

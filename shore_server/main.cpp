@@ -164,9 +164,9 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
     std::vector<std::pair<AttitudeSample, std::uint64_t>> batch;
     while (live.take(batch)) {
       for (const auto& [s, arrival_utc] : batch) {
-        const BoatView view = fleet.update(s, std::chrono::steady_clock::now(), arrival_utc);
+        BoatView view = fleet.update(s, std::chrono::steady_clock::now(), arrival_utc);
         alarms.on_sample(s, view.status ? view.status->group : std::string());
-        hub.publish_sample(s.boat_id, boat_json(view));
+        hub.publish_sample(s.boat_id, [v = std::move(view)] { return boat_json(v); });
       }
     }
   });
@@ -224,7 +224,7 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
   std::map<std::pair<std::string, std::uint64_t>, std::uint64_t> receipt_sent;  // (boat, run)
   while (!shutdown.wait_for(std::chrono::milliseconds(200))) {
     for (const auto& v : fleet.sweep(std::chrono::steady_clock::now()))
-      hub.publish_sample(v.last.boat_id, boat_json(v));
+      hub.publish_sample(v.last.boat_id, [v] { return boat_json(v); });
     for (const auto& a : fleet.sweep_athletes(std::chrono::steady_clock::now()))
       hub.publish_event("wearable", to_json_text(athlete_object(a)), a.last.athlete_id);
     const bool repeat = ++tick % 5 == 0;

@@ -57,7 +57,7 @@ TEST(FleetBounds, SilentBoatsAreForgottenAndTheModelIsCapped) {
 TEST(LiveHubBounds, ForgottenBoatsLeaveTheHub) {
   LiveHub hub(4, 16, std::chrono::milliseconds(10));
   auto c = hub.connect();
-  hub.publish_sample("gone", "{}");
+  hub.publish_sample("gone", [] { return std::string("{}"); });
   hub.forget("gone");
   bool closed = false;
   EXPECT_EQ(hub.wait(*c, std::chrono::milliseconds(50), closed), "");

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+
 namespace telltale::shore {
 namespace {
 
@@ -20,8 +22,8 @@ TEST(LiveHub, SlowClientGetsLatestPerBoat) {
   auto c = hub.connect();
   ASSERT_TRUE(c);
   for (int i = 0; i < 100; ++i) {
-    hub.publish_sample("A", "{\"v\":" + std::to_string(i) + "}");
-    hub.publish_sample("B", "{\"w\":" + std::to_string(i) + "}");
+    hub.publish_sample("A", [i] { return "{\"v\":" + std::to_string(i) + "}"; });
+    hub.publish_sample("B", [i] { return "{\"w\":" + std::to_string(i) + "}"; });
   }
   hub.publish_event("alarm", "{\"e\":1}", "A");
   bool closed = false;
@@ -33,12 +35,34 @@ TEST(LiveHub, SlowClientGetsLatestPerBoat) {
   EXPECT_EQ(count(out, "event: alarm"), 1);
   EXPECT_TRUE(hub.wait(*c, 1ms, closed).empty());
   // The next batch comes no sooner than one frame interval later, with only what changed.
-  hub.publish_sample("B", "{\"w\":100}");
+  hub.publish_sample("B", [] { return std::string("{\"w\":100}"); });
   const auto t0 = std::chrono::steady_clock::now();
   const std::string next = hub.wait(*c, 500ms, closed);
   EXPECT_GE(std::chrono::steady_clock::now() - t0, 30ms);
   EXPECT_EQ(count(next, "event: sample"), 1);
   EXPECT_NE(next.find("{\"w\":100}"), std::string::npos);
+}
+
+// Given 100 samples of a boat published between two batches and two clients, then the frame is
+// rendered once: not for the 99 samples no client sent, and not again for the second client.
+TEST(LiveHub, FramesAreRenderedOnlyWhenSentAndOnceForAllClients) {
+  LiveHub hub(4, 3);
+  auto a = hub.connect();
+  auto b = hub.connect();
+  std::atomic<int> renders{0};
+  for (int i = 0; i < 100; ++i) {
+    hub.publish_sample("A", [i, &renders] {
+      ++renders;
+      return "{\"v\":" + std::to_string(i) + "}";
+    });
+  }
+  EXPECT_EQ(renders.load(), 0) << "rendered before any client asked";
+  bool closed = false;
+  const std::string first = hub.wait(*a, 100ms, closed);
+  const std::string second = hub.wait(*b, 100ms, closed);
+  EXPECT_EQ(renders.load(), 1);
+  EXPECT_EQ(first, second);
+  EXPECT_NE(first.find("{\"v\":99}"), std::string::npos) << first;
 }
 
 TEST(LiveHub, EventOverflowIsReported) {
@@ -57,7 +81,7 @@ TEST(LiveHub, BoundedClientsFilterAndClose) {
   auto athlete = hub.connect(std::string("A"));
   auto coach = hub.connect();
   EXPECT_FALSE(hub.connect());  // full
-  hub.publish_sample("B", "{}");
+  hub.publish_sample("B", [] { return std::string("{}"); });
   hub.publish_event("alarm", "{}", "B");
   bool closed = false;
   EXPECT_TRUE(hub.wait(*athlete, 50ms, closed).empty());
