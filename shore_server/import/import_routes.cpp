@@ -120,6 +120,36 @@ void register_import_routes(httplib::Server& server, ShoreContext& ctx,
     res.set_content(to_json_text(json{{"id", id}, {"state", "running"}}), "application/json");
   });
 
+  server.Get("/api/v1/imports", [&ctx, &imports](const httplib::Request& req,
+                                                 httplib::Response& res) {
+    const Principal p = who(ctx, req);
+    allow_params(req, {"boat", "session", "limit"});
+    std::optional<std::string> boat;
+    if (const std::string* b = param(req, "boat")) {
+      if (!valid_id(*b)) throw HttpError(400, "boat id must be 1-32 of [A-Za-z0-9_-]");
+      boat = *b;
+    }
+    if (p.role == Role::kAthlete) {
+      if (boat && *boat != p.boat_id) throw HttpError(403, "an athlete sees only their own boat");
+      boat = p.boat_id;
+    }
+    std::optional<std::int64_t> session;
+    if (const std::string* s = param(req, "session")) {
+      session = parse_int(*s, 1, INT64_MAX);
+      if (!session) throw HttpError(400, "session must be a positive integer");
+    }
+    std::int64_t limit = 100;
+    if (const std::string* l = param(req, "limit")) {
+      const auto n = parse_int(*l, 1, 1000);
+      if (!n) throw HttpError(400, "limit must be an integer in 1..1000");
+      limit = *n;
+    }
+    json out = json::array();
+    for (const auto& r : imports.list(boat, session, static_cast<std::size_t>(limit)))
+      out.push_back(import_json(r));
+    res.set_content(to_json_text(out), "application/json");
+  });
+
   server.Get(R"(/api/v1/imports/([^/]+))",
              [&ctx, &imports](const httplib::Request& req, httplib::Response& res) {
                const Principal p = who(ctx, req);

@@ -5,7 +5,8 @@
 /// spool folder, at most HttpConfig::max_import_bytes): 202 {"id": N, "state": "running"}.
 /// GET /api/v1/imports/{id}: state (running | done | failed), bytes read of bytes, format,
 /// device, sessions, points, samples and fixes added, events, error, partial reason,
-/// duplicate_of. `import_json` is the one JSON view of an import (routes and stream events).
+/// duplicate_of. GET /api/v1/imports?boat&session&limit: the imports, newest first (a session's
+/// sources: `session=N`). `import_json` is the one JSON view of an import (routes and events).
 
 #include <httplib.h>
 

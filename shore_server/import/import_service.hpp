@@ -36,6 +36,12 @@ class ImportService {
   std::int64_t submit(ImportRequest request, std::uint64_t bytes);
   /// The import as it stands: running with its progress, or its result. nullopt: no such id.
   [[nodiscard]] std::optional<ImportRecord> status(std::int64_t id);
+  /// See ImportStore::list.
+  [[nodiscard]] std::vector<ImportRecord> list(const std::optional<std::string>& boat_id,
+                                               std::optional<std::int64_t> session,
+                                               std::size_t limit) {
+    return store_.list(boat_id, session, limit);
+  }
 
  private:
   void worker_loop();

@@ -457,4 +457,23 @@ std::optional<ImportRecord> ImportStore::get(std::int64_t id) {
   return out;
 }
 
+std::vector<ImportRecord> ImportStore::list(const std::optional<std::string>& boat_id,
+                                            std::optional<std::int64_t> session, std::size_t limit) {
+  std::vector<std::int64_t> ids;
+  store_.read([&](sqlite3* db) {
+    Sql q(db,
+          "SELECT id FROM imports WHERE (?1 IS NULL OR boat_id = ?1) AND (?2 IS NULL OR id IN "
+          "(SELECT import_id FROM import_sessions WHERE session_id = ?2)) ORDER BY id DESC "
+          "LIMIT ?3");
+    if (boat_id) q.s(1, *boat_id);
+    if (session) q.i(2, *session);
+    q.i(3, static_cast<std::int64_t>(limit));
+    while (q.step()) ids.push_back(q.col_i(0));
+  });
+  std::vector<ImportRecord> out;
+  for (const std::int64_t id : ids)
+    if (auto r = get(id)) out.push_back(std::move(*r));
+  return out;
+}
+
 }  // namespace telltale::shore::import

@@ -76,6 +76,11 @@ class ImportStore {
   void fail_unfinished();
   /// An import as recorded; nullopt if there is no such id.
   [[nodiscard]] std::optional<ImportRecord> get(std::int64_t id);
+  /// Imports (of one boat, or all), newest first, at most `limit`; `session`: only those that
+  /// stored into that session.
+  [[nodiscard]] std::vector<ImportRecord> list(const std::optional<std::string>& boat_id,
+                                               std::optional<std::int64_t> session,
+                                               std::size_t limit);
 
  private:
   void finish(const ImportRecord& r);

@@ -119,6 +119,13 @@ TEST_F(ImportTest, AtlasCsvBecomesAReviewableSessionAndReimportChangesNothing) {
   EXPECT_EQ(again["samples_added"], 0);
   EXPECT_EQ(again["sessions"], done["sessions"]);
   EXPECT_EQ(get_json("/api/v1/sessions?boat=ILCA-7").size(), 1u);
+  // The session's sources: both uploads of the file, newest first.
+  const auto sources = get_json("/api/v1/imports?session=" + std::to_string(session));
+  ASSERT_TRUE(sources.is_array());
+  ASSERT_EQ(sources.size(), 2u);
+  EXPECT_EQ(sources[1]["id"], id);
+  EXPECT_EQ(sources[1]["file_name"], "race1.csv");
+  EXPECT_EQ(sources[1]["sha256"].get<std::string>().size(), 64u);
 
   EXPECT_TRUE(eventually([&] { return saw_running.load() && saw_done.load(); },
                          std::chrono::seconds(5)));
