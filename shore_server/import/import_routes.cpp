@@ -7,6 +7,7 @@
 #include "json_views.hpp"
 #include "query.hpp"
 #include "route_helpers.hpp"
+#include "time_zone.hpp"
 
 namespace telltale::shore {
 namespace {
@@ -69,10 +70,16 @@ void register_import_routes(httplib::Server& server, ShoreContext& ctx,
     }
     if (const std::string* tz = param(req, "tz")) {
       r.options.utc_offset_s = import::parse_utc_offset(*tz);
-      if (!r.options.utc_offset_s)
-        throw HttpError(400,
-                        "tz must be a UTC offset such as +01:00, -0700 or UTC (zone names are not "
-                        "read yet)");
+      if (!r.options.utc_offset_s) {
+        auto zone = import::TimeZone::load(*tz);
+        if (!zone)
+          throw HttpError(400,
+                          "tz must be a time zone such as Europe/Madrid or a UTC offset such as "
+                          "+01:00, -0700 or UTC");
+        r.options.local_offset_s = [z = std::move(*zone)](std::int64_t local_s) {
+          return z.offset_at_local(local_s);
+        };
+      }
     }
     if (const std::string* d = param(req, "date")) {
       bool zone = false;

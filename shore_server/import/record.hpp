@@ -7,6 +7,7 @@
 /// north in [0, 360), SOG in m/s, time UTC in ns since 1970.
 
 #include <cstdint>
+#include <functional>
 #include <istream>
 #include <limits>
 #include <optional>
@@ -41,6 +42,9 @@ struct ImportOptions {
   /// Offset from UTC of local times without one (Atlas CSV's older dialect); nullopt: such a file
   /// is refused, never guessed.
   std::optional<std::int64_t> utc_offset_s;
+  /// Else the offset of a time zone, given the local time (seconds since 1970 read as if local
+  /// were UTC): time_zone.hpp's TimeZone::offset_at_local. Empty: none.
+  std::function<std::int64_t(std::int64_t)> local_offset_s;
   double heel_offset_deg = 0.0;   ///< subtracted from every heel (the instrument's zero)
   double pitch_offset_deg = 0.0;  ///< subtracted from every pitch (Atlas trim reads ~+6 at rest)
   /// East positive; used for magnetic headings when the file states no declination. NaN: none.

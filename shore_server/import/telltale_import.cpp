@@ -169,7 +169,7 @@ int main(int argc, char** argv) {
   app.add_option("--boat", o.boat, "the boat the files belong to")->required();
   app.add_option("--format", o.format, "force the format instead of reading it from the content")
       ->check(CLI::IsMember({"vakaros_csv", "vkx", "vtk", "nmea", "gpx"}));
-  app.add_option("--tz", o.tz, "UTC offset of local times without one (+01:00, -0700, UTC)");
+  app.add_option("--tz", o.tz, "time zone of local times without an offset (Europe/Madrid, +01:00, UTC)");
   app.add_option("--date", o.date, "UTC date (YYYY-MM-DD) of NMEA logs that state none");
   app.add_option("--heel-offset", o.heel_offset, "degrees subtracted from every heel")
       ->check(CLI::Range(-45.0, 45.0));

@@ -133,11 +133,22 @@ ParseResult parse_vakaros_csv(std::istream& in, const ImportOptions& options, Im
       return std::nullopt;
     };
     bool had_zone = false;
-    const auto t = parse_iso_time(cells[static_cast<std::size_t>(col[kTime])],
-                                  options.utc_offset_s, &had_zone);
+    auto t = parse_iso_time(cells[static_cast<std::size_t>(col[kTime])], options.utc_offset_s,
+                            &had_zone);
+    if (!t && options.local_offset_s) {
+      // Local time in a named zone: read as if UTC, then moved by the zone's offset at that time.
+      t = parse_iso_time(cells[static_cast<std::size_t>(col[kTime])], 0, &had_zone);
+      if (t && !had_zone) {
+        const std::int64_t local_s = static_cast<std::int64_t>(*t / 1'000'000'000ULL);
+        const std::int64_t utc_ns =
+            static_cast<std::int64_t>(*t) - options.local_offset_s(local_s) * 1'000'000'000LL;
+        t = utc_ns > 0 ? std::optional<std::uint64_t>(static_cast<std::uint64_t>(utc_ns))
+                       : std::nullopt;
+      }
+    }
     if (!t) {
       const auto probe = parse_iso_time(cells[static_cast<std::size_t>(col[kTime])], 0, &had_zone);
-      if (probe && !had_zone && !options.utc_offset_s)
+      if (probe && !had_zone && !options.utc_offset_s && !options.local_offset_s)
         return fail(line_no, "time '" + std::string(cells[static_cast<std::size_t>(col[kTime])]) +
                                  "' has no UTC offset: give the time zone of the recording (tz)");
       return fail(line_no, "timestamp '" + std::string(cells[static_cast<std::size_t>(col[kTime])]) +

@@ -4,7 +4,8 @@
 /// - `timestamp,latitude,longitude,sog_kts,cog,hdg_true,heel,trim` with local time and its UTC
 ///   offset (`2026-02-08T11:56:40.049+0100`);
 /// - the older `timestamp,latitude,longitude,sog_kts,cog,hdg_true,roll,pitch[,load_...]` whose time
-///   has no offset: the import needs ImportOptions::utc_offset_s, and is refused without it.
+///   has no offset: the import needs ImportOptions::utc_offset_s or local_offset_s (a named time
+///   zone, summer time included), and is refused without one.
 /// Columns are found by name (any case, any order, extra columns ignored); CRLF or LF; a UTF-8
 /// byte order mark is skipped; blank rows and spreadsheet padding (rows of commas, trailing empty
 /// cells) are passed over and counted. SOG in knots becomes m/s; heel/roll is + starboard down and
