@@ -241,12 +241,39 @@ constexpr const char* kEventColumns =
 
 }  // namespace
 
+/// One read-only connection, taken from the idle ones for the lease's scope.
+class Store::ReadLease {
+ public:
+  explicit ReadLease(Store& store) : store_(store) {
+    std::unique_lock lock(store_.readers_mutex_);
+    store_.reader_idle_.wait(lock, [&] { return !store_.idle_readers_.empty(); });
+    db_ = store_.idle_readers_.back();
+    store_.idle_readers_.pop_back();
+  }
+  ~ReadLease() {
+    {
+      std::lock_guard lock(store_.readers_mutex_);
+      store_.idle_readers_.push_back(db_);
+    }
+    store_.reader_idle_.notify_one();
+  }
+  ReadLease(const ReadLease&) = delete;
+  ReadLease& operator=(const ReadLease&) = delete;
+  [[nodiscard]] sqlite3* db() const { return db_; }
+
+ private:
+  Store& store_;
+  sqlite3* db_ = nullptr;
+};
+
 Store::Store(StoreConfig config) : config_(std::move(config)) {
   db_ = open_db(config_.path, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
   try {
     exec(db_, kSchema);
     migrate(db_);
-    reader_ = open_db(config_.path, SQLITE_OPEN_READONLY);
+    for (std::size_t i = 0; i < kReaders; ++i)
+      readers_.push_back(open_db(config_.path, SQLITE_OPEN_READONLY));
+    idle_readers_ = readers_;
     if (sqlite3_prepare_v2(db_,
                            "INSERT OR IGNORE INTO attitude (boat_id, t_utc_ns, seq, heel_deg, "
                            "pitch_deg, heading_deg, heel_rate_deg_s, pitch_rate_deg_s, "
@@ -255,7 +282,7 @@ Store::Store(StoreConfig config) : config_(std::move(config)) {
                            -1, &insert_, nullptr) != SQLITE_OK)
       throw StoreError(sqlite3_errmsg(db_));
   } catch (const StoreError& e) {
-    sqlite3_close(reader_);
+    for (auto* r : readers_) sqlite3_close(r);
     sqlite3_close(db_);
     throw StoreError("database " + config_.path + ": " + e.what());
   }
@@ -300,7 +327,7 @@ Store::~Store() {
                  "never acknowledged, the boats resend them from their logs.\n",
                  static_cast<unsigned long long>(dropped_));
   sqlite3_finalize(insert_);
-  sqlite3_close(reader_);
+  for (auto* r : readers_) sqlite3_close(r);
   sqlite3_close(db_);  // the last connection checkpoints and removes the WAL
 }
 
@@ -402,8 +429,8 @@ bool Store::commit_fixes(const std::vector<FixSample>& batch) {
 
 std::vector<FixSample> Store::fix_page(const std::string& boat_id, std::uint64_t after_ns,
                                        std::uint64_t to_ns, std::size_t limit) {
-  std::lock_guard lock(reader_mutex_);
-  Stmt q(reader_,
+  const ReadLease reader(*this);
+  Stmt q(reader.db(),
          "SELECT t_utc_ns, seq, gnss_utc_ns, lat_deg, lon_deg, sog_m_s, cog_deg, fix, satellites, "
          "hdop, boot_id FROM fixes WHERE boat_id = ? AND t_utc_ns > ? AND t_utc_ns <= ? AND "
          "fix <> 'none' ORDER BY t_utc_ns LIMIT ?");
@@ -498,8 +525,8 @@ FixStats Store::fix_stats(const std::string& boat_id, std::uint64_t from_ns, std
 std::vector<WearableSample> Store::wearable_track(const std::string& athlete_id,
                                                   std::uint64_t from_ns, std::uint64_t to_ns,
                                                   std::size_t limit) {
-  std::lock_guard lock(reader_mutex_);
-  Stmt q(reader_,
+  const ReadLease reader(*this);
+  Stmt q(reader.db(),
          "SELECT t_utc_ns, seq, steps, cadence_spm, gait, pose, x_m, y_m, heading_deg, "
          "distance_m FROM wearable WHERE athlete_id = ? AND t_utc_ns >= ? AND "
          "t_utc_ns <= ? ORDER BY t_utc_ns LIMIT ?");
@@ -703,8 +730,8 @@ void Store::write_transaction(const std::function<void(sqlite3*)>& work) {
 }
 
 void Store::read(const std::function<void(sqlite3*)>& work) {
-  std::lock_guard lock(reader_mutex_);
-  work(reader_);
+  const ReadLease reader(*this);
+  work(reader.db());
 }
 
 void Store::extend_session(const std::string& boat_id, std::uint64_t t_ns) {
@@ -920,11 +947,11 @@ void Store::apply_retention() {
 
 std::vector<SessionInfo> Store::sessions(const std::optional<std::string>& boat_id,
                                          std::uint64_t from_ns, std::uint64_t to_ns) {
-  std::lock_guard lock(reader_mutex_);
+  const ReadLease reader(*this);
   const std::string sql = std::string("SELECT ") + kSessionColumns +
                           " FROM sessions WHERE (?1 IS NULL OR boat_id = ?1) AND end_ns >= ?2 "
                           "AND start_ns <= ?3 ORDER BY start_ns DESC LIMIT 10000";
-  Stmt q(reader_, sql.c_str());
+  Stmt q(reader.db(), sql.c_str());
   if (boat_id) q.bind(1, *boat_id);
   q.bind_u(2, from_ns).bind_u(3, to_ns);
   std::vector<SessionInfo> out;
@@ -933,25 +960,25 @@ std::vector<SessionInfo> Store::sessions(const std::optional<std::string>& boat_
 }
 
 std::optional<SessionInfo> Store::session(std::int64_t id) {
-  std::lock_guard lock(reader_mutex_);
+  const ReadLease reader(*this);
   const std::string sql = std::string("SELECT ") + kSessionColumns + " FROM sessions WHERE id = ?";
-  Stmt q(reader_, sql.c_str());
+  Stmt q(reader.db(), sql.c_str());
   q.bind(1, id);
   if (!q.step()) return std::nullopt;
   return session_from(q);
 }
 
 bool Store::knows_boat(const std::string& boat_id) {
-  std::lock_guard lock(reader_mutex_);
-  Stmt q(reader_, "SELECT 1 FROM sessions WHERE boat_id = ? LIMIT 1");
+  const ReadLease reader(*this);
+  Stmt q(reader.db(), "SELECT 1 FROM sessions WHERE boat_id = ? LIMIT 1");
   q.bind(1, boat_id);
   return q.step();
 }
 
 std::vector<AttitudeRow> Store::attitude_page(const std::string& boat_id, std::uint64_t after_ns,
                                               std::uint64_t to_ns, std::size_t limit) {
-  std::lock_guard lock(reader_mutex_);
-  Stmt q(reader_,
+  const ReadLease reader(*this);
+  Stmt q(reader.db(),
          "SELECT t_utc_ns, seq, heel_deg, pitch_deg, heading_deg, heel_rate_deg_s, "
          "pitch_rate_deg_s, yaw_rate_deg_s, accel_weight, quality FROM attitude "
          "WHERE boat_id = ? AND t_utc_ns > ? AND t_utc_ns <= ? ORDER BY t_utc_ns LIMIT ?");
@@ -977,8 +1004,8 @@ void Store::visit_attitude(const std::string& boat_id, std::uint64_t from_ns, st
 }
 
 std::int64_t Store::count(const std::string& boat_id) {
-  std::lock_guard lock(reader_mutex_);
-  Stmt q(reader_, "SELECT COUNT(*) FROM attitude WHERE boat_id = ?");
+  const ReadLease reader(*this);
+  Stmt q(reader.db(), "SELECT COUNT(*) FROM attitude WHERE boat_id = ?");
   q.bind(1, boat_id);
   return q.step() ? q.i64(0) : 0;
 }
@@ -1007,8 +1034,8 @@ void Store::save_rules(const std::vector<AlarmRule>& rules) {
 }
 
 std::vector<AlarmRule> Store::load_rules() {
-  std::lock_guard lock(reader_mutex_);
-  Stmt q(reader_,
+  const ReadLease reader(*this);
+  Stmt q(reader.db(),
          "SELECT id, scope, quantity, min_deg, max_deg, hold_s, hysteresis_deg, level, "
          "enabled FROM alarm_rules ORDER BY position");
   std::vector<AlarmRule> out;
@@ -1041,12 +1068,12 @@ void Store::save_event(const AlarmEvent& e) {
 }
 
 std::vector<AlarmEvent> Store::events(const EventFilter& f) {
-  std::lock_guard lock(reader_mutex_);
+  const ReadLease reader(*this);
   const std::string sql = std::string("SELECT ") + kEventColumns +
                           " FROM alarm_events WHERE (?1 IS NULL OR boat_id = ?1) AND raised_ns "
                           ">= ?2 AND raised_ns <= ?3 AND (?4 = 0 OR phase != 'cleared') "
                           "ORDER BY raised_ns DESC, id DESC LIMIT ?5";
-  Stmt q(reader_, sql.c_str());
+  Stmt q(reader.db(), sql.c_str());
   if (f.boat_id) q.bind(1, *f.boat_id);
   q.bind_u(2, f.from_ns).bind_u(3, f.to_ns).bind(4, std::int64_t{f.active_only ? 1 : 0});
   q.bind(5, static_cast<std::int64_t>(f.limit));
@@ -1056,18 +1083,18 @@ std::vector<AlarmEvent> Store::events(const EventFilter& f) {
 }
 
 std::optional<AlarmEvent> Store::event(std::uint64_t id) {
-  std::lock_guard lock(reader_mutex_);
+  const ReadLease reader(*this);
   const std::string sql =
       std::string("SELECT ") + kEventColumns + " FROM alarm_events WHERE id = ?";
-  Stmt q(reader_, sql.c_str());
+  Stmt q(reader.db(), sql.c_str());
   q.bind_u(1, id);
   if (!q.step()) return std::nullopt;
   return event_from(q);
 }
 
 std::uint64_t Store::max_event_id() {
-  std::lock_guard lock(reader_mutex_);
-  Stmt q(reader_, "SELECT COALESCE(MAX(id), 0) FROM alarm_events");
+  const ReadLease reader(*this);
+  Stmt q(reader.db(), "SELECT COALESCE(MAX(id), 0) FROM alarm_events");
   return q.step() ? q.u64(0) : 0;
 }
 

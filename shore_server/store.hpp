@@ -197,7 +197,7 @@ class Store {
   /// exception goes on). The cached open sessions are re-read from disk afterwards, as `work` may
   /// have changed sessions. For imports: a whole file is stored, or nothing of it.
   void write_transaction(const std::function<void(sqlite3*)>& work);
-  /// Runs `work` on the read-only connection.
+  /// Runs `work` on one of the read-only connections.
   void read(const std::function<void(sqlite3*)>& work);
   [[nodiscard]] std::chrono::seconds session_gap() const { return config_.session_gap; }
 
@@ -247,10 +247,17 @@ class Store {
 
   StoreConfig config_;
   sqlite3* db_ = nullptr;      ///< writer connection (samples, sessions, alarms)
-  sqlite3* reader_ = nullptr;  ///< read-only connection for queries
   sqlite3_stmt* insert_ = nullptr;
   std::mutex db_mutex_;                               ///< serialises use of db_
-  std::mutex reader_mutex_;                           ///< serialises use of reader_
+  /// Read-only connections for queries. SQLite's WAL lets them read side by side and beside the
+  /// writer, so a long export no longer queues every chart request behind it: a query takes an
+  /// idle one (ReadLease) or waits for one.
+  static constexpr std::size_t kReaders = 4;
+  class ReadLease;
+  std::vector<sqlite3*> readers_;
+  std::vector<sqlite3*> idle_readers_;
+  std::mutex readers_mutex_;
+  std::condition_variable reader_idle_;
   std::map<std::string, SessionInfo> open_sessions_;  ///< latest session per boat (writer only)
   std::set<std::string> dirty_sessions_;              ///< open sessions changed in this batch
 

@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <future>
 #include <thread>
 
 namespace telltale::shore {
@@ -256,6 +257,30 @@ TEST_F(StoreTest, RetentionGoesByArrivalNotByTheBoatsClock) {
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   EXPECT_EQ(store.count("late"), 0);
   EXPECT_TRUE(store.sessions(std::string("late"), 0, UINT64_MAX).empty());
+}
+
+// Given a slow reader holding a read connection (an export streaming a long session), then other
+// queries still answer at once: the store reads through a pool of connections, not one behind a
+// mutex (where every chart request queued behind the export).
+TEST_F(StoreTest, ASlowReadDoesNotHoldUpOtherQueries) {
+  Store store(config());
+  store.enqueue(sample("q", 1, 1, kT0));
+  store.flush();
+  std::promise<void> holding;
+  std::promise<void> release;
+  std::thread slow([&] {
+    store.read([&](sqlite3*) {
+      holding.set_value();
+      release.get_future().wait();
+    });
+  });
+  holding.get_future().wait();
+  auto other = std::async(std::launch::async, [&] { return store.sessions(std::nullopt, 0, UINT64_MAX); });
+  const bool answered = other.wait_for(std::chrono::seconds(2)) == std::future_status::ready;
+  release.set_value();
+  slow.join();
+  ASSERT_TRUE(answered) << "a query waited for the slow reader";
+  EXPECT_EQ(other.get().size(), 1u);
 }
 
 // Given two nodes sailing with one boat id (two runs interleaving in time), the store flags the
