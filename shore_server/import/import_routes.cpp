@@ -7,7 +7,9 @@
 #include "json_views.hpp"
 #include "query.hpp"
 #include "route_helpers.hpp"
+#include "detect.hpp"
 #include "time_zone.hpp"
+#include "vtk.hpp"
 
 namespace telltale::shore {
 namespace {
@@ -61,9 +63,8 @@ void register_import_routes(httplib::Server& server, ShoreContext& ctx,
                        "name"});
     import::ImportRequest r;
     const std::string* boat = param(req, "boat");
-    if (!boat) throw HttpError(400, "boat is required: the boat the file belongs to");
-    if (!valid_id(*boat)) throw HttpError(400, "boat id must be 1-32 of [A-Za-z0-9_-]");
-    r.boat_id = *boat;
+    if (boat && !valid_id(*boat)) throw HttpError(400, "boat id must be 1-32 of [A-Za-z0-9_-]");
+    if (boat) r.boat_id = *boat;
     if (const std::string* f = param(req, "format")) {
       r.format = import::parse_format(*f);
       if (!r.format) throw HttpError(400, "format must be one of vakaros_csv, vkx, vtk, nmea, gpx");
@@ -120,6 +121,23 @@ void register_import_routes(httplib::Server& server, ShoreContext& ctx,
     if (bytes == 0) {
       std::remove(r.path.c_str());
       throw HttpError(400, "empty body: send the file as the request body");
+    }
+    if (r.boat_id.empty()) {
+      // No boat given: the device's serial where the file names one (Velocitek VTK).
+      std::string head(import::kDetectBytes, '\0');
+      std::ifstream in(r.path, std::ios::binary);
+      in.read(head.data(), static_cast<std::streamsize>(head.size()));
+      head.resize(static_cast<std::size_t>(in.gcount()));
+      const auto format = r.format ? r.format : import::detect_format(head);
+      const auto serial = format == import::Format::kVtk ? import::vtk_serial_number(head)
+                                                          : std::nullopt;
+      if (!serial) {
+        std::remove(r.path.c_str());
+        throw HttpError(400,
+                        "boat is required: the boat the file belongs to (this file names no "
+                        "device serial to take it from)");
+      }
+      r.boat_id = "velocitek-" + std::to_string(*serial);
     }
     const std::int64_t id = imports.submit(std::move(r), bytes);
     res.status = 202;

@@ -65,7 +65,8 @@ class Progress {
 };
 
 std::string query(const Options& o, const std::string& name) {
-  httplib::Params p{{"boat", o.boat}, {"name", name}};
+  httplib::Params p{{"name", name}};
+  if (!o.boat.empty()) p.emplace("boat", o.boat);
   if (!o.format.empty()) p.emplace("format", o.format);
   if (!o.tz.empty()) p.emplace("tz", o.tz);
   if (!o.date.empty()) p.emplace("date", o.date);
@@ -166,7 +167,9 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingPath);
   app.add_option("--shore", o.shore, "the shore's URL")->capture_default_str();
   app.add_option("--token", o.token, "coach or analyst token (default: $TELLTALE_TOKEN)");
-  app.add_option("--boat", o.boat, "the boat the files belong to")->required();
+  app.add_option("--boat", o.boat,
+                 "the boat the files belong to (without it: the device's serial where a file "
+                 "names one, Velocitek VTK)");
   app.add_option("--format", o.format, "force the format instead of reading it from the content")
       ->check(CLI::IsMember({"vakaros_csv", "vkx", "vtk", "nmea", "gpx"}));
   app.add_option("--tz", o.tz, "time zone of local times without an offset (Europe/Madrid, +01:00, UTC)");

@@ -185,6 +185,29 @@ bool decode_record(const unsigned char* data, std::size_t n, const ImportOptions
 
 }  // namespace
 
+std::optional<std::int64_t> vtk_serial_number(std::string_view data) {
+  const auto* p = reinterpret_cast<const unsigned char*>(data.data());
+  std::size_t off = 0;
+  while (off + 2 <= data.size()) {
+    const std::size_t len = p[off] | static_cast<std::size_t>(p[off + 1]) << 8;
+    if (off + 2 + len > data.size()) break;
+    Wire rec(p + off + 2, len);
+    std::uint32_t field;
+    unsigned type;
+    const unsigned char* body;
+    std::size_t n;
+    if (rec.tag(field, type) && field == 17 && type == 2 && rec.bytes(body, n)) {
+      std::uint64_t v[5] = {};
+      bool has[5] = {};
+      if (flat_varints(body, n, v, has) && has[4] && static_cast<std::int32_t>(v[4]) > 0)
+        return static_cast<std::int32_t>(v[4]);
+      return std::nullopt;
+    }
+    off += 2 + len;
+  }
+  return std::nullopt;
+}
+
 bool looks_like_vtk(std::string_view data) {
   if (data.size() < 3) return false;
   const auto* p = reinterpret_cast<const unsigned char*>(data.data());

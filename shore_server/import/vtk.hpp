@@ -24,6 +24,10 @@ namespace telltale::shore::import {
 [[nodiscard]] ParseResult parse_vtk(std::istream& in, const ImportOptions& options,
                                     ImportSink& sink);
 
+/// The device's serial number from a HardwareDescription record among the whole records at the
+/// start of `data` (the head of a file), for a default boat id; nullopt when there is none.
+[[nodiscard]] std::optional<std::int64_t> vtk_serial_number(std::string_view data);
+
 /// True if `data` holds a whole VTK record at its start whose protobuf decodes (for detection).
 [[nodiscard]] bool looks_like_vtk(std::string_view data);
 

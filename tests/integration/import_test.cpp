@@ -134,6 +134,52 @@ TEST_F(ImportTest, AtlasCsvBecomesAReviewableSessionAndReimportChangesNothing) {
   stream.join();
 }
 
+/// A Velocitek VTK file: its device description (serial 4321), then `n` trackpoints at 1 Hz.
+std::string vtk_file(int n) {
+  auto varint = [](std::string& s, std::uint64_t v) {
+    for (; v >= 0x80; v >>= 7) s.push_back(static_cast<char>((v & 0x7F) | 0x80));
+    s.push_back(static_cast<char>(v));
+  };
+  auto record = [&](unsigned field, const std::string& body) {
+    std::string rec, out;
+    varint(rec, (field << 3) | 2);
+    varint(rec, body.size());
+    rec += body;
+    out.push_back(static_cast<char>(rec.size() & 0xFF));
+    out.push_back(static_cast<char>(rec.size() >> 8));
+    return out + rec;
+  };
+  std::string hw;
+  varint(hw, 4 << 3);
+  varint(hw, 4321);
+  std::string out = record(17, hw);
+  for (int i = 0; i < n; ++i) {
+    std::string tp;
+    varint(tp, 1 << 3);
+    varint(tp, static_cast<std::uint64_t>(kT0s + i));
+    varint(tp, 3 << 3);
+    varint(tp, 2ULL * 395000000);  // zigzag of a positive sint32
+    varint(tp, 4 << 3);
+    varint(tp, 2ULL * 25000000);
+    out += record(1, tp);
+  }
+  return out;
+}
+
+TEST_F(ImportTest, VelocitekFileWithoutABoatGoesToItsSerial) {
+  auto res = upload("name=prostart.vtk", vtk_file(30));
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 202) << res->body;
+  const auto r = finished(nlohmann::json::parse(res->body)["id"].get<std::int64_t>());
+  EXPECT_EQ(r["state"], "done") << r.dump();
+  EXPECT_EQ(r["format"], "vtk");
+  EXPECT_EQ(r["boat_id"], "velocitek-4321");
+  EXPECT_EQ(r["device"], "Velocitek model 0 serial 4321");
+  EXPECT_EQ(r["points"], 30);
+  EXPECT_EQ(r["fixes_added"], 30);
+  EXPECT_EQ(get_json("/api/v1/sessions?boat=velocitek-4321").size(), 1u);
+}
+
 TEST_F(ImportTest, CutFileFailsNamingTheLineAndStoresNothing) {
   std::string csv = atlas_csv(100);
   csv.resize(csv.size() - 20);

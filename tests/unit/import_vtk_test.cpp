@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "import_support.hpp"
+#include "vtk.hpp"
 
 namespace telltale::shore::import {
 namespace {
@@ -86,6 +87,13 @@ TEST(ImportVtk, TrackpointsDeclinationDeviceAndButtons) {
   ASSERT_EQ(sink.events.size(), 1u);
   EXPECT_EQ(sink.events[0].kind, "line_pin");
   EXPECT_EQ(sink.events[0].t_utc_ns, a.t_utc_ns);
+}
+
+TEST(ImportVtk, SerialNumberFromTheHead) {
+  EXPECT_EQ(vtk_serial_number(declination(1) + hardware(4321) + trackpoint(1770548200, 0, 1, 1, 1)),
+            4321);
+  EXPECT_FALSE(vtk_serial_number(trackpoint(1770548200, 0, 1, 1, 1)));
+  EXPECT_FALSE(vtk_serial_number(hardware(4321).substr(0, 4)));  // cut
 }
 
 TEST(ImportVtk, NoDeclinationNoTrueHeading) {
