@@ -2,7 +2,9 @@
 // the shore, and open as sessions in review; a cut file shows its error.
 import assert from 'node:assert/strict';
 import { after, before, test } from 'node:test';
-import { domainFor, eventually, login, screenshots, startBrowser, startFleet } from './harness.mjs';
+import { mkdirSync } from 'node:fs';
+import { join } from 'node:path';
+import { artifacts, domainFor, eventually, login, screenshots, startBrowser, startFleet } from './harness.mjs';
 
 let fleet;
 let browser;
@@ -70,5 +72,33 @@ test('import view: dropped files upload with progress and open in review', async
   await eventually(async () => (await page.locator('.review-body').count()) > 0, { timeoutMs: 10000, what: 'review' });
   await page.waitForTimeout(1500);
   await screenshots(page, 'import-review');
+  assert.deepEqual(browser.problems, []);
+});
+
+test('import view: the progress bar moves while a file uploads', async () => {
+  await login(page, fleet, '#/import');
+  await page.waitForSelector('.drop-zone');
+  await page.fill('#import-boat', 'ILCA-5');
+  // A slow link (250 kB/s up), so the upload is seen under way: 8000 s at 2 Hz, ~1.3 MB.
+  const cdp = await browser.context.newCDPSession(page);
+  await cdp.send('Network.enable');
+  await cdp.send('Network.emulateNetworkConditions',
+    { offline: false, latency: 0, downloadThroughput: -1, uploadThroughput: 250 * 1024 });
+  await drop([{ name: 'long.csv', text: atlasCsv(16000) }]);
+  const item = page.locator('.import-item', { has: page.locator('.import-name', { hasText: 'long.csv' }) });
+  const values = [];
+  await eventually(async () => {
+    const v = Number(await item.locator('progress').getAttribute('value'));
+    values.push(v);
+    return v > 0.1 && v < 0.4;
+  }, { timeoutMs: 15000, intervalMs: 50, what: 'the upload under way' });
+  mkdirSync(artifacts, { recursive: true });
+  await page.screenshot({ path: join(artifacts, 'import-progress-laptop.png') });
+  await cdp.send('Network.emulateNetworkConditions',
+    { offline: false, latency: 0, downloadThroughput: -1, uploadThroughput: -1 });
+  await eventually(async () => (await item.getAttribute('data-state')) === 'done',
+    { timeoutMs: 30000, what: 'long.csv imported' });
+  // The bar only ever moved forward.
+  assert.ok(values.every((v, i) => i === 0 || v >= values[i - 1]), `progress ${values}`);
   assert.deepEqual(browser.problems, []);
 });

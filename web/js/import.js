@@ -38,7 +38,7 @@ export function mountImport(container, { role }) {
     placeholder: 'ILCA-7', autocomplete: 'off' });
   const format = el('select', { id: 'import-format', name: 'format' },
     FORMATS.map((f) => el('option', { value: f, text: f || 'read from the file' })));
-  const tz = el('input', { id: 'import-tz', name: 'tz', placeholder: '+01:00', size: 7 });
+  const tz = el('input', { id: 'import-tz', name: 'tz', placeholder: 'Europe/Madrid or +01:00', size: 12 });
   const pitch = el('input', { id: 'import-pitch', name: 'pitch_offset', type: 'number', step: '0.1', value: '0', size: 5 });
   const picker = el('input', { type: 'file', multiple: true, id: 'import-files', class: 'visually-hidden' });
   const drop = el('label', { class: 'drop-zone', for: 'import-files', tabindex: 0 },
@@ -52,7 +52,7 @@ export function mountImport(container, { role }) {
     el('div', { class: 'import-options' },
       el('label', { for: 'import-boat', text: 'Boat' }), boat,
       el('label', { for: 'import-format', text: 'Format' }), format,
-      el('label', { for: 'import-tz', text: 'UTC offset (files without one)' }), tz,
+      el('label', { for: 'import-tz', text: 'Time zone (files without an offset)' }), tz,
       el('label', { for: 'import-pitch', text: 'Pitch zero (°)' }), pitch),
     note, drop, picker, list));
 
@@ -75,11 +75,15 @@ export function mountImport(container, { role }) {
     try {
       const { id } = await upload(`/imports${q(params)}`, file, (done, total) => {
         bar.value = (0.5 * done) / total;
+        status.textContent = `uploading ${Math.round((100 * done) / total)} %`;
       });
       set('running', 'importing');
       for (;;) {
         const r = await api(`/imports/${id}`);
-        if (r.bytes) bar.value = 0.5 + (0.5 * r.bytes_read) / r.bytes;
+        if (r.bytes) {
+          bar.value = 0.5 + (0.5 * r.bytes_read) / r.bytes;
+          if (r.state === 'running') status.textContent = `importing ${Math.round((100 * r.bytes_read) / r.bytes)} %`;
+        }
         if (r.state === 'done') {
           bar.value = 1;
           set('done', `${r.format}, ${r.points} points${r.duplicate_of ? ' (already imported)' : ''}` +
