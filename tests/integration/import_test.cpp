@@ -180,6 +180,66 @@ TEST_F(ImportTest, VelocitekFileWithoutABoatGoesToItsSerial) {
   EXPECT_EQ(get_json("/api/v1/sessions?boat=velocitek-4321").size(), 1u);
 }
 
+TEST_F(ImportTest, FileOverlappingALiveBoatMergesIntoItsSession) {
+  start_boat("ILCA-6");
+  nlohmann::json live;
+  ASSERT_TRUE(eventually(
+      [&] {
+        live = get_json("/api/v1/sessions?boat=ILCA-6");
+        return live.is_array() && live.size() == 1 && live[0]["samples"].get<int>() > 100;
+      },
+      std::chrono::seconds(20)));
+  boats_.clear();  // the boat stops: its session is what it is
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  live = get_json("/api/v1/sessions?boat=ILCA-6");
+  ASSERT_EQ(live.size(), 1u);
+  const int live_samples = live[0]["samples"];
+  // The same boat's instrument log: from 20 s before the live data to 20 s after, at 2 Hz.
+  const auto start = live[0]["start"].get<std::string>();
+  const auto end = live[0]["end"].get<std::string>();
+  auto secs = [](const std::string& iso) {
+    std::tm tm{};
+    strptime(iso.c_str(), "%Y-%m-%dT%H:%M:%S", &tm);
+    return static_cast<long>(timegm(&tm));
+  };
+  const long from = secs(start) - 20, to = secs(end) + 20;
+  std::string csv = "timestamp,latitude,longitude,sog_kts,cog,hdg_true,heel,trim\n";
+  char line[160];
+  for (long t = from; t <= to; ++t)
+    for (int half = 0; half < 2; ++half) {
+      const std::time_t tt = t;
+      std::tm tm{};
+      gmtime_r(&tt, &tm);
+      std::snprintf(line, sizeof line,
+                    "%04d-%02d-%02dT%02d:%02d:%02d.%03d+00:00,39.5,2.5,5.0,45.0,47.0,4.0,6.0\n",
+                    tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min,
+                    tm.tm_sec, half ? 500 : 0);
+      csv += line;
+    }
+  const std::size_t rows = static_cast<std::size_t>(to - from + 1) * 2;
+  auto res = upload("boat=ILCA-6", csv);
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 202) << res->body;
+  const auto r = finished(nlohmann::json::parse(res->body)["id"].get<std::int64_t>());
+  ASSERT_EQ(r["state"], "done") << r.dump();
+  EXPECT_EQ(r["points"], rows);
+  const auto merged = get_json("/api/v1/sessions?boat=ILCA-6");
+  ASSERT_EQ(merged.size(), 1u) << merged.dump();
+  EXPECT_EQ(merged[0]["id"], live[0]["id"]);
+  EXPECT_EQ(merged[0]["samples"].get<int>(), live_samples + r["samples_added"].get<int>());
+  // A file row at the instant of a live sample is not added (the live one stays): never doubled.
+  const auto added = r["samples_added"].get<std::size_t>();
+  EXPECT_LE(added, rows);
+  EXPECT_GT(added, rows / 2);
+  auto c = client();
+  auto exported = c.Get("/api/v1/sessions/" + std::to_string(merged[0]["id"].get<int>()) +
+                            "/export?format=csv",
+                        bearer());
+  ASSERT_TRUE(exported);
+  EXPECT_EQ(std::count(exported->body.begin(), exported->body.end(), '\n') - 1,
+            static_cast<long>(live_samples) + static_cast<long>(added));
+}
+
 TEST_F(ImportTest, CutFileFailsNamingTheLineAndStoresNothing) {
   std::string csv = atlas_csv(100);
   csv.resize(csv.size() - 20);
