@@ -175,52 +175,122 @@ void stream_rows(httplib::Response& res, Store& store, const std::string& boat_i
       });
 }
 
-/// Column arrays for charts. Beyond max_points, each time bucket keeps the samples with the
-/// smallest and largest heel and pitch, so peaks survive downsampling (at most 4 per bucket).
-json attitude_columns(Store& store, const std::string& boat_id, std::uint64_t from_ns,
-                      std::uint64_t to_ns, std::optional<std::size_t> max_points) {
-  std::vector<AttitudeRow> rows;
-  std::size_t count = 0;
-  std::uint64_t first_ns = 0;
-  std::uint64_t last_ns = 0;
-  // First pass: count and time span (cheap: the primary key orders by time).
-  store.visit_attitude(boat_id, from_ns, to_ns, [&](const AttitudeRow& r) {
-    if (count == 0) first_ns = r.t_utc_ns;
-    last_ns = r.t_utc_ns;
-    ++count;
-    if (!max_points || count <= *max_points) rows.push_back(r);
-    return true;
-  });
-  const bool downsample = max_points && count > *max_points;
-  if (downsample) {
-    rows.clear();
-    const std::size_t buckets = *max_points / 4;
-    const double span = static_cast<double>(last_ns - first_ns) + 1.0;
-    std::vector<std::array<AttitudeRow, 4>> extremes(buckets);
-    std::vector<bool> used(buckets, false);
-    store.visit_attitude(boat_id, from_ns, to_ns, [&](const AttitudeRow& r) {
-      auto b = static_cast<std::size_t>(static_cast<double>(r.t_utc_ns - first_ns) / span *
-                                        static_cast<double>(buckets));
-      b = std::min(b, buckets - 1);
-      auto& e = extremes[b];
-      if (!used[b]) {
-        e = {r, r, r, r};
-        used[b] = true;
-        return true;
-      }
-      if (r.heel_deg < e[0].heel_deg) e[0] = r;
-      if (r.heel_deg > e[1].heel_deg) e[1] = r;
-      if (r.pitch_deg < e[2].pitch_deg) e[2] = r;
-      if (r.pitch_deg > e[3].pitch_deg) e[3] = r;
-      return true;
-    });
-    for (std::size_t b = 0; b < buckets; ++b) {
-      if (!used[b]) continue;
-      auto e = extremes[b];
+/// A chart's thinning: the time span cut into buckets, each keeping the samples with the lowest
+/// and highest heel and pitch (at most 4), so peaks survive downsampling.
+class ChartThinner {
+ public:
+  ChartThinner(std::uint64_t first_ns, std::uint64_t last_ns, std::size_t buckets)
+      : first_ns_(first_ns),
+        span_(static_cast<double>(last_ns - first_ns) + 1.0),
+        extremes_(buckets),
+        used_(buckets, false) {}
+
+  void add(const AttitudeRow& r) {
+    const std::size_t buckets = extremes_.size();
+    auto b = static_cast<std::size_t>(static_cast<double>(r.t_utc_ns - first_ns_) / span_ *
+                                      static_cast<double>(buckets));
+    b = std::min(b, buckets - 1);
+    auto& e = extremes_[b];
+    if (!used_[b]) {
+      e = {r, r, r, r};
+      used_[b] = true;
+      return;
+    }
+    if (r.heel_deg < e[0].heel_deg) e[0] = r;
+    if (r.heel_deg > e[1].heel_deg) e[1] = r;
+    if (r.pitch_deg < e[2].pitch_deg) e[2] = r;
+    if (r.pitch_deg > e[3].pitch_deg) e[3] = r;
+  }
+
+  [[nodiscard]] std::vector<AttitudeRow> rows() const {
+    std::vector<AttitudeRow> out;
+    for (std::size_t b = 0; b < extremes_.size(); ++b) {
+      if (!used_[b]) continue;
+      auto e = extremes_[b];
       std::sort(e.begin(), e.end(),
                 [](const AttitudeRow& x, const AttitudeRow& y) { return x.t_utc_ns < y.t_utc_ns; });
       for (std::size_t i = 0; i < e.size(); ++i)
-        if (i == 0 || e[i].t_utc_ns != e[i - 1].t_utc_ns) rows.push_back(e[i]);
+        if (i == 0 || e[i].t_utc_ns != e[i - 1].t_utc_ns) out.push_back(e[i]);
+    }
+    return out;
+  }
+
+ private:
+  std::uint64_t first_ns_;
+  double span_;
+  std::vector<std::array<AttitudeRow, 4>> extremes_;
+  std::vector<bool> used_;
+};
+
+/// Column arrays for charts. Beyond max_points, the range is thinned (ChartThinner). A range long
+/// enough for whole tier buckets to fill the chart is read from the store's chart tiers (a few
+/// thousand rows for a 4-hour session, whatever its rate), a shorter one from the samples; a
+/// downsampled count from the tiers includes the whole buckets at the range's ends.
+json attitude_columns(Store& store, const std::string& boat_id, std::uint64_t from_ns,
+                      std::uint64_t to_ns, std::optional<std::size_t> max_points) {
+  std::vector<AttitudeRow> rows;
+  std::int64_t count = 0;
+  bool downsample = false;
+  std::optional<std::vector<TierBucket>> tier;
+  if (max_points) {
+    // The coarsest tier says how many samples the range holds and over what span.
+    auto coarse = store.attitude_tier(boat_id, kTierWidths_s.back(), from_ns, to_ns);
+    for (const auto& b : coarse) count += b.n;
+    const std::size_t target = *max_points / 4;  // buckets of at most 4 samples
+    if (count > static_cast<std::int64_t>(*max_points) && !coarse.empty()) {
+      const std::uint64_t span_s =
+          (std::min<std::uint64_t>(to_ns,
+                                   coarse.back().start_ns + kTierWidths_s.back() * 1000000000ULL) -
+           std::max<std::uint64_t>(from_ns, coarse.front().start_ns)) /
+          1000000000ULL;
+      // The coarsest width that still gives every chart bucket a tier bucket of its own.
+      for (auto w = kTierWidths_s.rbegin(); w != kTierWidths_s.rend(); ++w) {
+        if (span_s / *w < target) continue;
+        tier = *w == kTierWidths_s.back() ? std::move(coarse)
+                                         : store.attitude_tier(boat_id, *w, from_ns, to_ns);
+        break;
+      }
+    }
+  }
+  if (tier) {
+    downsample = true;
+    std::uint64_t first_ns = UINT64_MAX, last_ns = 0;
+    const auto in_range = [&](const AttitudeRow& r) {
+      return r.t_utc_ns >= from_ns && r.t_utc_ns <= to_ns;
+    };
+    for (const auto& b : *tier)
+      for (const auto& r : b.extremes)
+        if (in_range(r)) {
+          first_ns = std::min(first_ns, r.t_utc_ns);
+          last_ns = std::max(last_ns, r.t_utc_ns);
+        }
+    if (first_ns <= last_ns) {
+      ChartThinner thin(first_ns, last_ns, *max_points / 4);
+      for (const auto& b : *tier)
+        for (const auto& r : b.extremes)
+          if (in_range(r)) thin.add(r);
+      rows = thin.rows();
+    }
+  } else {
+    count = 0;
+    std::uint64_t first_ns = 0;
+    std::uint64_t last_ns = 0;
+    // First pass: count and time span (cheap: the primary key orders by time).
+    store.visit_attitude(boat_id, from_ns, to_ns, [&](const AttitudeRow& r) {
+      if (count == 0) first_ns = r.t_utc_ns;
+      last_ns = r.t_utc_ns;
+      ++count;
+      if (!max_points || count <= static_cast<std::int64_t>(*max_points)) rows.push_back(r);
+      return true;
+    });
+    downsample = max_points && count > static_cast<std::int64_t>(*max_points);
+    if (downsample) {
+      ChartThinner thin(first_ns, last_ns, *max_points / 4);
+      store.visit_attitude(boat_id, from_ns, to_ns, [&](const AttitudeRow& r) {
+        thin.add(r);
+        return true;
+      });
+      rows = thin.rows();
     }
   }
   json t = json::array(), heel = json::array(), pitch = json::array(), heading = json::array();

@@ -181,7 +181,66 @@ sqlite3* open_db(const std::string& path, int flags) {
 /// backfill receipts). Version 2: sessions gained received_ns (the shore's arrival time, for
 /// retention; 0 in older rows: their end_ns stands in). Databases from earlier builds are
 /// migrated in place; a database from a newer build is refused rather than misread.
-constexpr int kSchemaVersion = 2;
+constexpr int kSchemaVersion = 3;
+
+// Chart tiers (schema 3): per boat and time bucket of each of kTierWidths seconds, the number of
+// samples and the four samples with the lowest and highest heel and pitch (time, heel, pitch,
+// heading of each), which is what a chart keeps when it thins. A trigger keeps them as samples are
+// inserted by any path (live, backfill, import; an ignored duplicate fires nothing), merging in
+// any order, so a chart of a 4-hour session reads a few thousand tier rows, not 360 000 samples.
+constexpr const char* kTierTable = R"sql(
+CREATE TABLE IF NOT EXISTS attitude_tier (
+  boat_id TEXT NOT NULL,
+  width_s INTEGER NOT NULL,
+  bucket INTEGER NOT NULL,
+  n INTEGER NOT NULL,
+  e0_t INTEGER, e0_heel REAL, e0_pitch REAL, e0_hdg REAL,
+  e1_t INTEGER, e1_heel REAL, e1_pitch REAL, e1_hdg REAL,
+  e2_t INTEGER, e2_heel REAL, e2_pitch REAL, e2_hdg REAL,
+  e3_t INTEGER, e3_heel REAL, e3_pitch REAL, e3_hdg REAL,
+  PRIMARY KEY (boat_id, width_s, bucket)
+) WITHOUT ROWID;
+)sql";
+
+/// The upsert that merges the rows `select_from` yields (alias `a`: an attitude row) into the tier
+/// of `width_s`. e0/e1: lowest/highest heel; e2/e3: lowest/highest pitch. SQLite evaluates every
+/// SET expression on the row as it was, so each CASE compares with the old extreme.
+std::string tier_upsert(std::uint64_t width_s, const std::string& select_from) {
+  const std::string w = std::to_string(width_s);
+  const std::string w_ns = std::to_string(width_s * 1000000000ULL);
+  std::string sql =
+      "INSERT INTO attitude_tier SELECT a.boat_id, " + w + ", a.t_utc_ns / " + w_ns + ", 1";
+  for (int e = 0; e < 4; ++e) sql += ", a.t_utc_ns, a.heel_deg, a.pitch_deg, a.heading_deg";
+  sql += " " + select_from + " ON CONFLICT (boat_id, width_s, bucket) DO UPDATE SET n = n + excluded.n";
+  static constexpr std::array<std::pair<const char*, const char*>, 4> kExtremes = {
+      {{"heel", "<"}, {"heel", ">"}, {"pitch", "<"}, {"pitch", ">"}}};
+  for (std::size_t e = 0; e < kExtremes.size(); ++e) {
+    const std::string p = "e" + std::to_string(e) + "_";
+    const std::string wins = std::string("excluded.") + p + kExtremes[e].first + " " +
+                             kExtremes[e].second + " " + p + kExtremes[e].first;
+    for (const char* col : {"t", "heel", "pitch", "hdg"})
+      sql += ", " + p + col + " = CASE WHEN " + wins + " THEN excluded." + p + col + " ELSE " + p +
+             col + " END";
+  }
+  return sql;
+}
+
+/// The trigger that keeps every tier as samples are inserted.
+std::string tier_trigger() {
+  std::string sql = "CREATE TRIGGER IF NOT EXISTS attitude_tiers AFTER INSERT ON attitude BEGIN ";
+  for (const auto w : kTierWidths_s)
+    sql += tier_upsert(w, "FROM (SELECT NEW.boat_id AS boat_id, NEW.t_utc_ns AS t_utc_ns, "
+                          "NEW.heel_deg AS heel_deg, NEW.pitch_deg AS pitch_deg, "
+                          "NEW.heading_deg AS heading_deg) a WHERE true") +
+           "; ";
+  return sql + "END;";
+}
+
+/// Rebuilds the tiers of `boat_id` over [from_ns, to_ns] (widened to whole buckets of every width)
+/// from the samples there: after samples were deleted, or to build tiers for a database written
+/// before they existed (boat_id empty: every boat, the whole time).
+void rebuild_tiers(sqlite3* db, const std::string& boat_id, std::uint64_t from_ns,
+                   std::uint64_t to_ns);
 
 void migrate(sqlite3* db) {
   Stmt version_q(db, "PRAGMA user_version");
@@ -196,7 +255,31 @@ void migrate(sqlite3* db) {
       db, "SELECT COUNT(*) FROM pragma_table_info('sessions') WHERE name = 'received_ns'");
   if (has_received.step() && has_received.i64(0) == 0)
     exec(db, "ALTER TABLE sessions ADD COLUMN received_ns INTEGER NOT NULL DEFAULT 0");
+  if (version < 3) rebuild_tiers(db, "", 0, std::numeric_limits<std::int64_t>::max());
   exec(db, ("PRAGMA user_version = " + std::to_string(kSchemaVersion)).c_str());
+}
+
+void rebuild_tiers(sqlite3* db, const std::string& boat_id, std::uint64_t from_ns,
+                   std::uint64_t to_ns) {
+  const std::uint64_t widest_ns = kTierWidths_s.back() * 1000000000ULL;
+  const std::uint64_t lo = from_ns / widest_ns * widest_ns;
+  const std::uint64_t hi = std::min<std::uint64_t>(
+      to_ns / widest_ns * widest_ns + widest_ns - 1, std::numeric_limits<std::int64_t>::max());
+  const std::string match = boat_id.empty() ? "?1 = ''" : "boat_id = ?1";
+  for (const auto w : kTierWidths_s) {
+    const std::uint64_t w_ns = w * 1000000000ULL;
+    Stmt del(db, ("DELETE FROM attitude_tier WHERE " + match +
+                  " AND width_s = ?2 AND bucket BETWEEN ?3 AND ?4")
+                     .c_str());
+    del.bind(1, boat_id).bind_u(2, w).bind_u(3, lo / w_ns).bind_u(4, hi / w_ns);
+    del.step();
+    Stmt add(db, tier_upsert(w, "FROM attitude a WHERE (" +
+                                    std::string(boat_id.empty() ? "?1 = ''" : "a.boat_id = ?1") +
+                                    ") AND a.t_utc_ns BETWEEN ?2 AND ?3 ORDER BY a.boat_id, a.t_utc_ns")
+                     .c_str());
+    add.bind(1, boat_id).bind_u(2, lo).bind_u(3, hi);
+    add.step();
+  }
 }
 
 SessionInfo session_from(const Stmt& s) {
@@ -270,6 +353,8 @@ Store::Store(StoreConfig config) : config_(std::move(config)) {
   db_ = open_db(config_.path, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
   try {
     exec(db_, kSchema);
+    exec(db_, kTierTable);
+    exec(db_, tier_trigger().c_str());
     migrate(db_);
     for (std::size_t i = 0; i < kReaders; ++i)
       readers_.push_back(open_db(config_.path, SQLITE_OPEN_READONLY));
@@ -930,6 +1015,7 @@ void Store::apply_retention() {
       del_samples.bind(1, g.boat_id).bind_u(2, g.start_ns).bind_u(3, g.end_ns).step();
       del_fixes.reset();
       del_fixes.bind(1, g.boat_id).bind_u(2, g.start_ns).bind_u(3, g.end_ns).step();
+      rebuild_tiers(db_, g.boat_id, g.start_ns, g.end_ns);
     }
     Stmt e(db_, "DELETE FROM alarm_events WHERE phase = 'cleared' AND cleared_ns < ?");
     e.bind_u(1, cutoff).step();
@@ -1001,6 +1087,34 @@ void Store::visit_attitude(const std::string& boat_id, std::uint64_t from_ns, st
     if (rows.size() < page) return;
     after = rows.back().t_utc_ns;
   }
+}
+
+std::vector<TierBucket> Store::attitude_tier(const std::string& boat_id, std::uint64_t width_s,
+                                             std::uint64_t from_ns, std::uint64_t to_ns) {
+  std::vector<TierBucket> out;
+  if (from_ns > to_ns) return out;
+  const std::uint64_t w_ns = width_s * 1000000000ULL;
+  const ReadLease reader(*this);
+  Stmt q(reader.db(),
+         "SELECT bucket, n, e0_t, e0_heel, e0_pitch, e0_hdg, e1_t, e1_heel, e1_pitch, e1_hdg, "
+         "e2_t, e2_heel, e2_pitch, e2_hdg, e3_t, e3_heel, e3_pitch, e3_hdg FROM attitude_tier "
+         "WHERE boat_id = ? AND width_s = ? AND bucket BETWEEN ? AND ? ORDER BY bucket");
+  q.bind(1, boat_id).bind_u(2, width_s).bind_u(3, from_ns / w_ns);
+  q.bind_u(4, std::min<std::uint64_t>(to_ns, std::numeric_limits<std::int64_t>::max()) / w_ns);
+  while (q.step()) {
+    TierBucket b;
+    b.start_ns = q.u64(0) * w_ns;
+    b.n = q.i64(1);
+    for (int e = 0; e < 4; ++e) {
+      AttitudeRow& r = b.extremes[static_cast<std::size_t>(e)];
+      r.t_utc_ns = q.u64(2 + 4 * e);
+      r.heel_deg = q.dbl(3 + 4 * e);
+      r.pitch_deg = q.dbl(4 + 4 * e);
+      r.heading_deg = q.dbl(5 + 4 * e);
+    }
+    out.push_back(b);
+  }
+  return out;
 }
 
 std::int64_t Store::count(const std::string& boat_id) {

@@ -28,6 +28,7 @@
 
 #include <sqlite3.h>
 
+#include <array>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -93,6 +94,18 @@ struct AttitudeRow {
   double yaw_rate_deg_s = 0.0;
   double accel_weight = 0.0;
   double quality = 0.0;
+};
+
+/// Widths of the chart tiers' time buckets, finest first (Store::attitude_tier).
+inline constexpr std::array<std::uint64_t, 2> kTierWidths_s = {1, 16};
+
+/// One time bucket of a chart tier: how many samples it holds and the four that a thinned chart
+/// keeps (lowest heel, highest heel, lowest pitch, highest pitch; only time, heel, pitch and
+/// heading are set).
+struct TierBucket {
+  std::uint64_t start_ns = 0;
+  std::int64_t n = 0;
+  std::array<AttitudeRow, 4> extremes{};
 };
 
 /// What the fixes of a span say about the sailing.
@@ -163,6 +176,11 @@ class Store {
                                                        std::uint64_t after_ns, std::uint64_t to_ns,
                                                        std::size_t limit);
   [[nodiscard]] std::int64_t count(const std::string& boat_id);
+  /// The boat's chart tier of `width_s` (one of kTierWidths_s): every bucket that overlaps
+  /// [from_ns, to_ns], in time order. Kept as samples are stored; reads one row per bucket.
+  [[nodiscard]] std::vector<TierBucket> attitude_tier(const std::string& boat_id,
+                                                      std::uint64_t width_s, std::uint64_t from_ns,
+                                                      std::uint64_t to_ns);
 
   // --- alarms (synchronous) ----------------------------------------------------------------
   void save_rules(const std::vector<AlarmRule>& rules);

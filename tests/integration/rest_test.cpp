@@ -174,6 +174,7 @@ TEST_F(RestTest, SessionsAttitudeAndStreamedExportAgree) {
   const json small = get_json("/api/v1/sessions/" + sid + "/attitude?max_points=40");
   EXPECT_TRUE(small["downsampled"].get<bool>());
   EXPECT_LE(small["t_s"].size(), 40u);
+  EXPECT_EQ(small["count"], samples);  // from the chart tiers: the session is whole buckets
   // Peaks survive downsampling.
   const auto max_of = [](const json& a) {
     double m = -1e9;

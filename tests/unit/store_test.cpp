@@ -12,6 +12,7 @@
 #include <cmath>
 #include <filesystem>
 #include <future>
+#include <map>
 #include <thread>
 
 namespace telltale::shore {
@@ -257,6 +258,81 @@ TEST_F(StoreTest, RetentionGoesByArrivalNotByTheBoatsClock) {
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   EXPECT_EQ(store.count("late"), 0);
   EXPECT_TRUE(store.sessions(std::string("late"), 0, UINT64_MAX).empty());
+}
+
+/// Brute force: per bucket of `width_s`, the count and the lowest/highest heel and pitch.
+struct Expected {
+  std::int64_t n = 0;
+  double heel_lo = 1e9, heel_hi = -1e9, pitch_lo = 1e9, pitch_hi = -1e9;
+};
+std::map<std::uint64_t, Expected> expected_tier(const std::vector<AttitudeSample>& samples,
+                                                std::uint64_t width_s) {
+  std::map<std::uint64_t, Expected> out;
+  for (const auto& s : samples) {
+    Expected& e = out[s.t_utc_ns / (width_s * kSecond) * width_s * kSecond];
+    ++e.n;
+    e.heel_lo = std::min(e.heel_lo, s.heel_deg);
+    e.heel_hi = std::max(e.heel_hi, s.heel_deg);
+    e.pitch_lo = std::min(e.pitch_lo, s.pitch_deg);
+    e.pitch_hi = std::max(e.pitch_hi, s.pitch_deg);
+  }
+  return out;
+}
+
+void expect_tiers(Store& store, const std::vector<AttitudeSample>& samples) {
+  for (const auto w : kTierWidths_s) {
+    SCOPED_TRACE("width " + std::to_string(w) + " s");
+    const auto want = expected_tier(samples, w);
+    const auto got = store.attitude_tier("tier", w, 0, UINT64_MAX);
+    ASSERT_EQ(got.size(), want.size());
+    for (const auto& b : got) {
+      const Expected& e = want.at(b.start_ns);
+      EXPECT_EQ(b.n, e.n) << b.start_ns;
+      EXPECT_EQ(b.extremes[0].heel_deg, e.heel_lo);
+      EXPECT_EQ(b.extremes[1].heel_deg, e.heel_hi);
+      EXPECT_EQ(b.extremes[2].pitch_deg, e.pitch_lo);
+      EXPECT_EQ(b.extremes[3].pitch_deg, e.pitch_hi);
+      for (const auto& r : b.extremes) {
+        EXPECT_GE(r.t_utc_ns, b.start_ns);
+        EXPECT_LT(r.t_utc_ns, b.start_ns + w * kSecond);
+      }
+    }
+  }
+}
+
+// Given 10 minutes of 25 Hz samples stored out of order (the second half live, the first half
+// backfilled after it, some twice), then every chart tier holds exactly the count and the extremes
+// a brute-force pass over the samples finds; and a database from before the tiers gets them built
+// when it is opened.
+TEST_F(StoreTest, ChartTiersHoldTheCountAndExtremesOfEveryBucket) {
+  std::vector<AttitudeSample> samples;
+  for (std::uint64_t i = 0; i < 15000; ++i) {
+    auto s = sample("tier", 5, i + 1, kT0 + i * kSecond / 25);
+    s.heel_deg = 20.0 * std::sin(static_cast<double>(i) * 0.013) + static_cast<double>(i % 7);
+    s.pitch_deg = 5.0 * std::cos(static_cast<double>(i) * 0.029) - static_cast<double>(i % 5);
+    samples.push_back(s);
+  }
+  {
+    Store store(config());
+    for (std::size_t i = samples.size() / 2; i < samples.size(); ++i) store.enqueue(samples[i]);
+    store.flush();
+    for (std::size_t i = 0; i < samples.size() / 2; ++i) store.enqueue(samples[i]);
+    for (std::size_t i = 0; i < 500; ++i) store.enqueue(samples[i]);  // re-sent: ignored
+    store.flush();
+    expect_tiers(store, samples);
+  }
+  {  // The same database as an older shore left it: no tiers.
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(config().path.c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(db,
+                           "DROP TRIGGER attitude_tiers; DROP TABLE attitude_tier; "
+                           "PRAGMA user_version = 2;",
+                           nullptr, nullptr, nullptr),
+              SQLITE_OK);
+    sqlite3_close(db);
+  }
+  Store reopened(config());
+  expect_tiers(reopened, samples);
 }
 
 // Given a slow reader holding a read connection (an export streaming a long session), then other
