@@ -4,6 +4,7 @@
 /// result within the record's contract (record.hpp): a time, a position whole or absent and in
 /// range, speeds not negative, courses and headings in [0, 360), heel within ±180 and pitch
 /// within ±90, and a result whose status agrees with what came out. Parsing twice gives the same.
+/// Format detection and the VTK serial lookup (a default boat id) run on every input too.
 
 #include <cmath>
 #include <cstdint>
@@ -13,6 +14,7 @@
 #include "detect.hpp"
 #include "fuzz_support.hpp"
 #include "record.hpp"
+#include "vtk.hpp"
 
 namespace telltale::fuzz {
 
@@ -41,7 +43,9 @@ struct CheckingSink : shore::import::ImportSink {
 inline void fuzz_parser(shore::import::Format format, const std::uint8_t* data, std::size_t size) {
   using shore::import::ParseStatus;
   const std::string bytes(reinterpret_cast<const char*>(data), size);
-  (void)shore::import::detect_format(std::string_view(bytes).substr(0, shore::import::kDetectBytes));
+  const std::string_view head = std::string_view(bytes).substr(0, shore::import::kDetectBytes);
+  (void)shore::import::detect_format(head);
+  if (const auto serial = shore::import::vtk_serial_number(head)) FUZZ_CHECK(*serial > 0);
   CheckingSink a, b;
   std::istringstream in_a(bytes), in_b(bytes);
   const auto ra = shore::import::parse_log(format, in_a, {}, a);
