@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "detect.hpp"
+#include "sqlite_stmt.hpp"
 
 namespace telltale::shore::import {
 namespace {
@@ -52,71 +53,6 @@ CREATE TABLE IF NOT EXISTS import_events (
 );
 )sql";
 
-/// A prepared statement; throws StoreError on failure.
-class Sql {
- public:
-  Sql(sqlite3* db, const char* sql) : db_(db) {
-    if (sqlite3_prepare_v2(db, sql, -1, &st_, nullptr) != SQLITE_OK)
-      throw StoreError(sqlite3_errmsg(db));
-  }
-  ~Sql() { sqlite3_finalize(st_); }
-  Sql(const Sql&) = delete;
-  Sql& operator=(const Sql&) = delete;
-  Sql& i(int k, std::int64_t v) {
-    sqlite3_bind_int64(st_, k, v);
-    return *this;
-  }
-  Sql& u(int k, std::uint64_t v) { return i(k, static_cast<std::int64_t>(v)); }
-  Sql& d(int k, double v) {
-    if (std::isfinite(v)) {
-      sqlite3_bind_double(st_, k, v);
-    } else {
-      sqlite3_bind_null(st_, k);
-    }
-    return *this;
-  }
-  Sql& s(int k, const std::string& v) {
-    sqlite3_bind_text(st_, k, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT);
-    return *this;
-  }
-  bool step() {
-    const int rc = sqlite3_step(st_);
-    if (rc == SQLITE_ROW) return true;
-    if (rc == SQLITE_DONE) return false;
-    throw StoreError(sqlite3_errmsg(db_));
-  }
-  /// Steps a write and resets for the next one; returns the rows it changed.
-  int run() {
-    step();
-    const int n = sqlite3_changes(db_);
-    sqlite3_reset(st_);
-    return n;
-  }
-  void reset() {
-    sqlite3_reset(st_);
-    sqlite3_clear_bindings(st_);
-  }
-  std::int64_t col_i(int c) const { return sqlite3_column_int64(st_, c); }
-  std::uint64_t col_u(int c) const { return static_cast<std::uint64_t>(col_i(c)); }
-  std::string col_s(int c) const {
-    const auto* p = sqlite3_column_text(st_, c);
-    return p ? reinterpret_cast<const char*>(p) : "";
-  }
-
- private:
-  sqlite3* db_;
-  sqlite3_stmt* st_ = nullptr;
-};
-
-void exec(sqlite3* db, const char* sql) {
-  char* err = nullptr;
-  if (sqlite3_exec(db, sql, nullptr, nullptr, &err) != SQLITE_OK) {
-    std::string msg = err ? err : "unknown error";
-    sqlite3_free(err);
-    throw StoreError(msg);
-  }
-}
-
 std::uint64_t now_ns() {
   return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
                                         std::chrono::system_clock::now().time_since_epoch())
@@ -149,27 +85,27 @@ class StoreSink : public ImportSink {
         event_(db,
                "INSERT INTO import_events (import_id, boat_id, t_utc_ns, kind, detail) "
                "VALUES (?1, ?2, ?3, ?4, ?5)") {
-    attitude_.s(1, boat_);
-    fix_.s(1, boat_);
-    event_.i(1, import_id_).s(2, boat_);
+    attitude_.bind(1, boat_);
+    fix_.bind(1, boat_);
+    event_.bind(1, import_id_).bind(2, boat_);
   }
 
   void point(const ImportPoint& p) override {
     std::uint64_t added = 0;
     if (std::isfinite(p.heel_deg) && std::isfinite(p.pitch_deg)) {
-      attitude_.u(2, p.t_utc_ns).d(3, p.heel_deg).d(4, p.pitch_deg).d(5, p.heading_deg);
+      attitude_.bind_u(2, p.t_utc_ns).bind(3, p.heel_deg).bind(4, p.pitch_deg).bind(5, p.heading_deg);
       added = static_cast<std::uint64_t>(attitude_.run());
       samples_added += added;
     }
     if (std::isfinite(p.lat_deg) && std::isfinite(p.lon_deg)) {
-      fix_.u(2, p.t_utc_ns).d(3, p.lat_deg).d(4, p.lon_deg).d(5, p.sog_m_s).d(6, p.cog_deg);
+      fix_.bind_u(2, p.t_utc_ns).bind(3, p.lat_deg).bind(4, p.lon_deg).bind(5, p.sog_m_s).bind(6, p.cog_deg);
       fixes_added += static_cast<std::uint64_t>(fix_.run());
     }
     extend(p.t_utc_ns, added);
     if (++points_ % 4096 == 0 && progress_) progress_(static_cast<std::uint64_t>(in_.tellg()));
   }
   void event(const ImportEvent& e) override {
-    event_.u(3, e.t_utc_ns).s(4, e.kind).s(5, e.detail);
+    event_.bind_u(3, e.t_utc_ns).bind(4, e.kind).bind(5, e.detail);
     event_.run();
   }
   void device(std::string_view d) override { device_name = std::string(d.substr(0, 200)); }
@@ -179,53 +115,53 @@ class StoreSink : public ImportSink {
     std::vector<std::int64_t> out;
     const std::uint64_t received = now_ns();
     for (const Span& sp : spans_) {
-      Sql q(db_,
+      Stmt q(db_,
             "SELECT id, start_ns, end_ns, samples FROM sessions WHERE boat_id = ?1 AND "
             "start_ns <= ?3 + ?4 AND end_ns + ?4 >= ?2 ORDER BY id");
-      q.s(1, boat_).u(2, sp.start).u(3, sp.end).u(4, gap_ns_);
+      q.bind(1, boat_).bind_u(2, sp.start).bind_u(3, sp.end).bind_u(4, gap_ns_);
       std::int64_t keep = 0;
       std::uint64_t start = sp.start, end = sp.end;
       std::int64_t samples = static_cast<std::int64_t>(sp.added);
       std::vector<std::int64_t> gone;
       while (q.step()) {
         if (keep == 0) {
-          keep = q.col_i(0);
+          keep = q.i64(0);
         } else {
-          gone.push_back(q.col_i(0));
+          gone.push_back(q.i64(0));
         }
-        start = std::min(start, q.col_u(1));
-        end = std::max(end, q.col_u(2));
-        samples += q.col_i(3);
+        start = std::min(start, q.u64(1));
+        end = std::max(end, q.u64(2));
+        samples += q.i64(3);
       }
       if (keep == 0) {
-        Sql ins(db_,
+        Stmt ins(db_,
                 "INSERT INTO sessions (boat_id, start_ns, end_ns, samples, received_ns) "
                 "VALUES (?1, ?2, ?3, ?4, ?5)");
-        ins.s(1, boat_).u(2, start).u(3, end).i(4, samples).u(5, received);
+        ins.bind(1, boat_).bind_u(2, start).bind_u(3, end).bind(4, samples).bind_u(5, received);
         ins.run();
         keep = sqlite3_last_insert_rowid(db_);
       } else {
-        Sql up(db_,
+        Stmt up(db_,
                "UPDATE sessions SET start_ns = ?2, end_ns = ?3, samples = ?4, "
                "received_ns = MAX(received_ns, ?5) WHERE id = ?1");
-        up.i(1, keep).u(2, start).u(3, end).i(4, samples).u(5, received);
+        up.bind(1, keep).bind_u(2, start).bind_u(3, end).bind(4, samples).bind_u(5, received);
         up.run();
         for (std::int64_t g : gone) {
           // Sessions this span bridged: one session now; earlier imports follow it.
-          Sql move(db_, "UPDATE OR IGNORE import_sessions SET session_id = ?2 WHERE session_id = ?1");
-          move.i(1, g).i(2, keep);
+          Stmt move(db_, "UPDATE OR IGNORE import_sessions SET session_id = ?2 WHERE session_id = ?1");
+          move.bind(1, g).bind(2, keep);
           move.run();
-          Sql drop_links(db_, "DELETE FROM import_sessions WHERE session_id = ?1");
-          drop_links.i(1, g);
+          Stmt drop_links(db_, "DELETE FROM import_sessions WHERE session_id = ?1");
+          drop_links.bind(1, g);
           drop_links.run();
-          Sql drop(db_, "DELETE FROM sessions WHERE id = ?1");
-          drop.i(1, g);
+          Stmt drop(db_, "DELETE FROM sessions WHERE id = ?1");
+          drop.bind(1, g);
           drop.run();
           std::erase(out, g);
         }
       }
-      Sql link(db_, "INSERT OR IGNORE INTO import_sessions (import_id, session_id) VALUES (?1, ?2)");
-      link.i(1, import_id_).i(2, keep);
+      Stmt link(db_, "INSERT OR IGNORE INTO import_sessions (import_id, session_id) VALUES (?1, ?2)");
+      link.bind(1, import_id_).bind(2, keep);
       link.run();
       if (std::find(out.begin(), out.end(), keep) == out.end()) out.push_back(keep);
     }
@@ -263,7 +199,7 @@ class StoreSink : public ImportSink {
   std::uint64_t gap_ns_;
   std::istream& in_;
   const std::function<void(std::uint64_t)>& progress_;
-  Sql attitude_, fix_, event_;
+  Stmt attitude_, fix_, event_;
   std::uint64_t points_ = 0;
   std::vector<Span> spans_;
 };
@@ -304,10 +240,10 @@ std::int64_t ImportStore::begin(const std::string& boat_id, const std::string& f
                                 std::uint64_t bytes) {
   std::int64_t id = 0;
   store_.write_transaction([&](sqlite3* db) {
-    Sql ins(db,
+    Stmt ins(db,
             "INSERT INTO imports (boat_id, file_name, bytes, state, created_ns) "
             "VALUES (?1, ?2, ?3, 'running', ?4)");
-    ins.s(1, boat_id).s(2, file_name).u(3, bytes).u(4, now_ns());
+    ins.bind(1, boat_id).bind(2, file_name).bind_u(3, bytes).bind_u(4, now_ns());
     ins.run();
     id = sqlite3_last_insert_rowid(db);
   });
@@ -324,13 +260,13 @@ void ImportStore::fail_unfinished() {
 
 void ImportStore::finish(const ImportRecord& r) {
   store_.write_transaction([&](sqlite3* db) {
-    Sql up(db,
+    Stmt up(db,
            "UPDATE imports SET format = ?2, device = ?3, sha256 = ?4, state = ?5, points = ?6, "
            "samples_added = ?7, fixes_added = ?8, events = ?9, skipped = ?10, start_ns = ?11, "
            "end_ns = ?12, error = ?13, partial = ?14, duplicate_of = ?15 WHERE id = ?1");
-    up.i(1, r.id).s(2, r.format).s(3, r.device).s(4, r.sha256).s(5, r.state).u(6, r.points);
-    up.u(7, r.samples_added).u(8, r.fixes_added).u(9, r.events).u(10, r.skipped);
-    up.u(11, r.start_ns).u(12, r.end_ns).s(13, r.error).s(14, r.partial).i(15, r.duplicate_of);
+    up.bind(1, r.id).bind(2, r.format).bind(3, r.device).bind(4, r.sha256).bind(5, r.state).bind_u(6, r.points);
+    up.bind_u(7, r.samples_added).bind_u(8, r.fixes_added).bind_u(9, r.events).bind_u(10, r.skipped);
+    up.bind_u(11, r.start_ns).bind_u(12, r.end_ns).bind(13, r.error).bind(14, r.partial).bind(15, r.duplicate_of);
     up.run();
   });
 }
@@ -367,25 +303,25 @@ ImportRecord ImportStore::run(std::int64_t id, const ImportRequest& req,
     store_.write_transaction([&](sqlite3* db) {
       // The same content for the same boat: nothing to do (checked in the transaction, so two
       // uploads of one file at once store it once).
-      Sql dup(db,
+      Stmt dup(db,
               "SELECT id FROM imports WHERE sha256 = ?1 AND boat_id = ?2 AND state = 'done' AND "
               "duplicate_of = 0 AND id <> ?3 ORDER BY id LIMIT 1");
-      dup.s(1, r.sha256).s(2, r.boat_id).i(3, id);
+      dup.bind(1, r.sha256).bind(2, r.boat_id).bind(3, id);
       if (dup.step()) {
-        r.duplicate_of = dup.col_i(0);
-        Sql same(db, "SELECT points, device, partial, start_ns, end_ns FROM imports WHERE id = ?1");
-        same.i(1, r.duplicate_of);
+        r.duplicate_of = dup.i64(0);
+        Stmt same(db, "SELECT points, device, partial, start_ns, end_ns FROM imports WHERE id = ?1");
+        same.bind(1, r.duplicate_of);
         if (same.step()) {
-          r.points = same.col_u(0);
-          r.device = same.col_s(1);
-          r.partial = same.col_s(2);
-          r.start_ns = same.col_u(3);
-          r.end_ns = same.col_u(4);
+          r.points = same.u64(0);
+          r.device = same.text(1);
+          r.partial = same.text(2);
+          r.start_ns = same.u64(3);
+          r.end_ns = same.u64(4);
         }
-        Sql links(db,
+        Stmt links(db,
                   "INSERT OR IGNORE INTO import_sessions (import_id, session_id) SELECT ?1, "
                   "session_id FROM import_sessions WHERE import_id = ?2");
-        links.i(1, id).i(2, r.duplicate_of);
+        links.bind(1, id).bind(2, r.duplicate_of);
         links.run();
         return;
       }
@@ -423,35 +359,35 @@ ImportRecord ImportStore::run(std::int64_t id, const ImportRequest& req,
 std::optional<ImportRecord> ImportStore::get(std::int64_t id) {
   std::optional<ImportRecord> out;
   store_.read([&](sqlite3* db) {
-    Sql q(db,
+    Stmt q(db,
           "SELECT boat_id, state, format, device, file_name, sha256, bytes, points, samples_added, "
           "fixes_added, events, skipped, start_ns, end_ns, error, partial, duplicate_of "
           "FROM imports WHERE id = ?1");
-    q.i(1, id);
+    q.bind(1, id);
     if (!q.step()) return;
     ImportRecord r;
     r.id = id;
-    r.boat_id = q.col_s(0);
-    r.state = q.col_s(1);
-    r.format = q.col_s(2);
-    r.device = q.col_s(3);
-    r.file_name = q.col_s(4);
-    r.sha256 = q.col_s(5);
-    r.bytes = q.col_u(6);
+    r.boat_id = q.text(0);
+    r.state = q.text(1);
+    r.format = q.text(2);
+    r.device = q.text(3);
+    r.file_name = q.text(4);
+    r.sha256 = q.text(5);
+    r.bytes = q.u64(6);
     r.bytes_read = r.state == "running" ? 0 : r.bytes;
-    r.points = q.col_u(7);
-    r.samples_added = q.col_u(8);
-    r.fixes_added = q.col_u(9);
-    r.events = q.col_u(10);
-    r.skipped = q.col_u(11);
-    r.start_ns = q.col_u(12);
-    r.end_ns = q.col_u(13);
-    r.error = q.col_s(14);
-    r.partial = q.col_s(15);
-    r.duplicate_of = q.col_i(16);
-    Sql s(db, "SELECT session_id FROM import_sessions WHERE import_id = ?1 ORDER BY session_id");
-    s.i(1, id);
-    while (s.step()) r.sessions.push_back(s.col_i(0));
+    r.points = q.u64(7);
+    r.samples_added = q.u64(8);
+    r.fixes_added = q.u64(9);
+    r.events = q.u64(10);
+    r.skipped = q.u64(11);
+    r.start_ns = q.u64(12);
+    r.end_ns = q.u64(13);
+    r.error = q.text(14);
+    r.partial = q.text(15);
+    r.duplicate_of = q.i64(16);
+    Stmt s(db, "SELECT session_id FROM import_sessions WHERE import_id = ?1 ORDER BY session_id");
+    s.bind(1, id);
+    while (s.step()) r.sessions.push_back(s.i64(0));
     out = std::move(r);
   });
   return out;
@@ -461,14 +397,14 @@ std::vector<ImportRecord> ImportStore::list(const std::optional<std::string>& bo
                                             std::optional<std::int64_t> session, std::size_t limit) {
   std::vector<std::int64_t> ids;
   store_.read([&](sqlite3* db) {
-    Sql q(db,
+    Stmt q(db,
           "SELECT id FROM imports WHERE (?1 IS NULL OR boat_id = ?1) AND (?2 IS NULL OR id IN "
           "(SELECT import_id FROM import_sessions WHERE session_id = ?2)) ORDER BY id DESC "
           "LIMIT ?3");
-    if (boat_id) q.s(1, *boat_id);
-    if (session) q.i(2, *session);
-    q.i(3, static_cast<std::int64_t>(limit));
-    while (q.step()) ids.push_back(q.col_i(0));
+    if (boat_id) q.bind(1, *boat_id);
+    if (session) q.bind(2, *session);
+    q.bind(3, static_cast<std::int64_t>(limit));
+    while (q.step()) ids.push_back(q.i64(0));
   });
   std::vector<ImportRecord> out;
   for (const std::int64_t id : ids)
