@@ -431,15 +431,7 @@ void register_rest_routes(httplib::Server& server, ShoreContext& ctx) {
   server.Get("/api/v1/sessions", [&ctx](const httplib::Request& req, httplib::Response& res) {
     const Principal p = who(ctx, req);
     allow_params(req, {"boat", "from", "to"});
-    std::optional<std::string> boat;
-    if (const std::string* b = param(req, "boat")) {
-      if (!valid_id(*b)) throw HttpError(400, "boat id must be 1-32 of [A-Za-z0-9_-]");
-      boat = *b;
-    }
-    if (p.role == Role::kAthlete) {
-      if (boat && *boat != p.boat_id) throw HttpError(403, "an athlete sees only their own boat");
-      boat = p.boat_id;
-    }
+    const std::optional<std::string> boat = boat_filter(req, p);
     const TimeRange range = parse_range(param(req, "from"), param(req, "to"));
     json arr = json::array();
     for (const auto& s : ctx.store.sessions(boat, range.from_ns, range.to_ns))
@@ -526,15 +518,7 @@ void register_rest_routes(httplib::Server& server, ShoreContext& ctx) {
     const Principal p = who(ctx, req);
     allow_params(req, {"boat", "from", "to", "active", "limit"});
     EventFilter f;
-    if (const std::string* b = param(req, "boat")) {
-      if (!valid_id(*b)) throw HttpError(400, "boat id must be 1-32 of [A-Za-z0-9_-]");
-      f.boat_id = *b;
-    }
-    if (p.role == Role::kAthlete) {
-      if (f.boat_id && *f.boat_id != p.boat_id)
-        throw HttpError(403, "an athlete sees only their own boat");
-      f.boat_id = p.boat_id;
-    }
+    f.boat_id = boat_filter(req, p);
     const TimeRange range = parse_range(param(req, "from"), param(req, "to"));
     f.from_ns = range.from_ns;
     f.to_ns = range.to_ns;

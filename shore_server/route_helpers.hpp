@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <initializer_list>
+#include <optional>
 #include <string>
 
 #include "http_api.hpp"
@@ -42,6 +43,21 @@ inline void allow_params(const httplib::Request& req, std::initializer_list<cons
 inline const std::string* param(const httplib::Request& req, const char* name) {
   auto it = req.params.find(name);
   return it == req.params.end() ? nullptr : &it->second;
+}
+
+/// The `boat` query filter as the caller may use it: checked, and an athlete's own boat whether
+/// given or not (403 for another boat). Nothing: every boat.
+inline std::optional<std::string> boat_filter(const httplib::Request& req, const Principal& p) {
+  std::optional<std::string> boat;
+  if (const std::string* b = param(req, "boat")) {
+    if (!valid_id(*b)) throw HttpError(400, "boat id must be 1-32 of [A-Za-z0-9_-]");
+    boat = *b;
+  }
+  if (p.role == Role::kAthlete) {
+    if (boat && *boat != p.boat_id) throw HttpError(403, "an athlete sees only their own boat");
+    boat = p.boat_id;
+  }
+  return boat;
 }
 
 inline std::string path_id(const httplib::Request& req, const char* what) {

@@ -149,15 +149,7 @@ void register_import_routes(httplib::Server& server, ShoreContext& ctx,
                                                  httplib::Response& res) {
     const Principal p = who(ctx, req);
     allow_params(req, {"boat", "session", "limit"});
-    std::optional<std::string> boat;
-    if (const std::string* b = param(req, "boat")) {
-      if (!valid_id(*b)) throw HttpError(400, "boat id must be 1-32 of [A-Za-z0-9_-]");
-      boat = *b;
-    }
-    if (p.role == Role::kAthlete) {
-      if (boat && *boat != p.boat_id) throw HttpError(403, "an athlete sees only their own boat");
-      boat = p.boat_id;
-    }
+    const std::optional<std::string> boat = boat_filter(req, p);
     std::optional<std::int64_t> session;
     if (const std::string* s = param(req, "session")) {
       session = parse_int(*s, 1, INT64_MAX);
