@@ -40,7 +40,8 @@ json boat_problems(const BoatView& v) {
     add("duplicate_id", "two nodes publish as '" + v.last.boat_id + "' (runs " +
                             std::to_string(v.last.boot_id) + " and " +
                             std::to_string(v.duplicate_boot_id) +
-                            "): give each its own --boat-id; their samples share one session");
+                            "): give each its own --boat-id; meanwhile the later one is "
+                            "recorded under an id of its own (in the sessions list)");
   }
   if (std::abs(v.clock_offset_ms) > kClockSuspectMs) {
     char buf[96];

@@ -93,6 +93,12 @@ CREATE TABLE IF NOT EXISTS alarm_events (
   message TEXT NOT NULL
 );
 CREATE INDEX IF NOT EXISTS alarm_events_by_time ON alarm_events (raised_ns);
+CREATE TABLE IF NOT EXISTS boat_aliases (
+  boat_id TEXT NOT NULL,
+  boot_id INTEGER NOT NULL,
+  alias TEXT NOT NULL,
+  PRIMARY KEY (boat_id, boot_id)
+) WITHOUT ROWID;
 )sql";
 
 sqlite3* open_db(const std::string& path, int flags) {
@@ -285,6 +291,7 @@ Store::Store(StoreConfig config) : config_(std::move(config)) {
     exec(db_, kTierTable);
     exec(db_, tier_trigger().c_str());
     migrate(db_);
+    load_aliases();
     for (std::size_t i = 0; i < kReaders; ++i)
       readers_.push_back(open_db(config_.path, SQLITE_OPEN_READONLY));
     idle_readers_ = readers_;
@@ -423,7 +430,10 @@ bool Store::commit_fixes(const std::vector<FixSample>& batch) {
              "sog_m_s, cog_deg, fix, satellites, hdop, boot_id) VALUES (?,?,?,?,?,?,?,?,?,?,?,?)");
     for (const auto& f : batch) {
       ins.reset();
-      ins.bind(1, f.boat_id).bind_u(2, f.t_utc_ns).bind_u(3, f.seq).bind_u(4, f.gnss_utc_ns);
+      // A second node's run has its own id (recorded_id): its fixes go with its samples.
+      const auto alias = aliases_.find({f.boat_id, f.boot_id});
+      ins.bind(1, alias == aliases_.end() ? f.boat_id : alias->second);
+      ins.bind_u(2, f.t_utc_ns).bind_u(3, f.seq).bind_u(4, f.gnss_utc_ns);
       ins.bind(5, f.lat_deg).bind(6, f.lon_deg).bind(7, f.sog_m_s).bind(8, f.cog_deg);
       ins.bind(9, f.fix).bind(10, static_cast<std::int64_t>(f.satellites)).bind(11, f.hdop);
       ins.bind_u(12, f.boot_id);
@@ -660,9 +670,9 @@ bool Store::commit(std::vector<AttitudeSample>& batch) {
       return a.boat_id != b.boat_id ? a.boat_id < b.boat_id : a.t_utc_ns < b.t_utc_ns;
     });
     for (const auto& s : batch) {
+      const std::string& id = recorded_id(s);
       sqlite3_reset(insert_);
-      sqlite3_bind_text(insert_, 1, s.boat_id.c_str(), static_cast<int>(s.boat_id.size()),
-                        SQLITE_TRANSIENT);
+      sqlite3_bind_text(insert_, 1, id.c_str(), static_cast<int>(id.size()), SQLITE_TRANSIENT);
       sqlite3_bind_int64(insert_, 2, static_cast<sqlite3_int64>(s.t_utc_ns));
       sqlite3_bind_int64(insert_, 3, static_cast<sqlite3_int64>(s.seq));
       sqlite3_bind_double(insert_, 4, s.heel_deg);
@@ -682,7 +692,7 @@ bool Store::commit(std::vector<AttitudeSample>& batch) {
       if (sqlite3_step(insert_) != SQLITE_DONE) throw StoreError(sqlite3_errmsg(db_));
       if (sqlite3_changes(db_) == 1) {  // a duplicate (re-sent sample) changes nothing
         ++inserted;
-        extend_session(s.boat_id, s.t_utc_ns);
+        extend_session(id, s.t_utc_ns);
       }
     }
     Stmt up(db_,
@@ -713,6 +723,11 @@ bool Store::commit(std::vector<AttitudeSample>& batch) {
     open_sessions_.clear();  // reload from disk: the rolled-back changes are gone
     dirty_sessions_.clear();
     backfilled_.clear();
+    try {
+      load_aliases();  // an alias made in this batch went with it; the next attempt makes it again
+    } catch (const StoreError&) {
+      aliases_.clear();
+    }
     // Keep the batch for the next attempt (disk full, locked): nothing already received is lost
     // while the process lives.
     std::lock_guard lock(mutex_);
@@ -842,8 +857,12 @@ void Store::track_receipt(const AttitudeSample& s) {
   Receipt& r = it->second;
   if (added) {
     // A run not seen since this shore started: what is already stored counts (restart).
-    Stmt q(db_, "SELECT seq FROM attitude WHERE boat_id = ? AND boot_id = ? ORDER BY seq");
+    // Under the boat's id, and its run's alias if it has one (a second node's run).
+    const auto alias = aliases_.find({s.boat_id, s.boot_id});
+    Stmt q(db_,
+           "SELECT seq FROM attitude WHERE boat_id IN (?1, ?3) AND boot_id = ?2 ORDER BY seq");
     q.bind(1, s.boat_id).bind(2, static_cast<std::int64_t>(s.boot_id));
+    q.bind(3, alias == aliases_.end() ? s.boat_id : alias->second);
     while (q.step()) {
       const std::uint64_t seq = q.u64(0);
       if (seq == r.acked + 1) {
@@ -871,6 +890,53 @@ void Store::track_receipt(const AttitudeSample& s) {
       std::erase_if(runs, [&](const auto& e) { return now - e.second.touched > kIdle; });
     std::erase_if(spans_, [](const auto& e) { return e.second.empty(); });
   }
+}
+
+void Store::load_aliases() {
+  aliases_.clear();
+  Stmt q(db_, "SELECT boat_id, boot_id, alias FROM boat_aliases");
+  while (q.step()) aliases_[{q.text(0), q.u64(1)}] = q.text(2);
+}
+
+std::string Store::duplicate_alias(const std::string& boat_id, std::uint64_t boot_id) {
+  char hex[8];
+  std::snprintf(hex, sizeof hex, "%06llx", static_cast<unsigned long long>(boot_id & 0xFFFFFF));
+  return boat_id.substr(0, 25) + "-" + hex;
+}
+
+const std::string& Store::recorded_id(const AttitudeSample& s) {
+  const auto key = std::make_pair(s.boat_id, s.boot_id);
+  if (const auto it = aliases_.find(key); it != aliases_.end()) return it->second;
+  // The same test as duplicate_ids(): this run and another, both storing lately, over time
+  // spans that overlap by more than a second. The later-started run is the second node's.
+  constexpr auto kWindow = std::chrono::seconds(30);
+  constexpr std::uint64_t kOverlap_ns = 1'000'000'000;
+  const auto now = std::chrono::steady_clock::now();
+  bool second = false;
+  {
+    std::lock_guard lock(receipts_mutex_);
+    const auto boat = spans_.find(s.boat_id);
+    if (boat == spans_.end()) return s.boat_id;
+    const auto mine = boat->second.find(s.boot_id);
+    if (mine == boat->second.end()) return s.boat_id;
+    for (const auto& [boot, span] : boat->second) {
+      if (boot == s.boot_id || now - span.touched > kWindow) continue;
+      const std::uint64_t lo = std::max(span.min_t_ns, mine->second.min_t_ns);
+      const std::uint64_t hi = std::min(span.max_t_ns, mine->second.max_t_ns);
+      if (hi > lo && hi - lo > kOverlap_ns && span.min_t_ns < mine->second.min_t_ns &&
+          !aliases_.count({s.boat_id, boot}))
+        second = true;
+    }
+  }
+  if (!second) return s.boat_id;
+  const std::string alias = duplicate_alias(s.boat_id, s.boot_id);
+  Stmt save(db_, "INSERT OR REPLACE INTO boat_aliases (boat_id, boot_id, alias) VALUES (?, ?, ?)");
+  save.bind(1, s.boat_id).bind(2, static_cast<std::int64_t>(s.boot_id)).bind(3, alias);
+  save.step();  // in the batch's transaction: rolled back with it if the batch fails
+  std::fprintf(stderr,
+               "shore_server: two nodes publish as '%s': run %llx is recorded as '%s' from now\n",
+               s.boat_id.c_str(), static_cast<unsigned long long>(s.boot_id), alias.c_str());
+  return aliases_.emplace(key, alias).first->second;
 }
 
 std::vector<Store::DuplicateId> Store::duplicate_ids() const {

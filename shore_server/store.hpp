@@ -201,14 +201,19 @@ class Store {
 
   /// Two runs of one boat id storing samples of the same time span, both within the last
   /// `kDuplicateWindow`: two nodes configured with one id (a restart or an earlier run's delivery
-  /// never overlaps the new run in time). Flagged, not yet kept apart: their samples still share
-  /// the boat's sessions.
+  /// never overlaps the new run in time). Flagged, and kept apart: from the moment the store sees
+  /// the overlap (about a second of the later run's samples), the later run is recorded under
+  /// its own id, duplicate_alias() (stored, so its backfill lands there after a restart too).
   struct DuplicateId {
     std::string boat_id;
     std::uint64_t boot_a;
     std::uint64_t boot_b;
   };
   [[nodiscard]] std::vector<DuplicateId> duplicate_ids() const;
+  /// The id under which a second node's run of `boat_id` is recorded: the id cut to 25
+  /// characters, '-' and the run's low 24 bits in hex (a valid id of at most 32 characters).
+  [[nodiscard]] static std::string duplicate_alias(const std::string& boat_id,
+                                                   std::uint64_t boot_id);
 
   /// Runs `work` on the writer connection inside one transaction (BEGIN IMMEDIATE), the live
   /// writer waiting meanwhile: committed when `work` returns, rolled back when it throws (the
@@ -262,6 +267,13 @@ class Store {
   };
   /// boat -> run -> the time span it stored (under receipts_mutex_), for duplicate_ids().
   std::map<std::string, std::map<std::uint64_t, RunSpan>> spans_;
+  /// (boat, run) -> the id its samples are recorded under: a second node's run (writer thread;
+  /// loaded from and saved to the boat_aliases table).
+  std::map<std::pair<std::string, std::uint64_t>, std::string> aliases_;
+  /// The id `s` is recorded under: its boat's, or its run's alias once that run is seen to
+  /// overlap an earlier run of the same id (writer thread, inside a commit).
+  const std::string& recorded_id(const AttitudeSample& s);
+  void load_aliases();
 
   StoreConfig config_;
   sqlite3* db_ = nullptr;      ///< writer connection (samples, sessions, alarms)

@@ -10,6 +10,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <regex>
+#include <set>
 #include <thread>
 
 #include "shore_fixture.hpp"
@@ -86,6 +87,19 @@ TEST_F(FleetTest, TwoNodesWithOneIdAreFlaggedOnTheCardAndInHealthz) {
       },
       15s))
       << health;
+  // Recorded apart: the second node's run under an id of its own, with its track.
+  json sessions;
+  EXPECT_TRUE(eventually(
+      [&] {
+        sessions = get_json("/api/v1/sessions");
+        std::set<std::string> ids;
+        for (const auto& s : sessions) ids.insert(s["boat_id"].get<std::string>());
+        return ids.size() == 2 && ids.count("twin") &&
+               std::any_of(ids.begin(), ids.end(),
+                           [](const std::string& id) { return id.rfind("twin-", 0) == 0; });
+      },
+      10s))
+      << sessions;
   EXPECT_EQ(second.stop(SIGINT), 0);
   EXPECT_TRUE(eventually(
       [&] {

@@ -383,6 +383,39 @@ TEST_F(StoreTest, TwoRunsOfOneIdAtOnceAreFlagged) {
   EXPECT_EQ(dups[0].boot_b, 8u);
 }
 
+// Given two nodes sailing as "tw" at once (25 Hz each, batches as they arrive), then the second
+// node's run is recorded under its own id from the moment the overlap shows (its first second or
+// so stays with the first node's), the first node's run stays whole under "tw", and after a
+// restart of the shore the second run's resent samples still go to its own id.
+TEST_F(StoreTest, TwoNodesUnderOneIdAreKeptApart) {
+  const std::string alias = Store::duplicate_alias("tw", 0xabcdef12);
+  EXPECT_EQ(alias, "tw-cdef12");
+  EXPECT_EQ(Store::duplicate_alias(std::string(32, 'x'), 1), std::string(25, 'x') + "-000001");
+  const auto both = [&](Store& store, std::uint64_t from, std::uint64_t to) {
+    for (std::uint64_t i = from; i <= to; ++i) {
+      store.enqueue(sample("tw", 0x7, i, kT0 + i * kSecond / 25));
+      store.enqueue(sample("tw", 0xabcdef12, i, kT0 + i * kSecond / 25 + kSecond / 100));
+      if (i % 6 == 0) store.flush();  // a batch per ~250 ms, as live
+    }
+    store.flush();
+  };
+  {
+    Store store(config());
+    both(store, 1, 250);  // 10 s
+    EXPECT_EQ(store.count("tw") + store.count(alias), 500);
+    EXPECT_GE(store.count(alias), 200) << "the second node's samples stayed under the boat's id";
+    EXPECT_LE(store.count("tw"), 300);
+    const auto sessions = store.sessions(std::nullopt, 0, UINT64_MAX);
+    ASSERT_EQ(sessions.size(), 2u);
+  }
+  Store reopened(config());
+  const auto before = reopened.count("tw");
+  for (std::uint64_t i = 200; i <= 250; ++i)  // the second node resends its tail
+    reopened.enqueue(sample("tw", 0xabcdef12, i, kT0 + i * kSecond / 25 + kSecond / 100));
+  reopened.flush();
+  EXPECT_EQ(reopened.count("tw"), before);
+}
+
 /// A private mount namespace for this test process (root only): tmpfs mounts with a size limit
 /// stay invisible to everything else. False where that is not allowed.
 bool private_mounts() {
