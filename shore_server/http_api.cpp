@@ -161,8 +161,9 @@ struct HttpApi::Impl {
 
     server.Get("/healthz", [this](const httplib::Request&, httplib::Response& res) {
       const std::string store_error = ctx.store.last_error();
+      const auto boats = ctx.fleet.boats();
       json j = {{"status", store_error.empty() ? "ok" : "degraded"},
-                {"boats", ctx.fleet.boats().size()},
+                {"boats", boats.size()},
                 {"stream_clients", ctx.hub.clients()},
                 {"samples_committed", ctx.store.committed()},
                 {"fixes_committed", ctx.store.fixes_committed()}};
@@ -180,7 +181,14 @@ struct HttpApi::Impl {
                     {"fixes_dropped", sh.fixes_dropped}};
       if (sh.failing || sh.dropped > 0 || sh.wearable_dropped > 0 || sh.fixes_dropped > 0)
         j["status"] = "degraded";
-      // Two nodes sailing with one boat id: flagged (their samples still share sessions).
+      // What the boats' cards show as badges, by problem: {"log_failing": ["b1"], ...}.
+      json problems = json::object();
+      for (const auto& b : boats) {
+        for (const auto& p : boat_problems(b))
+          problems[p["code"].get<std::string>()].push_back(b.last.boat_id);
+      }
+      j["boat_problems"] = problems;
+      // Two nodes sailing with one boat id: the store records the later one apart.
       json duplicates = json::array();
       for (const auto& d : ctx.store.duplicate_ids())
         duplicates.push_back({{"boat_id", d.boat_id}, {"runs", {d.boot_a, d.boot_b}}});

@@ -83,7 +83,9 @@ TEST_F(FleetTest, TwoNodesWithOneIdAreFlaggedOnTheCardAndInHealthz) {
         if (!res || res->status != 200) return false;
         health = json::parse(res->body);
         return health.contains("duplicate_boat_ids") &&
-               health["duplicate_boat_ids"][0]["boat_id"] == "twin";
+               health["duplicate_boat_ids"][0]["boat_id"] == "twin" &&
+               health["boat_problems"].contains("duplicate_id") &&
+               health["boat_problems"]["duplicate_id"][0] == "twin";
       },
       15s))
       << health;
