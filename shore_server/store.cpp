@@ -146,7 +146,8 @@ std::string tier_upsert(std::uint64_t width_s, const std::string& select_from) {
   std::string sql =
       "INSERT INTO attitude_tier SELECT a.boat_id, " + w + ", a.t_utc_ns / " + w_ns + ", 1";
   for (int e = 0; e < 4; ++e) sql += ", a.t_utc_ns, a.heel_deg, a.pitch_deg, a.heading_deg";
-  sql += " " + select_from + " ON CONFLICT (boat_id, width_s, bucket) DO UPDATE SET n = n + excluded.n";
+  sql += " " + select_from +
+         " ON CONFLICT (boat_id, width_s, bucket) DO UPDATE SET n = n + excluded.n";
   static constexpr std::array<std::pair<const char*, const char*>, 4> kExtremes = {
       {{"heel", "<"}, {"heel", ">"}, {"pitch", "<"}, {"pitch", ">"}}};
   for (std::size_t e = 0; e < kExtremes.size(); ++e) {
@@ -210,7 +211,8 @@ void rebuild_tiers(sqlite3* db, const std::string& boat_id, std::uint64_t from_n
     del.step();
     Stmt add(db, tier_upsert(w, "FROM attitude a WHERE (" +
                                     std::string(boat_id.empty() ? "?1 = ''" : "a.boat_id = ?1") +
-                                    ") AND a.t_utc_ns BETWEEN ?2 AND ?3 ORDER BY a.boat_id, a.t_utc_ns")
+                                    ") AND a.t_utc_ns BETWEEN ?2 AND ?3 "
+                                    "ORDER BY a.boat_id, a.t_utc_ns")
                      .c_str());
     add.bind(1, boat_id).bind_u(2, lo).bind_u(3, hi);
     add.step();
@@ -669,8 +671,14 @@ bool Store::commit(std::vector<AttitudeSample>& batch) {
     std::sort(batch.begin(), batch.end(), [](const AttitudeSample& a, const AttitudeSample& b) {
       return a.boat_id != b.boat_id ? a.boat_id < b.boat_id : a.t_utc_ns < b.t_utc_ns;
     });
+    const AttitudeSample* run_of_id = nullptr;  // the id is looked up once per run in a row
+    const std::string* recorded = nullptr;
     for (const auto& s : batch) {
-      const std::string& id = recorded_id(s);
+      if (!run_of_id || run_of_id->boat_id != s.boat_id || run_of_id->boot_id != s.boot_id) {
+        recorded = &recorded_id(s);
+        run_of_id = &s;
+      }
+      const std::string& id = *recorded;
       sqlite3_reset(insert_);
       sqlite3_bind_text(insert_, 1, id.c_str(), static_cast<int>(id.size()), SQLITE_TRANSIENT);
       sqlite3_bind_int64(insert_, 2, static_cast<sqlite3_int64>(s.t_utc_ns));
@@ -907,10 +915,8 @@ std::string Store::duplicate_alias(const std::string& boat_id, std::uint64_t boo
 const std::string& Store::recorded_id(const AttitudeSample& s) {
   const auto key = std::make_pair(s.boat_id, s.boot_id);
   if (const auto it = aliases_.find(key); it != aliases_.end()) return it->second;
-  // The same test as duplicate_ids(): this run and another, both storing lately, over time
-  // spans that overlap by more than a second. The later-started run is the second node's.
-  constexpr auto kWindow = std::chrono::seconds(30);
-  constexpr std::uint64_t kOverlap_ns = 1'000'000'000;
+  // Another run storing the same span at once (at_once), started earlier: this is the second
+  // node's run.
   const auto now = std::chrono::steady_clock::now();
   bool second = false;
   {
@@ -920,11 +926,8 @@ const std::string& Store::recorded_id(const AttitudeSample& s) {
     const auto mine = boat->second.find(s.boot_id);
     if (mine == boat->second.end()) return s.boat_id;
     for (const auto& [boot, span] : boat->second) {
-      if (boot == s.boot_id || now - span.touched > kWindow) continue;
-      const std::uint64_t lo = std::max(span.min_t_ns, mine->second.min_t_ns);
-      const std::uint64_t hi = std::min(span.max_t_ns, mine->second.max_t_ns);
-      if (hi > lo && hi - lo > kOverlap_ns && span.min_t_ns < mine->second.min_t_ns &&
-          !aliases_.count({s.boat_id, boot}))
+      if (boot != s.boot_id && at_once(span, mine->second, now) &&
+          span.min_t_ns < mine->second.min_t_ns && !aliases_.count({s.boat_id, boot}))
         second = true;
     }
   }
@@ -939,23 +942,26 @@ const std::string& Store::recorded_id(const AttitudeSample& s) {
   return aliases_.emplace(key, alias).first->second;
 }
 
-std::vector<Store::DuplicateId> Store::duplicate_ids() const {
+bool Store::at_once(const RunSpan& a, const RunSpan& b,
+                    std::chrono::steady_clock::time_point now) {
   // Both runs storing within this window, and their spans overlapping by more than a second: a
   // restarted boat's runs follow each other in time, two boats with one id interleave.
   constexpr auto kWindow = std::chrono::seconds(30);
   constexpr std::uint64_t kOverlap_ns = 1'000'000'000;
+  if (now - a.touched > kWindow || now - b.touched > kWindow) return false;
+  const std::uint64_t lo = std::max(a.min_t_ns, b.min_t_ns);
+  const std::uint64_t hi = std::min(a.max_t_ns, b.max_t_ns);
+  return hi > lo && hi - lo > kOverlap_ns;
+}
+
+std::vector<Store::DuplicateId> Store::duplicate_ids() const {
   const auto now = std::chrono::steady_clock::now();
   std::lock_guard lock(receipts_mutex_);
   std::vector<DuplicateId> out;
   for (const auto& [boat, runs] : spans_) {
     for (auto a = runs.begin(); a != runs.end(); ++a) {
-      if (now - a->second.touched > kWindow) continue;
-      for (auto b = std::next(a); b != runs.end(); ++b) {
-        if (now - b->second.touched > kWindow) continue;
-        const std::uint64_t lo = std::max(a->second.min_t_ns, b->second.min_t_ns);
-        const std::uint64_t hi = std::min(a->second.max_t_ns, b->second.max_t_ns);
-        if (hi > lo && hi - lo > kOverlap_ns) out.push_back({boat, a->first, b->first});
-      }
+      for (auto b = std::next(a); b != runs.end(); ++b)
+        if (at_once(a->second, b->second, now)) out.push_back({boat, a->first, b->first});
     }
   }
   return out;

@@ -265,6 +265,9 @@ class Store {
     std::uint64_t max_t_ns = 0;
     std::chrono::steady_clock::time_point touched;
   };
+  /// Two runs of one id storing the same time span at once (see duplicate_ids()).
+  static bool at_once(const RunSpan& a, const RunSpan& b,
+                      std::chrono::steady_clock::time_point now);
   /// boat -> run -> the time span it stored (under receipts_mutex_), for duplicate_ids().
   std::map<std::string, std::map<std::uint64_t, RunSpan>> spans_;
   /// (boat, run) -> the id its samples are recorded under: a second node's run (writer thread;
