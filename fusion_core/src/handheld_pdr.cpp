@@ -371,13 +371,11 @@ double WalkingHeading::heading_at(double t_s) const {
 }
 
 // ---------------------------------------------------------------------------------------------
-HandheldPdr::HandheldPdr(Params p, const StepLengthModel& lengths)
+HandheldPdr::HandheldPdr(Params p)
     : params_(p),
-      lengths_(lengths),
       att_(p.attitude),
       bias_(p.bias),
       detector_(p.steps) {}
-
 
 int HandheldPdr::update(const ImuSample& s, const Eigen::Vector3d& mag_uT) {
   if (gate_imu_sample(s, ImuGateParams{}, have_t_, last_t_s_, diag_).verdict ==
@@ -422,7 +420,7 @@ int HandheldPdr::update(const ImuSample& s, const Eigen::Vector3d& mag_uT) {
     }
     const double hz = interval > 0.0 ? 1.0 / interval : 1.8;
     const double len =
-        params_.step_scale * lengths_.length_m(PhonePose::kHandHeld, params_.height_m, hz);
+        params_.step_scale * walk_ratio_step_length_m(params_.height_m, hz, params_.length);
     const double heading = heading_.heading_at(c.t_s);
     last_.t_s = c.t_s;
     last_.x_m += len * std::sin(heading);

@@ -18,7 +18,6 @@ using telltale::fusion::HandheldPdr;
 using telltale::fusion::HandheldPdrParams;
 using telltale::fusion::HandheldStep;
 using telltale::fusion::ImuSample;
-using telltale::fusion::PhonePose;
 
 constexpr double kG = 9.80665;
 constexpr double kRate = 50.0;
@@ -59,11 +58,10 @@ struct Walk {
   Truth truth;
 };
 
-/// The step's true length: the population model's own at this height and cadence, so the test
-/// checks the pipeline (counting, gating, heading), not the model.
+/// The step's true length: the walk-ratio law's own at this height and cadence, so the test
+/// checks the pipeline (counting, gating, heading), not the law.
 double true_step_length(double step_hz) {
-  return telltale::fusion::builtin_step_length_model().length_m(PhonePose::kHandHeld, 1.75,
-                                                                step_hz);
+  return telltale::fusion::walk_ratio_step_length_m(1.75, step_hz);
 }
 
 Walk synthesise(const std::vector<Segment>& plan, const Eigen::Vector3d& gyro_bias,
@@ -339,3 +337,16 @@ TEST(StandBiasLearner, ChangingFieldGivesNoMagneticEstimate) {
 }
 
 }  // namespace
+
+// The walk-ratio law: the population norm it is anchored on (a step of 0.415 x height at
+// 112 steps/min), the step in proportion to cadence and to height. Seed 003's simulator-fitted
+// line gave 0.69 m at 1.6 steps/s and 1.75 m, against the 0.58-0.61 m of real phone walks there.
+TEST(WalkRatio, StepLengthFollowsTheWalkRatioOfPeople) {
+  using telltale::fusion::walk_ratio_step_length_m;
+  EXPECT_NEAR(walk_ratio_step_length_m(1.75, 112.0 / 60.0), 0.415 * 1.75, 0.005);
+  EXPECT_NEAR(walk_ratio_step_length_m(1.75, 1.6), 0.62, 0.01);
+  EXPECT_NEAR(walk_ratio_step_length_m(1.75, 2.0) / walk_ratio_step_length_m(1.75, 1.5),
+              2.0 / 1.5, 1e-12);
+  EXPECT_NEAR(walk_ratio_step_length_m(1.60, 1.8) / walk_ratio_step_length_m(1.90, 1.8),
+              1.60 / 1.90, 1e-12);
+}

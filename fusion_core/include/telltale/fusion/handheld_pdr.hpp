@@ -8,7 +8,7 @@
 ///   3. WalkStepDetector: steps from the vertical specific force, counted only once the motion
 ///      is a walk (a regular cadence with the phone's tilt steady), so handling the phone,
 ///      standing and pausing make no steps and no distance;
-///   4. step length from height and cadence (StepLengthModel, hand-held row);
+///   4. step length from height and cadence by the walk ratio (walk_ratio_step_length_m);
 ///   5. WalkingHeading: the phone's yaw about the vertical, the bias-corrected gyro integrated
 ///      about the up direction. A phone held in front keeps a fixed yaw to the walking direction,
 ///      so turns of the phone are turns of the walk; the magnetometer (unreliable indoors) only
@@ -230,9 +230,31 @@ class WalkingHeading {
 };
 
 // ---------------------------------------------------------------------------------------------
+/// Step length from height and cadence, by the walk ratio. People choose, at every walking
+/// speed from a stroll to a brisk walk, nearly the same ratio of step length to cadence (the
+/// "walk ratio": the combination of the two that costs least energy per metre); a faster walk
+/// lengthens the step and quickens the cadence in proportion. The ratio scales with body size.
+/// Anchored on the population norm at the preferred speed, a step of 0.415 x height at
+/// 112 steps/min: ratio / height = 0.415 / 112 = 0.0037 per (step/min), so
+///   L = 0.0037 x height x 60 f = 0.222 x height x f     (L, height in m; f in steps/s).
+/// At 1.75 m: 0.65 m at 100 steps/min, 0.58 m at 90. This replaces seed 003's linear
+/// L = a h + b f + c for the hand-held phone: its coefficients were fitted to our own gait
+/// simulator, whose walkers take a 0.67-0.72 m step at 95-100 steps/min, longer than people do.
+/// Below about 98 steps/min the ratio is known to grow (slow walkers shorten the step less than
+/// the cadence); that is not modelled, so a slow walker's distance comes out a little short.
+struct WalkRatioParams {
+  double ratio_per_height_min = 0.0037;  ///< walk ratio / height, m per (step/min) per m
+};
+[[nodiscard]] inline double walk_ratio_step_length_m(double height_m, double step_hz,
+                                                     const WalkRatioParams& p = {}) {
+  return p.ratio_per_height_min * height_m * 60.0 * step_hz;
+}
+
+// ---------------------------------------------------------------------------------------------
 struct HandheldPdrParams {
   double height_m = 1.75;
-  double step_scale = 1.0;  ///< personal factor on the model's step length (1: population)
+  double step_scale = 1.0;  ///< personal factor on the walk-ratio step length (1: population)
+  WalkRatioParams length;
   TelltaleAttitudeParams attitude;
   StandBiasParams bias;
   WalkStepParams steps;
@@ -252,7 +274,7 @@ struct HandheldStep {
 class HandheldPdr {
  public:
   using Params = HandheldPdrParams;
-  explicit HandheldPdr(Params p = {}, const StepLengthModel& lengths = builtin_step_length_model());
+  explicit HandheldPdr(Params p = {});
   /// Feeds one sample (mag may be NaN). Returns how many steps were laid at it: steps()[0..n),
   /// each with its own time (at or before this sample's).
   int update(const ImuSample& s, const Eigen::Vector3d& mag_uT);
@@ -273,7 +295,6 @@ class HandheldPdr {
   ImuGateCounts diag_;
   bool have_t_ = false;
   double last_t_s_ = 0.0;
-  StepLengthModel lengths_;
   TelltaleAttitudeFilter att_;
   StandBiasLearner bias_;
   WalkStepDetector detector_;
