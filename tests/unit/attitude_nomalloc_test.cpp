@@ -1,27 +1,12 @@
-// No heap inside update(), for every attitude filter. This executable compiles the filters'
-// sources itself with EIGEN_RUNTIME_NO_MALLOC (tests/CMakeLists.txt), so Eigen's guard covers
-// their code, and counts every operator new for allocations outside Eigen.
+// No heap inside update(), for every attitude filter, with the shared counting allocator of
+// no_heap_guard.hpp (fusion_core linked as built for the product).
 #include <gtest/gtest.h>
 
-#include <atomic>
 #include <cmath>
-#include <cstdlib>
-#include <new>
 #include <vector>
 
+#include "no_heap_guard.hpp"
 #include "telltale/fusion/attitude.hpp"
-
-namespace {
-std::atomic<long> g_news{0};
-}
-
-void* operator new(std::size_t n) {
-  ++g_news;
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace telltale::fusion {
 namespace {
@@ -42,18 +27,17 @@ TEST(AttitudeNoHeap, UpdateAllocatesNothing) {
   }
   for (const auto& name : attitude_filter_names()) {
     auto filter = make_attitude_filter(name);
-    const long before = g_news.load();
-    Eigen::internal::set_is_malloc_allowed(false);
     double sink = 0.0;
-    for (std::size_t k = 0; k < samples.size(); ++k) {
-      const ImuSample& s = samples[k];
-      // The boat's speed from GNSS for the first half (held from 5 Hz fixes), unknown after.
-      if (k % 20 == 0) filter->set_speed(k < 1000 ? 2.5 : std::nan(""), 0.1, 0.05);
-      filter->update(s);
-      sink += filter->output().heel_rad;
-    }
-    Eigen::internal::set_is_malloc_allowed(true);
-    EXPECT_EQ(g_news.load(), before) << name;
+    const std::size_t n = telltale::test::allocations_in([&] {
+      for (std::size_t k = 0; k < samples.size(); ++k) {
+        const ImuSample& s = samples[k];
+        // The boat's speed from GNSS for the first half (held from 5 Hz fixes), unknown after.
+        if (k % 20 == 0) filter->set_speed(k < 1000 ? 2.5 : std::nan(""), 0.1, 0.05);
+        filter->update(s);
+        sink += filter->output().heel_rad;
+      }
+    });
+    EXPECT_EQ(n, 0u) << name;
     EXPECT_TRUE(std::isfinite(sink)) << name;
   }
 }
