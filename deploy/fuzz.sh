@@ -24,35 +24,53 @@ echo "fuzz: build $(($(date +%s) - start)) s"
 # Leaks are findings too; UBSan stops at the first report like ASan does.
 export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
-failed=0
-summary=$(printf '%-18s %8s %12s %10s %8s %8s\n' target seconds executions exec/s cov crashes)
-for t in "${targets[@]}"; do
-  corpus="$build/corpus/$t"
-  crashes="$build/crashes/$t"
-  log="$build/logs/$t.log"
+# Targets run side by side, one per core: each is a single process on one input at a time.
+run_target() {
+  local t=$1 corpus="$build/corpus/$1" crashes="$build/crashes/$1" log="$build/logs/$1.log"
   mkdir -p "$corpus" "$crashes" "$(dirname "$log")"
-  dict=()
+  rm -f "$build/logs/$t.summary"
+  local dict=()
   [ -f "$root/tests/fuzz/dict/$t.dict" ] && dict=(-dict="$root/tests/fuzz/dict/$t.dict")
+  local before t0 status=0
   before=$(find "$crashes" -type f | wc -l)
   t0=$(date +%s)
-  status=0
   # -timeout: one input taking over 10 s is a hang, reported like a crash.
   "$build/bin/$t" -max_total_time="$seconds" -timeout=10 -print_final_stats=1 \
     -artifact_prefix="$crashes/" "${dict[@]}" "$corpus" "$root/tests/fuzz/corpus/$t" \
     >"$log" 2>&1 || status=$?
+  local ran execs rate cov found
   ran=$(($(date +%s) - t0))
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
   cov=$({ grep -o 'cov: [0-9]*' "$log" || true; } | tail -1 | cut -d' ' -f2)
   found=$(($(find "$crashes" -type f | wc -l) - before))
   if [ "$status" -ne 0 ] && [ "$found" -eq 0 ]; then found=1; fi  # died without an artifact
-  summary+=$(printf '\n%-18s %8s %12s %10s %8s %8s' "$t" "$ran" "${execs:-?}" "${rate:-?}" \
-    "${cov:-?}" "$found")
+  printf '%-18s %8s %12s %10s %8s %8s\n' "$t" "$ran" "${execs:-?}" "${rate:-?}" "${cov:-?}" \
+    "$found" >"$build/logs/$t.summary"
   if [ "$found" -ne 0 ]; then
-    failed=1
     echo "fuzz: $t crashed (status $status); log $log; inputs in $crashes/:" >&2
     grep -E 'ERROR|INVARIANT|SUMMARY|Test unit written' "$log" | head -20 >&2 || true
+    return 1
   fi
+}
+jobs_max=$(nproc)
+failed=0
+running=0
+for t in "${targets[@]}"; do
+  if [ "$running" -ge "$jobs_max" ]; then
+    wait -n || failed=1
+    running=$((running - 1))
+  fi
+  run_target "$t" &
+  running=$((running + 1))
+done
+while [ "$running" -gt 0 ]; do
+  wait -n || failed=1
+  running=$((running - 1))
+done
+summary=$(printf '%-18s %8s %12s %10s %8s %8s' target seconds executions exec/s cov crashes)
+for t in "${targets[@]}"; do
+  summary+=$'\n'$(cat "$build/logs/$t.summary" 2>/dev/null || echo "$t: did not run")
 done
 echo "$summary"
 [ "$failed" -eq 0 ] || { echo "fuzz: FAILED (crash inputs kept under $build/crashes)" >&2; exit 1; }
