@@ -21,56 +21,6 @@ bool finite_in(double v, double lo, double hi) { return std::isfinite(v) && v >=
 /// NaN ("no value") or within [lo, hi].
 bool nan_or_in(double v, double lo, double hi) { return std::isnan(v) || (v >= lo && v <= hi); }
 
-const char* kind_name(msg::NodeKind kind) {
-  switch (kind) {
-    case msg::NODE_KIND_BOAT:
-      return "boat";
-    case msg::NODE_KIND_WEARABLE:
-      return "wearable";
-    case msg::NODE_KIND_SHORE:
-      return "shore";
-  }
-  return "unknown";
-}
-
-const char* gait_name(msg::Gait g) {
-  switch (g) {
-    case msg::GAIT_STILL:
-      return "still";
-    case msg::GAIT_SLOW_WALK:
-      return "slow_walk";
-    case msg::GAIT_WALK:
-      return "walk";
-    case msg::GAIT_FAST_WALK:
-      return "fast_walk";
-    case msg::GAIT_JOG:
-      return "jog";
-    case msg::GAIT_RUN:
-      return "run";
-    case msg::GAIT_UNKNOWN:
-      break;
-  }
-  return "unknown";
-}
-
-const char* pose_name(msg::Pose p) {
-  switch (p) {
-    case msg::POSE_HAND_HELD:
-      return "hand_held";
-    case msg::POSE_PHONE_CALL:
-      return "phone_call";
-    case msg::POSE_POCKET:
-      return "pocket";
-    case msg::POSE_ARM_SWING:
-      return "arm_swing";
-    case msg::POSE_FOOT:
-      return "foot";
-    case msg::POSE_UNKNOWN:
-      break;
-  }
-  return "unknown";
-}
-
 /// The first member of every keyed type the shore reads is its string id: after the 4-byte
 /// encapsulation header comes its CDR length (terminating NUL included). True when that length
 /// is the length the bounded string kept plus one, i.e. nothing was cut and no NUL was inside.
@@ -181,7 +131,7 @@ Reject check(const WearableSample& s, std::uint64_t shore_now_ns) {
 Reject check(const FixSample& s, std::uint64_t shore_now_ns) {
   if (!contract_id(s.boat_id)) return Reject::kId;
   if (!contract_time(s.t_utc_ns, shore_now_ns)) return Reject::kTime;
-  if (s.fix != "none" && s.fix != "2d" && s.fix != "3d" && s.fix != "dgnss") return Reject::kValue;
+  if (!known_fix_kind(s.fix)) return Reject::kValue;
   if (s.fix == "none") {
     // No fix: no position may ride along (the gate on the boat blanks it).
     for (double v : {s.lat_deg, s.lon_deg, s.sog_m_s, s.cog_deg})
@@ -248,88 +198,6 @@ nlohmann::json IngestCounters::to_json() const {
   j["last_rejected"] =
       last_rejected_.empty() ? nlohmann::json(nullptr) : nlohmann::json(last_rejected_);
   return j;
-}
-
-AttitudeSample from_wire(const msg::BoatAttitude& m) {
-  AttitudeSample s;
-  s.boat_id = m.boat_id().to_string();
-  s.seq = m.seq();
-  s.t_utc_ns = m.t_utc_ns();
-  s.heel_deg = m.heel_deg();
-  s.pitch_deg = m.pitch_deg();
-  s.heading_deg = m.heading_deg();
-  s.heel_rate_deg_s = m.heel_rate_deg_s();
-  s.pitch_rate_deg_s = m.pitch_rate_deg_s();
-  s.yaw_rate_deg_s = m.yaw_rate_deg_s();
-  s.accel_weight = m.accel_weight();
-  s.quality = m.quality();
-  s.leds[0] = m.leds().left_leds();
-  s.leds[1] = m.leds().right_leds();
-  s.leds[2] = m.leds().up_leds();
-  s.leds[3] = m.leds().down_leds();
-  s.led_count = m.leds().led_count();
-  s.boot_id = m.boot_id();
-  return s;
-}
-
-WearableSample from_wire(const msg::WearableMotion& m) {
-  WearableSample w;
-  w.athlete_id = m.athlete_id().to_string();
-  w.seq = m.seq();
-  w.t_utc_ns = m.t_utc_ns();
-  w.steps = m.steps();
-  w.cadence_spm = m.cadence_spm();
-  w.gait = gait_name(m.gait());
-  w.pose = pose_name(m.pose());
-  w.x_m = m.x_m();
-  w.y_m = m.y_m();
-  w.heading_deg = m.heading_deg();
-  w.distance_m = m.distance_m();
-  return w;
-}
-
-FixSample from_wire(const msg::BoatFix& m) {
-  FixSample f;
-  f.boat_id = m.boat_id().to_string();
-  f.seq = m.seq();
-  f.t_utc_ns = m.t_utc_ns();
-  f.gnss_utc_ns = m.gnss_utc_ns();
-  f.lat_deg = m.lat_deg();
-  f.lon_deg = m.lon_deg();
-  f.sog_m_s = m.sog_m_s();
-  f.cog_deg = m.cog_deg();
-  switch (m.fix()) {
-    case msg::FIX_KIND_NONE:
-      f.fix = "none";
-      break;
-    case msg::FIX_KIND_2D:
-      f.fix = "2d";
-      break;
-    case msg::FIX_KIND_3D:
-      f.fix = "3d";
-      break;
-    case msg::FIX_KIND_DGNSS:
-      f.fix = "dgnss";
-      break;
-    default:
-      f.fix = "invalid";  // an enum value off the contract: refused by check()
-  }
-  f.satellites = m.satellites();
-  f.hdop = static_cast<double>(m.hdop());
-  f.boot_id = m.boot_id();
-  return f;
-}
-
-NodeStatusInfo from_wire(const msg::NodeStatus& m) {
-  NodeStatusInfo s;
-  s.kind = kind_name(m.kind());
-  s.software_version = m.software_version().to_string();
-  s.uptime_s = m.uptime_s();
-  s.sensor_health = m.sensor_health();
-  s.health_text = m.health_text().to_string();
-  s.samples_published = m.samples_published();
-  s.group = m.group().to_string();
-  return s;
 }
 
 Ingest::Ingest(IngestSinks sinks, std::function<std::uint64_t()> clock)

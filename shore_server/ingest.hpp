@@ -28,6 +28,7 @@
 
 #include "fleet.hpp"
 #include "telltalePubSubTypes.h"
+#include "wire.hpp"
 
 namespace telltale::shore {
 
@@ -113,11 +114,6 @@ class Ingest {
   std::function<std::uint64_t()> clock_;
   IngestCounters counters_;
 };
-
-[[nodiscard]] AttitudeSample from_wire(const msg::BoatAttitude& m);
-[[nodiscard]] WearableSample from_wire(const msg::WearableMotion& m);
-[[nodiscard]] NodeStatusInfo from_wire(const msg::NodeStatus& m);
-[[nodiscard]] FixSample from_wire(const msg::BoatFix& m);
 
 /// The generated types, deserialising strictly: a key string longer than its bound (or with a
 /// NUL inside) arrives as an empty id, which the checks reject, instead of a truncated one that

@@ -9,6 +9,7 @@
 #include "dds_security.hpp"
 #include "shutdown.hpp"
 #include "telltalePubSubTypes.h"
+#include "wire.hpp"
 
 namespace telltale::shore {
 
@@ -171,11 +172,7 @@ std::vector<std::string> ShoreDds::recycle_full_readers(std::chrono::seconds min
 
 bool ShoreDds::publish_ack(const std::string& boat_id, std::uint64_t boot_id,
                            std::uint64_t acked_seq) {
-  msg::ShoreAck m;
-  m.boat_id(boat_id);
-  m.boot_id(boot_id);
-  m.acked_seq(acked_seq);
-  m.t_utc_ns(utc_now_ns());
+  msg::ShoreAck m = to_wire(Store::Ack{boat_id, boot_id, acked_seq}, utc_now_ns());
   std::lock_guard lock(write_mutex_);
   const auto now = std::chrono::steady_clock::now();
   const auto key = std::make_pair(boat_id, boot_id);
@@ -210,18 +207,7 @@ void ShoreDds::publish_rules(const std::vector<AlarmRule>& rules) {
   ++rule_revision_;
   std::vector<std::string> ids;
   for (const auto& r : rules) {
-    msg::AlarmRule m;
-    m.rule_id(r.id);
-    m.scope(r.scope);
-    m.quantity(r.quantity == AlarmQuantity::kHeel ? msg::ALARM_QUANTITY_HEEL
-                                                  : msg::ALARM_QUANTITY_PITCH);
-    m.min_deg(r.min_deg);
-    m.max_deg(r.max_deg);
-    m.hold_s(r.hold_s);
-    m.hysteresis_deg(r.hysteresis_deg);
-    m.level(r.level == AlarmLevel::kAlarm ? msg::ALARM_LEVEL_ALARM : msg::ALARM_LEVEL_WARN);
-    m.enabled(r.enabled);
-    m.revision(rule_revision_);
+    msg::AlarmRule m = to_wire(r, rule_revision_);
     rule_writer_->write(&m);
     ids.push_back(r.id);
   }
@@ -235,33 +221,7 @@ void ShoreDds::publish_rules(const std::vector<AlarmRule>& rules) {
 }
 
 void ShoreDds::publish_event(const AlarmEvent& e) {
-  msg::AlarmEvent m;
-  m.boat_id(e.boat_id);
-  m.rule_id(e.rule_id);
-  m.event_id(e.id);
-  m.level(e.level == AlarmLevel::kAlarm  ? msg::ALARM_LEVEL_ALARM
-          : e.level == AlarmLevel::kWarn ? msg::ALARM_LEVEL_WARN
-                                         : msg::ALARM_LEVEL_NORMAL);
-  switch (e.phase) {
-    case AlarmPhase::kRaised:
-      m.phase(msg::ALARM_PHASE_RAISED);
-      m.t_utc_ns(e.raised_ns);
-      break;
-    case AlarmPhase::kAcknowledged:
-      m.phase(msg::ALARM_PHASE_ACKNOWLEDGED);
-      m.t_utc_ns(e.acknowledged_ns);
-      break;
-    case AlarmPhase::kSilenced:
-      m.phase(msg::ALARM_PHASE_SILENCED);
-      m.t_utc_ns(e.silenced_ns);
-      break;
-    case AlarmPhase::kCleared:
-      m.phase(msg::ALARM_PHASE_CLEARED);
-      m.t_utc_ns(e.cleared_ns);
-      break;
-  }
-  m.value_deg(e.value_deg);
-  m.message(e.message.substr(0, 128));
+  msg::AlarmEvent m = to_wire(e);
   std::lock_guard lock(write_mutex_);
   event_writer_->write(&m);
 }
