@@ -3,10 +3,12 @@
 // time in each heel band, a second session (another boat or another day) overlaid, and export.
 // With GNSS: the session's track coloured by heel with a marker that follows the scrubber, a
 // speed chart, distance and speeds, GPX download, and heel against speed (heel_speed.js).
+// Manoeuvres (manoeuvres.js): listed, marked on the timeline and the track, overlaid at t0, ranked.
 import { api, has, q } from './api.js';
 import { COLORS, autoResize, loadUPlot, markersPlugin, widthOf } from './charts.js';
 import { KNOTS_PER_M_S } from './geo.js';
 import { heelSpeedPanel } from './heel_speed.js';
+import { manoeuvreMarkersPlugin, manoeuvrePanels } from './manoeuvres.js';
 import { moveTrackMarker, trackPanel } from './track.js';
 import { clock, deg, duration, el, isoToSeconds, svg } from './util.js';
 
@@ -72,7 +74,7 @@ export function mountReview(container, { query, navigate }) {
     const main = await load(state.session);
     const vs = state.vs ? await load(state.vs) : null;
     if (stopped) return;
-    cleanups.push(render(body, uPlot, main, vs));
+    cleanups.push(render(body, uPlot, main, vs, sessions));
   })().catch((err) => body.append(el('p', { class: 'message', text: `Cannot load the session: ${err.message}` })));
 
   return () => {
@@ -81,7 +83,7 @@ export function mountReview(container, { query, navigate }) {
   };
 }
 
-function render(body, uPlot, main, vs) {
+function render(body, uPlot, main, vs, sessions) {
   const m = main.detail;
   const t0 = m.start_t_s;
   // Two sessions that overlap in time (two boats in the same race) are aligned on the clock;
@@ -104,6 +106,7 @@ function render(body, uPlot, main, vs) {
     x: isoToSeconds(ev.raised_at) - t0,
     color: ev.level === 'alarm' ? '#c00018' : '#b35c00',
   }));
+  const manoeuvreMarks = []; // filled once the session's manoeuvres are in
   const fmtRel = (v) => {
     const s = Math.round(v);
     return `${s < 0 ? '-' : ''}${Math.floor(Math.abs(s) / 60)}:${String(Math.abs(s) % 60).padStart(2, '0')}`;
@@ -157,7 +160,7 @@ function render(body, uPlot, main, vs) {
         const step = vals.length > 1 ? vals[1] - vals[0] : 1;
         return vals.map((v) => (step < 1 ? `${v.toFixed(1)} s` : fmtRel(v)));
       } }, { size: 50 }],
-      plugins: [markersPlugin(() => markers)],
+      plugins: [markersPlugin(() => markers), manoeuvreMarkersPlugin(() => manoeuvreMarks)],
       hooks: {
         setCursor: [(u) => {
           const i = u.cursor.idx;
@@ -185,7 +188,7 @@ function render(body, uPlot, main, vs) {
         { label: `Speed kn ${name(main)}`, stroke: COLORS[2], width: 2, spanGaps: false,
           value: (u, v) => (v === null ? '–' : `${v.toFixed(1)} kn`) }],
       axes: [{ space: 70, values: (u, vals) => vals.map((v) => fmtRel(v)) }, { size: 50 }],
-      plugins: [markersPlugin(() => markers)],
+      plugins: [markersPlugin(() => markers), manoeuvreMarkersPlugin(() => manoeuvreMarks)],
       hooks: {
         setCursor: [(u) => {
           const i = u.cursor.idx;
@@ -232,6 +235,21 @@ function render(body, uPlot, main, vs) {
   });
   showReadout(0);
 
+  // Manoeuvres: listed (a row's time jumps the scrubber to its t0), on the timeline and the
+  // track, overlaid, ranked against the other boats of the race.
+  const jump = (rel) => {
+    scrub.value = String(rel);
+    scrub.dispatchEvent(new Event('input'));
+    // The charts' cursors snap the scrubber to their nearest drawn point: back to t0 itself.
+    scrub.value = String(rel);
+    showReadout(rel);
+  };
+  const manoeuvres = has('/sessions/{id}/manoeuvres')
+    ? manoeuvrePanels({ uPlot, detail: m, sessions, jump, marks: manoeuvreMarks, trackSection: track,
+      redraw: () => charts.forEach((u) => u.redraw(false)) })
+    : null;
+  if (manoeuvres) body.append(manoeuvres.nodes[0]);
+
   // Alarm events on the timeline, listed too.
   body.append(el('section', { class: 'panel', 'aria-label': 'alarm events' },
     el('h2', { text: `Alarm events (${main.events.length})` }),
@@ -249,10 +267,12 @@ function render(body, uPlot, main, vs) {
     el('h2', { text: 'Time in each heel band' }),
     bandsTable([main, vs].filter(Boolean), name)));
   if (m.gnss) body.append(heelSpeedPanel(m));
+  if (manoeuvres) body.append(manoeuvres.nodes[1]);
 
   const stopResize = autoResize(() => charts, chartsBox, CHART_H);
   return () => {
     stopResize();
+    manoeuvres?.destroy();
     charts.forEach((u) => u.destroy());
   };
 }
