@@ -1,11 +1,14 @@
 // Manoeuvres in the REST API (see manoeuvre_routes.hpp).
 #include "manoeuvre_routes.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include "json_views.hpp"
+#include "query.hpp"
 #include "route_helpers.hpp"
 #include "store.hpp"
 #include "telltale/fusion/manoeuvres.hpp"
@@ -23,6 +26,10 @@ std::string num(double v, int decimals = 3) {
   return buf;
 }
 
+// With `from`: the data read from this long before it, so a manoeuvre at `from` has its
+// detection windows (10 s of course either side) and its metrics' (20 s before t0) complete.
+constexpr std::uint64_t kLookbackNs = 45'000'000'000ULL;
+
 std::uint64_t to_ns(std::uint64_t base_ns, double t_s) {
   return base_ns + static_cast<std::uint64_t>(std::llround(std::max(0.0, t_s) * 1e9));
 }
@@ -33,7 +40,7 @@ void register_manoeuvre_routes(httplib::Server& server, ShoreContext& ctx) {
   server.Get(R"(/api/v1/sessions/([^/]+)/manoeuvres)", [&ctx](const httplib::Request& req,
                                                              httplib::Response& res) {
     const Principal p = who(ctx, req);
-    allow_params(req, {"format", "wind_from_deg"});
+    allow_params(req, {"format", "wind_from_deg", "from"});
     bool csv = false;
     if (const std::string* f = param(req, "format")) {
       if (*f == "csv") csv = true;
@@ -54,17 +61,26 @@ void register_manoeuvre_routes(httplib::Server& server, ShoreContext& ctx) {
     const auto rel = [base](std::uint64_t t) {
       return t >= base ? static_cast<double>(t - base) * 1e-9 : -static_cast<double>(base - t) * 1e-9;
     };
+    // `from` (a live session polled by the fleet view): only the manoeuvres from then, read
+    // from the data of the 45 s before it on, not the whole session.
+    const std::string* from_param = param(req, "from");
+    const std::uint64_t from_ns = from_param ? parse_range(from_param, nullptr).from_ns : 0;
+    const std::uint64_t read_from = std::max(s->start_ns, from_ns > kLookbackNs ? from_ns - kLookbackNs : 0);
     std::vector<fusion::CourseSample> fixes;
-    ctx.store.visit_fixes(s->boat_id, s->start_ns, s->end_ns, [&](const FixSample& f) {
+    std::uint64_t data_to = 0;
+    ctx.store.visit_fixes(s->boat_id, read_from, s->end_ns, [&](const FixSample& f) {
       fixes.push_back({rel(f.t_utc_ns), f.cog_deg, f.sog_m_s});
+      data_to = f.t_utc_ns;
       return true;
     });
     std::vector<fusion::HeelSample> heel;
-    ctx.store.visit_attitude(s->boat_id, s->start_ns, s->end_ns, [&](const AttitudeRow& r) {
+    ctx.store.visit_attitude(s->boat_id, read_from, s->end_ns, [&](const AttitudeRow& r) {
       heel.push_back({rel(r.t_utc_ns), r.heel_deg, r.pitch_deg});
       return true;
     });
-    const fusion::ManoeuvreReport rep = fusion::analyse_manoeuvres(fixes, heel, opt);
+    fusion::ManoeuvreReport rep = fusion::analyse_manoeuvres(fixes, heel, opt);
+    if (from_param)
+      std::erase_if(rep.manoeuvres, [&](const fusion::Manoeuvre& m) { return to_ns(base, m.t0_s) < from_ns; });
     if (csv) {
       std::string out =
           "kind,t_utc,turn_deg,turn_dir,distance_lost_m,vmg_lost_m,heel_peak_deg,"
@@ -136,6 +152,8 @@ void register_manoeuvre_routes(httplib::Server& server, ShoreContext& ctx) {
     res.set_content(
         to_json_text({{"session_id", s->id},
                       {"boat_id", s->boat_id},
+                      {"from_utc", from_param ? json(iso8601(from_ns)) : json(nullptr)},
+                      {"data_to_utc", data_to ? json(iso8601(data_to)) : json(nullptr)},
                       {"wind", {{"from_deg", rep.wind_from_deg ? json(*rep.wind_from_deg) : json(nullptr)},
                                 {"given", rep.wind_given},
                                 {"uncertainty_deg", rep.wind_from_deg ? json(rep.wind_uncertainty_deg) : json(nullptr)},

@@ -1,7 +1,9 @@
 // One boat's card: big heel and pitch numbers, the boat seen from astern (heels) and from the
 // side (pitches), the instrument's LED panel, alarm state, stale marker and a one-minute
-// sparkline. Used by the fleet view and at the top of the boat view.
+// sparkline; on the fleet view also the boat's last manoeuvre (kind, age, distance lost). Used by
+// the fleet view and at the top of the boat view.
 import { speedText } from './geo.js';
+import { KIND_LABEL, metres } from './manoeuvres.js';
 import { deg, el, svg } from './util.js';
 
 const SPARK_S = 60;
@@ -39,6 +41,9 @@ export function createCard(id) {
       el('span', { class: 'label', text: 'SOG' }),
       el('span', { class: 'value speed', text: '–' }), el('span', { class: 'unit-big', text: 'kn' }),
       el('span', { class: 'speed-ms', text: '– m/s' }), el('span', { class: 'cog' })),
+    el('div', { class: 'last-manoeuvre', hidden: true, 'aria-label': 'last manoeuvre' },
+      el('span', { class: 'label', text: 'Last' }), el('span', { class: 'm-kind' }), el('span', { class: 'm-age' }),
+      el('span', { class: 'm-lost' })),
     el('div', { class: 'figures' },
       svg('svg', { class: 'silhouette astern', viewBox: '-55 -52 110 70', role: 'img',
         'aria-label': 'boat from astern' },
@@ -67,6 +72,7 @@ export function createCard(id) {
     group: root.querySelector('.group-tag'),
     problems: root.querySelector('.problems'),
     meta: root.querySelector('.meta'),
+    manoeuvre: root.querySelector('.last-manoeuvre'),
   };
   return root;
 }
@@ -141,4 +147,19 @@ export function updateSparkline(root, entry) {
   };
   root._parts.spark.heel.setAttribute('points', line(heel));
   root._parts.spark.pitch.setAttribute('points', line(pitch));
+}
+
+// The boat's last manoeuvre: {kind, t0 (epoch s), distance_lost_m, final}; without `m` the one
+// shown (its age moves on).
+export function updateManoeuvre(root, m = root._manoeuvre) {
+  if (!m) return;
+  root._manoeuvre = m;
+  const row = root._parts.manoeuvre;
+  row.hidden = false;
+  Object.assign(row.dataset, { kind: m.kind, t0: String(m.t0), final: String(m.final), lost: String(m.distance_lost_m) });
+  row.querySelector('.m-kind').textContent = KIND_LABEL[m.kind] ?? m.kind;
+  const age = Math.max(0, Date.now() / 1000 - m.t0);
+  row.querySelector('.m-age').textContent = age < 90 ? `${Math.round(age)} s ago` : age < 5400 ? `${Math.round(age / 60)} min ago`
+    : `${(age / 3600).toFixed(1)} h ago`;
+  row.querySelector('.m-lost').textContent = m.final ? `lost ${metres(m.distance_lost_m)}` : 'lost: measuring…';
 }

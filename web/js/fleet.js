@@ -1,5 +1,8 @@
-// Fleet view: one card per boat, sortable (id, heel, alarm) and groupable (by the boat's group).
-import { createCard, updateCard, updateSparkline } from './card.js';
+// Fleet view: one card per boat, sortable (id, heel, alarm) and groupable (by the boat's group),
+// each with the boat's last manoeuvre when the shore finds manoeuvres (manoeuvre_live.js).
+import { has } from './api.js';
+import { createCard, updateCard, updateManoeuvre, updateSparkline } from './card.js';
+import { watchManoeuvres } from './manoeuvre_live.js';
 import { el } from './util.js';
 
 const ALARM_RANK = { alarm: 0, warn: 1, normal: 2 };
@@ -21,6 +24,7 @@ export function mountFleet(container, { live }) {
     empty, grid);
 
   const cards = new Map();
+  const pending = new Map(); // a boat's last manoeuvre found before its card exists
   const dirty = new Set();
   let frame = 0;
 
@@ -29,6 +33,7 @@ export function mountFleet(container, { live }) {
     if (!c) {
       c = createCard(id);
       cards.set(id, c);
+      if (pending.has(id)) updateManoeuvre(c, pending.get(id));
       arrange();
     }
     return c;
@@ -103,12 +108,18 @@ export function mountFleet(container, { live }) {
       if (stale || c.dataset.stale === 'true') updateCard(c, entry, stale);
     }
     if (sort.value !== 'id') arrange();
+    for (const c of cards.values()) updateManoeuvre(c); // its age
   }, 1000);
+  const stopManoeuvres = has('/sessions/{id}/manoeuvres') ? watchManoeuvres((id, m) => {
+    if (cards.has(id)) updateManoeuvre(cards.get(id), m);
+    else pending.set(id, m);
+  }) : () => {};
 
   return () => {
     live.removeEventListener('boat', onBoat);
     clearInterval(sparkTimer);
     clearInterval(slowTimer);
+    stopManoeuvres();
     if (frame) cancelAnimationFrame(frame);
   };
 }
