@@ -253,7 +253,10 @@ function overlayPanel(uPlot) {
       ]).then(([att, tr]) => ({ att, tr })));
       cache.get(m.key).catch(() => cache.delete(m.key));
     }
-    return cache.get(m.key);
+    const got = cache.get(m.key);
+    // A manoeuvre of a live session whose window is not over yet: read again next time.
+    if (Date.now() / 1000 < m.t0 + AFTER_S + 5) cache.delete(m.key);
+    return got;
   };
   async function show(list) {
     const mine = ++seq;
