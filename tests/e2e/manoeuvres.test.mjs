@@ -49,15 +49,18 @@ test('review before any manoeuvre, and a failed fetch: one clear message each', 
   // The shore failing: a message in the panel, the rest of the review still there.
   await page.route('**/manoeuvres', (route) => route.fulfill({ status: 503, contentType: 'application/json',
     body: JSON.stringify({ error: 'shore busy' }) }));
-  await page.evaluate(() => { location.hash = `${location.hash}&x=1`; });
-  await page.waitForSelector('.manoeuvres[data-state="error"]', { timeout: 8000 });
-  assert.match(await page.textContent('.manoeuvres .message'), /Cannot load the manoeuvres: shore busy/);
-  assert.ok(await page.$('.chart[data-series="heel"] canvas'), 'charts still drawn');
-  await page.unroute('**/manoeuvres');
-  await page.evaluate(() => { location.hash = '#/fleet'; });
+  try {
+    await page.evaluate(() => { location.hash = `${location.hash}&x=1`; });
+    await page.waitForSelector('.manoeuvres[data-state="error"]', { timeout: 8000 });
+    assert.match(await page.textContent('.manoeuvres .message'), /Cannot load the manoeuvres: shore busy/);
+    assert.ok(await page.$('.chart[data-series="heel"] canvas'), 'charts still drawn');
+  } finally {
+    await page.unroute('**/manoeuvres');
+  }
 });
 
 test('live: the fleet card shows the tack and its distance lost within 30 s of its exit', async (t) => {
+  await page.evaluate(() => { location.hash = '#/fleet'; });
   await page.waitForSelector(`.card[data-boat="${A}"]`, { timeout: 5000 });
   const row = `.card[data-boat="${A}"] .last-manoeuvre`;
   let shownAt = null;
