@@ -232,7 +232,9 @@ function overlayPanel(uPlot) {
   const charts = el('div', { class: 'charts overlay-charts' });
   const status = el('div', { class: 'overlay-status', 'aria-live': 'polite' });
   const node = el('section', { class: 'manoeuvre-overlay', 'aria-label': 'manoeuvres overlaid at t0', dataset: { count: '0' } },
-    el('h3', { text: `Overlay: −${BEFORE_S} s … +${AFTER_S} s around t0` }), status, charts);
+    el('h3', { text: `Overlay: −${BEFORE_S} s … +${AFTER_S} s around t0` }),
+    el('p', { class: 'hint', text: 'Heel (+ starboard), SOG, and turn rate from the COG (1 s), positive in each manoeuvre\u2019s own turning direction.' }),
+    status, charts);
   const cache = new Map();
   let drawn = [];
   let seq = 0;
@@ -300,7 +302,7 @@ function overlayPanel(uPlot) {
     const label = ({ m }) => `${m.boat} ${KIND_LABEL[m.kind] ?? m.kind} ${clock(m.t0)}`;
     const sync = uPlot.sync('manoeuvre-overlay');
     for (const [name, title, unit, data] of [['heel', 'Heel', '°', heel], ['sog', 'SOG', 'kn', sog],
-      ['rate', 'Turn rate (its own direction)', '°/s', rate]]) {
+      ['rate', 'Turn', '°/s', rate]]) {
       const box = el('div', { class: 'chart', dataset: { series: `overlay-${name}` } });
       charts.append(box);
       const joined = joinTables(uPlot, data);
