@@ -70,17 +70,8 @@ json boat_object(const BoatView& v) {
       {"id", s.boat_id},
       {"kind", "boat"},
       {"group", v.status ? v.status->group : std::string()},
-      {"seq", s.seq},
       {"t_utc_ns", s.t_utc_ns},
       {"last_sample_time", iso8601(s.t_utc_ns)},
-      {"heel_deg", finite_or_null(s.heel_deg)},
-      {"pitch_deg", finite_or_null(s.pitch_deg)},
-      {"heading_deg", finite_or_null(s.heading_deg)},
-      {"heel_rate_deg_s", finite_or_null(s.heel_rate_deg_s)},
-      {"pitch_rate_deg_s", finite_or_null(s.pitch_rate_deg_s)},
-      {"yaw_rate_deg_s", finite_or_null(s.yaw_rate_deg_s)},
-      {"accel_weight", finite_or_null(static_cast<double>(s.accel_weight))},
-      {"quality", finite_or_null(static_cast<double>(s.quality))},
       {"leds",
        {{"left", s.leds[0]},
         {"right", s.leds[1]},
@@ -93,14 +84,11 @@ json boat_object(const BoatView& v) {
       {"clock_offset_ms", finite_or_null(v.clock_offset_ms)},
       {"clock_suspect", std::abs(v.clock_offset_ms) > kClockSuspectMs},
   };
+  // The sample's fields, as in the exports (sample_fields.hpp).
+  add_exported(j, kAttitudeFields, &s);
   // Position: null without a fresh fix with a position (never the last one as if it were new).
   const bool positioned = v.fix && v.fix_fresh && v.fix->fix != "none";
-  const FixSample* f = positioned ? &*v.fix : nullptr;
-  const double nan = std::nan("");
-  j["lat_deg"] = finite_or_null(f ? f->lat_deg : nan);
-  j["lon_deg"] = finite_or_null(f ? f->lon_deg : nan);
-  j["sog_m_s"] = finite_or_null(f ? f->sog_m_s : nan);
-  j["cog_deg"] = finite_or_null(f ? f->cog_deg : nan);
+  add_exported(j, kFixFields, positioned ? &*v.fix : nullptr);
   j["gnss_fix"] = v.fix && v.fix_fresh ? json(v.fix->fix) : json(nullptr);
   if (v.fix) {
     // GNSS time minus the boat's clock at the fix: the boat clock's true error (plus the

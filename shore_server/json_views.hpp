@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "fleet.hpp"
+#include "sample_fields.hpp"
 #include "store.hpp"
 #include "telltale/fusion/alarm_engine.hpp"
 
@@ -23,6 +24,24 @@ namespace telltale::shore {
 [[nodiscard]] std::string iso8601(std::uint64_t t_utc_ns);
 /// A number, or null when it is not finite.
 [[nodiscard]] nlohmann::json finite_or_null(double v);
+
+/// Sets `j[name]` for every exported field of `table` (sample_fields.hpp) from `record`: numbers
+/// that are not finite, and every field when there is no record, as null.
+template <class Table, class Record>
+void add_exported(nlohmann::json& j, const Table& table, const Record* record) {
+  for_each_field<kExported>(table, [&](const auto& f) {
+    if (!record) {
+      j[f.name] = nullptr;
+      return;
+    }
+    const auto& v = f.get(*record);
+    if constexpr (std::is_floating_point_v<std::remove_cvref_t<decltype(v)>>) {
+      j[f.name] = finite_or_null(static_cast<double>(v));
+    } else {
+      j[f.name] = v;
+    }
+  });
+}
 
 /// What a coach should know is wrong with a boat, most serious first: `[{code, text}]` with
 /// code "log_failing" (its session log cannot write), "duplicate_id" (two nodes under one id),

@@ -74,10 +74,6 @@ std::string csv_number(double v) {
   return buf;
 }
 
-constexpr const char* kCsvHeader =
-    "time_utc,t_s,seq,heel_deg,pitch_deg,heading_deg,heel_rate_deg_s,pitch_rate_deg_s,"
-    "yaw_rate_deg_s,accel_weight,quality,lat_deg,lon_deg,sog_m_s,cog_deg\n";
-
 std::string csv_coordinate(double v) {
   if (!std::isfinite(v)) return "";
   char buf[32];
@@ -85,37 +81,55 @@ std::string csv_coordinate(double v) {
   return buf;
 }
 
+/// ",cell" for every exported field of `table` (sample_fields.hpp); empty cells without a record.
+template <class Table, class Record>
+void add_csv_cells(std::string& out, const Table& table, const Record* record) {
+  for_each_field<kExported>(table, [&](const auto& f) {
+    out += ',';
+    if (!record) return;
+    const auto& v = f.get(*record);
+    using T = std::remove_cvref_t<decltype(v)>;
+    if constexpr (std::is_floating_point_v<T>) {
+      out += f.csv == CsvFormat::kCoordinate ? csv_coordinate(static_cast<double>(v))
+                                             : csv_number(static_cast<double>(v));
+    } else if constexpr (std::is_same_v<T, std::string>) {
+      // Quoted when it holds a comma, a quote or a line break.
+      if (v.find_first_of(",\"\r\n") == std::string::npos) {
+        out += v;
+      } else {
+        out += '"';
+        for (const char c : v) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+        out += '"';
+      }
+    } else {
+      out += std::to_string(v);
+    }
+  });
+}
+
+/// The sample exports' columns: the sample's time, its exported fields, then those of the fix
+/// current at its time.
+const std::string& csv_header() {
+  static const std::string kHeader = "time_utc,t_s," + field_names<kExported>(kAttitudeFields, ",") +
+                                     "," + field_names<kExported>(kFixFields, ",") + "\n";
+  return kHeader;
+}
+
 /// One attitude sample with the fix current at its time (empty position columns without one).
 std::string csv_row(const AttitudeRow& r, const FixSample* f) {
   char t[32];
   std::snprintf(t, sizeof t, "%.3f", static_cast<double>(r.t_utc_ns) * 1e-9);
-  const double nan = std::nan("");
-  return iso8601(r.t_utc_ns) + "," + t + "," + std::to_string(r.seq) + "," +
-         csv_number(r.heel_deg) + "," + csv_number(r.pitch_deg) + "," + csv_number(r.heading_deg) +
-         "," + csv_number(r.heel_rate_deg_s) + "," + csv_number(r.pitch_rate_deg_s) + "," +
-         csv_number(r.yaw_rate_deg_s) + "," + csv_number(r.accel_weight) + "," +
-         csv_number(r.quality) + "," + csv_coordinate(f ? f->lat_deg : nan) + "," +
-         csv_coordinate(f ? f->lon_deg : nan) + "," + csv_number(f ? f->sog_m_s : nan) + "," +
-         csv_number(f ? f->cog_deg : nan) + "\n";
+  std::string out = iso8601(r.t_utc_ns) + "," + t;
+  add_csv_cells(out, kAttitudeFields, &r);
+  add_csv_cells(out, kFixFields, f);
+  return out + "\n";
 }
 
 json row_object(const AttitudeRow& r, const FixSample* f) {
-  const double nan = std::nan("");
-  return {{"time_utc", iso8601(r.t_utc_ns)},
-          {"t_s", static_cast<double>(r.t_utc_ns) * 1e-9},
-          {"seq", r.seq},
-          {"heel_deg", finite_or_null(r.heel_deg)},
-          {"pitch_deg", finite_or_null(r.pitch_deg)},
-          {"heading_deg", finite_or_null(r.heading_deg)},
-          {"heel_rate_deg_s", finite_or_null(r.heel_rate_deg_s)},
-          {"pitch_rate_deg_s", finite_or_null(r.pitch_rate_deg_s)},
-          {"yaw_rate_deg_s", finite_or_null(r.yaw_rate_deg_s)},
-          {"accel_weight", finite_or_null(r.accel_weight)},
-          {"quality", finite_or_null(r.quality)},
-          {"lat_deg", finite_or_null(f ? f->lat_deg : nan)},
-          {"lon_deg", finite_or_null(f ? f->lon_deg : nan)},
-          {"sog_m_s", finite_or_null(f ? f->sog_m_s : nan)},
-          {"cog_deg", finite_or_null(f ? f->cog_deg : nan)}};
+  json j = {{"time_utc", iso8601(r.t_utc_ns)}, {"t_s", static_cast<double>(r.t_utc_ns) * 1e-9}};
+  add_exported(j, kAttitudeFields, &r);
+  add_exported(j, kFixFields, f);
+  return j;
 }
 
 /// Streams every stored sample of a boat in [from, to] as CSV or JSON, a page at a time: a long
@@ -143,7 +157,7 @@ void stream_rows(httplib::Response& res, Store& store, const std::string& boat_i
         if (!cursor->started) {
           cursor->started = true;
           if (format == Format::kCsv) {
-            out = kCsvHeader;
+            out = csv_header();
           } else {
             std::string h = to_json_text(head);
             h.pop_back();  // reopen the object to append the samples array

@@ -6,29 +6,17 @@
 #include <limits>
 #include <map>
 
+#include "sample_fields.hpp"
 #include "sqlite_stmt.hpp"
 
 namespace telltale::shore {
 namespace {
 
+/// Every table but the two sample tables, whose CREATE TABLE comes from their field tables
+/// (sample_fields.hpp).
 constexpr const char* kSchema = R"sql(
 PRAGMA journal_mode = WAL;
 PRAGMA synchronous = NORMAL;
-CREATE TABLE IF NOT EXISTS attitude (
-  boat_id TEXT NOT NULL,
-  t_utc_ns INTEGER NOT NULL,
-  seq INTEGER NOT NULL,
-  heel_deg REAL NOT NULL,
-  pitch_deg REAL NOT NULL,
-  heading_deg REAL,
-  heel_rate_deg_s REAL,
-  pitch_rate_deg_s REAL,
-  yaw_rate_deg_s REAL,
-  accel_weight REAL,
-  quality REAL,
-  boot_id INTEGER NOT NULL DEFAULT 0,
-  PRIMARY KEY (boat_id, t_utc_ns)
-) WITHOUT ROWID;
 CREATE TABLE IF NOT EXISTS wearable (
   athlete_id TEXT NOT NULL,
   t_utc_ns INTEGER NOT NULL,
@@ -42,21 +30,6 @@ CREATE TABLE IF NOT EXISTS wearable (
   heading_deg REAL,
   distance_m REAL,
   PRIMARY KEY (athlete_id, t_utc_ns)
-) WITHOUT ROWID;
-CREATE TABLE IF NOT EXISTS fixes (
-  boat_id TEXT NOT NULL,
-  t_utc_ns INTEGER NOT NULL,
-  seq INTEGER NOT NULL,
-  gnss_utc_ns INTEGER NOT NULL,
-  lat_deg REAL,
-  lon_deg REAL,
-  sog_m_s REAL,
-  cog_deg REAL,
-  fix TEXT NOT NULL,
-  satellites INTEGER NOT NULL,
-  hdop REAL,
-  boot_id INTEGER NOT NULL,
-  PRIMARY KEY (boat_id, t_utc_ns)
 ) WITHOUT ROWID;
 CREATE TABLE IF NOT EXISTS sessions (
   id INTEGER PRIMARY KEY AUTOINCREMENT,
@@ -178,15 +151,28 @@ std::string tier_trigger() {
 void rebuild_tiers(sqlite3* db, const std::string& boat_id, std::uint64_t from_ns,
                    std::uint64_t to_ns);
 
+/// ALTER TABLE ADD COLUMN for every stored field of `table` that `table_name` lacks.
+template <class Table>
+void add_missing_columns(sqlite3* db, const char* table_name, const Table& table) {
+  for_each_field<kStored>(table, [&](const auto& f) {
+    Stmt has(db, "SELECT COUNT(*) FROM pragma_table_info(?1) WHERE name = ?2");
+    has.bind(1, std::string(table_name)).bind(2, std::string(f.name));
+    if (has.step() && has.i64(0) == 0)
+      exec(db, (std::string("ALTER TABLE ") + table_name + " ADD COLUMN " + f.name + " " + f.sql)
+                   .c_str());
+  });
+}
+
 void migrate(sqlite3* db) {
   Stmt version_q(db, "PRAGMA user_version");
   const int version = version_q.step() ? static_cast<int>(version_q.i64(0)) : 0;
   if (version > kSchemaVersion)
     throw StoreError("written by a newer Telltale (schema " + std::to_string(version) +
                      ", this build knows " + std::to_string(kSchemaVersion) + ")");
-  Stmt has_boot(db, "SELECT COUNT(*) FROM pragma_table_info('attitude') WHERE name = 'boot_id'");
-  if (has_boot.step() && has_boot.i64(0) == 0)
-    exec(db, "ALTER TABLE attitude ADD COLUMN boot_id INTEGER NOT NULL DEFAULT 0");
+  // A field of a sample table that an older database lacks (attitude.boot_id before version 1)
+  // is added as the field table defines it.
+  add_missing_columns(db, "attitude", kAttitudeFields);
+  add_missing_columns(db, "fixes", kFixFields);
   Stmt has_received(
       db, "SELECT COUNT(*) FROM pragma_table_info('sessions') WHERE name = 'received_ns'");
   if (has_received.step() && has_received.i64(0) == 0)
@@ -223,18 +209,11 @@ SessionInfo session_from(const Stmt& s) {
   return {s.i64(0), s.text(1), s.u64(2), s.u64(3), s.i64(4)};
 }
 
+/// A row of select_columns(kAttitudeFields).
 AttitudeRow row_from(const Stmt& s) {
   AttitudeRow r;
   r.t_utc_ns = s.u64(0);
-  r.seq = s.u64(1);
-  r.heel_deg = s.dbl(2);
-  r.pitch_deg = s.dbl(3);
-  r.heading_deg = s.dbl(4);
-  r.heel_rate_deg_s = s.dbl(5);
-  r.pitch_rate_deg_s = s.dbl(6);
-  r.yaw_rate_deg_s = s.dbl(7);
-  r.accel_weight = s.dbl(8);
-  r.quality = s.dbl(9);
+  read_fields(s.get(), 1, kAttitudeFields, r);
   return r;
 }
 
@@ -290,6 +269,8 @@ Store::Store(StoreConfig config) : config_(std::move(config)) {
   db_ = open_db(config_.path, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
   try {
     exec(db_, kSchema);
+    exec(db_, create_table_sql("attitude", kAttitudeFields).c_str());
+    exec(db_, create_table_sql("fixes", kFixFields).c_str());
     exec(db_, kTierTable);
     exec(db_, tier_trigger().c_str());
     migrate(db_);
@@ -297,12 +278,8 @@ Store::Store(StoreConfig config) : config_(std::move(config)) {
     for (std::size_t i = 0; i < kReaders; ++i)
       readers_.push_back(open_db(config_.path, SQLITE_OPEN_READONLY));
     idle_readers_ = readers_;
-    if (sqlite3_prepare_v2(db_,
-                           "INSERT OR IGNORE INTO attitude (boat_id, t_utc_ns, seq, heel_deg, "
-                           "pitch_deg, heading_deg, heel_rate_deg_s, pitch_rate_deg_s, "
-                           "yaw_rate_deg_s, accel_weight, quality, boot_id) "
-                           "VALUES (?,?,?,?,?,?,?,?,?,?,?,?)",
-                           -1, &insert_, nullptr) != SQLITE_OK)
+    if (sqlite3_prepare_v2(db_, insert_sql("attitude", kAttitudeFields).c_str(), -1, &insert_,
+                           nullptr) != SQLITE_OK)
       throw StoreError(sqlite3_errmsg(db_));
   } catch (const StoreError& e) {
     for (auto* r : readers_) sqlite3_close(r);
@@ -427,18 +404,14 @@ bool Store::commit_fixes(const std::vector<FixSample>& batch) {
   std::lock_guard db_lock(db_mutex_);
   try {
     exec(db_, "BEGIN");
-    Stmt ins(db_,
-             "INSERT OR IGNORE INTO fixes (boat_id, t_utc_ns, seq, gnss_utc_ns, lat_deg, lon_deg, "
-             "sog_m_s, cog_deg, fix, satellites, hdop, boot_id) VALUES (?,?,?,?,?,?,?,?,?,?,?,?)");
+    Stmt ins(db_, insert_sql("fixes", kFixFields).c_str());
     for (const auto& f : batch) {
       ins.reset();
       // A second node's run has its own id (recorded_id): its fixes go with its samples.
       const auto alias = aliases_.find({f.boat_id, f.boot_id});
       ins.bind(1, alias == aliases_.end() ? f.boat_id : alias->second);
-      ins.bind_u(2, f.t_utc_ns).bind_u(3, f.seq).bind_u(4, f.gnss_utc_ns);
-      ins.bind(5, f.lat_deg).bind(6, f.lon_deg).bind(7, f.sog_m_s).bind(8, f.cog_deg);
-      ins.bind(9, f.fix).bind(10, static_cast<std::int64_t>(f.satellites)).bind(11, f.hdop);
-      ins.bind_u(12, f.boot_id);
+      ins.bind_u(2, f.t_utc_ns);
+      bind_fields(ins.get(), 3, kFixFields, f);
       ins.step();
     }
     exec(db_, "COMMIT");
@@ -456,26 +429,17 @@ bool Store::commit_fixes(const std::vector<FixSample>& batch) {
 std::vector<FixSample> Store::fix_page(const std::string& boat_id, std::uint64_t after_ns,
                                        std::uint64_t to_ns, std::size_t limit) {
   const ReadLease reader(*this);
-  Stmt q(reader.db(),
-         "SELECT t_utc_ns, seq, gnss_utc_ns, lat_deg, lon_deg, sog_m_s, cog_deg, fix, satellites, "
-         "hdop, boot_id FROM fixes WHERE boat_id = ? AND t_utc_ns > ? AND t_utc_ns <= ? AND "
-         "fix <> 'none' ORDER BY t_utc_ns LIMIT ?");
+  static const std::string kSql = "SELECT " + select_columns(kFixFields) +
+                                 " FROM fixes WHERE boat_id = ? AND t_utc_ns > ? AND "
+                                 "t_utc_ns <= ? AND fix <> 'none' ORDER BY t_utc_ns LIMIT ?";
+  Stmt q(reader.db(), kSql.c_str());
   q.bind(1, boat_id).bind_u(2, after_ns).bind_u(3, to_ns).bind(4, static_cast<std::int64_t>(limit));
   std::vector<FixSample> rows;
   while (q.step()) {
     FixSample f;
     f.boat_id = boat_id;
     f.t_utc_ns = q.u64(0);
-    f.seq = q.u64(1);
-    f.gnss_utc_ns = q.u64(2);
-    f.lat_deg = q.dbl(3);
-    f.lon_deg = q.dbl(4);
-    f.sog_m_s = q.dbl(5);
-    f.cog_deg = q.dbl(6);
-    f.fix = q.text(7);
-    f.satellites = static_cast<std::uint32_t>(q.i64(8));
-    f.hdop = q.dbl(9);
-    f.boot_id = q.u64(10);
+    read_fields(q.get(), 1, kFixFields, f);
     rows.push_back(std::move(f));
   }
   return rows;
@@ -682,21 +646,8 @@ bool Store::commit(std::vector<AttitudeSample>& batch) {
       sqlite3_reset(insert_);
       sqlite3_bind_text(insert_, 1, id.c_str(), static_cast<int>(id.size()), SQLITE_TRANSIENT);
       sqlite3_bind_int64(insert_, 2, static_cast<sqlite3_int64>(s.t_utc_ns));
-      sqlite3_bind_int64(insert_, 3, static_cast<sqlite3_int64>(s.seq));
-      sqlite3_bind_double(insert_, 4, s.heel_deg);
-      sqlite3_bind_double(insert_, 5, s.pitch_deg);
-      if (std::isfinite(s.heading_deg)) {
-        sqlite3_bind_double(insert_, 6, s.heading_deg);
-      } else {
-        sqlite3_bind_null(insert_, 6);
-      }
-      sqlite3_bind_double(insert_, 7, s.heel_rate_deg_s);
-      sqlite3_bind_double(insert_, 8, s.pitch_rate_deg_s);
-      sqlite3_bind_double(insert_, 9, s.yaw_rate_deg_s);
-      sqlite3_bind_double(insert_, 10, static_cast<double>(s.accel_weight));
-      sqlite3_bind_double(insert_, 11, static_cast<double>(s.quality));
       // Boot ids are random 64-bit numbers: stored as their two's-complement int64.
-      sqlite3_bind_int64(insert_, 12, static_cast<sqlite3_int64>(s.boot_id));
+      bind_fields(insert_, 3, kAttitudeFields, s);
       if (sqlite3_step(insert_) != SQLITE_DONE) throw StoreError(sqlite3_errmsg(db_));
       if (sqlite3_changes(db_) == 1) {  // a duplicate (re-sent sample) changes nothing
         ++inserted;
@@ -1065,10 +1016,11 @@ bool Store::knows_boat(const std::string& boat_id) {
 std::vector<AttitudeRow> Store::attitude_page(const std::string& boat_id, std::uint64_t after_ns,
                                               std::uint64_t to_ns, std::size_t limit) {
   const ReadLease reader(*this);
-  Stmt q(reader.db(),
-         "SELECT t_utc_ns, seq, heel_deg, pitch_deg, heading_deg, heel_rate_deg_s, "
-         "pitch_rate_deg_s, yaw_rate_deg_s, accel_weight, quality FROM attitude "
-         "WHERE boat_id = ? AND t_utc_ns > ? AND t_utc_ns <= ? ORDER BY t_utc_ns LIMIT ?");
+  static const std::string kSql =
+      "SELECT " + select_columns(kAttitudeFields) +
+      " FROM attitude WHERE boat_id = ? AND t_utc_ns > ? AND t_utc_ns <= ? ORDER BY t_utc_ns "
+      "LIMIT ?";
+  Stmt q(reader.db(), kSql.c_str());
   q.bind(1, boat_id).bind_u(2, after_ns).bind_u(3, to_ns).bind(4, static_cast<std::int64_t>(limit));
   std::vector<AttitudeRow> out;
   out.reserve(limit);

@@ -162,24 +162,19 @@ void register_track_routes(httplib::Server& server, ShoreContext& ctx) {
     }
     if (!ctx.fleet.boat(id) && !ctx.store.knows_boat(id))
       throw HttpError(404, "unknown boat '" + id + "'");
-    json t = json::array(), lat = json::array(), lon = json::array(), sog = json::array(),
-         cog = json::array();
     const auto points = ctx.store.track(id, range.from_ns, range.to_ns, max_points);
+    // One array per exported field of the fix (sample_fields.hpp), as the sample exports have.
+    json j = {{"boat_id", id}, {"points", points.size()}, {"t_s", json::array()}};
     for (const auto& f : points) {
-      t.push_back(static_cast<double>(f.t_utc_ns) * 1e-9);
-      lat.push_back(finite_or_null(f.lat_deg));
-      lon.push_back(finite_or_null(f.lon_deg));
-      sog.push_back(finite_or_null(f.sog_m_s));
-      cog.push_back(finite_or_null(f.cog_deg));
+      j["t_s"].push_back(static_cast<double>(f.t_utc_ns) * 1e-9);
+      json row = json::object();
+      add_exported(row, kFixFields, &f);
+      for (auto& [name, value] : row.items()) j[name].push_back(std::move(value));
     }
-    res.set_content(to_json_text({{"boat_id", id},
-                                  {"points", points.size()},
-                                  {"t_s", std::move(t)},
-                                  {"lat_deg", std::move(lat)},
-                                  {"lon_deg", std::move(lon)},
-                                  {"sog_m_s", std::move(sog)},
-                                  {"cog_deg", std::move(cog)}}),
-                    "application/json");
+    for_each_field<kExported>(kFixFields, [&](const auto& field) {
+      if (!j.contains(field.name)) j[field.name] = json::array();
+    });
+    res.set_content(to_json_text(j), "application/json");
   });
 
   server.Get(R"(/api/v1/sessions/([^/]+)/gpx)", [&ctx](const httplib::Request& req,
