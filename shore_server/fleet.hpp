@@ -30,19 +30,24 @@ using fusion::to_string;
 
 using SteadyTime = std::chrono::steady_clock::time_point;
 
-/// One boat's latest attitude, in wire units.
-struct AttitudeSample {
-  std::string boat_id;
-  std::uint64_t seq = 0;
+/// The values of one attitude sample, in wire units: what the store keeps and reads back
+/// (sample_fields.hpp kAttitudeFields), and the part of AttitudeSample a field is added to.
+struct AttitudeRow {
   std::uint64_t t_utc_ns = 0;
+  std::uint64_t seq = 0;
   double heel_deg = 0.0;
   double pitch_deg = 0.0;
   double heading_deg = 0.0;  ///< NaN when the boat has no heading source
   double heel_rate_deg_s = 0.0;
   double pitch_rate_deg_s = 0.0;
   double yaw_rate_deg_s = 0.0;
-  float accel_weight = 0.0f;
-  float quality = 0.0f;
+  double accel_weight = 0.0;  ///< a float on the wire
+  double quality = 0.0;       ///< a float on the wire
+};
+
+/// One boat's latest attitude as it arrived: its values, and what only the live path has.
+struct AttitudeSample : AttitudeRow {
+  std::string boat_id;
   std::uint8_t leds[4] = {0, 0, 0, 0};  ///< left, right, up, down
   std::uint8_t led_count = 0;
   std::uint64_t boot_id = 0;  ///< the boat node's run; seq restarts with a new one

@@ -110,8 +110,9 @@ void add_csv_cells(std::string& out, const Table& table, const Record* record) {
 /// The sample exports' columns: the sample's time, its exported fields, then those of the fix
 /// current at its time.
 const std::string& csv_header() {
-  static const std::string kHeader = "time_utc,t_s," + field_names<kExported>(kAttitudeFields, ",") +
-                                     "," + field_names<kExported>(kFixFields, ",") + "\n";
+  static const std::string kHeader = "time_utc,t_s," +
+                                     field_names<kExported>(kAttitudeFields, ",") + "," +
+                                     field_names<kExported>(kFixFields, ",") + "\n";
   return kHeader;
 }
 

@@ -7,11 +7,11 @@
 /// rows of the exports, the JSON keys of the exported rows and of GET /boats. openapi.json is
 /// held to them by a test (tests/unit/sample_fields_test.cpp).
 ///
-/// Adding a field to a record on the shore: a member in its struct(s) (fleet.hpp; for the
-/// attitude also AttitudeRow in store.hpp when the field is read back), one row here, its
-/// property in openapi.json, and its line in wire.cpp. A field added after a database was made
-/// must be nullable or have a DEFAULT (SQLite's ALTER TABLE ADD COLUMN rule): the store adds it
-/// to an older database as it opens it.
+/// Adding a field to a record on the shore, one edit per layer: its member (fleet.hpp: AttitudeRow,
+/// which AttitudeSample extends, or FixSample), one row here, its lines in wire.cpp (to_wire and
+/// from_wire), its property in openapi.json (SampleRow, and Boat or Track). A field added after
+/// a database was made must be nullable or have a DEFAULT (SQLite's ALTER TABLE ADD COLUMN rule):
+/// the store adds it to an older database as it opens it.
 ///
 /// Every table's key, written apart: boat_id TEXT and t_utc_ns INTEGER, the primary key.
 
@@ -46,18 +46,19 @@ struct Field {
   const char* name;  ///< column name, CSV column and JSON key; the unit is in the name
   const char* sql;   ///< type and constraints in CREATE TABLE
   CsvFormat csv;
-  const char* doc;   ///< meaning (openapi.json's description of it says the same)
+  const char* doc;  ///< meaning (openapi.json's description of it says the same)
   Get get;
 };
 
 template <unsigned Uses, class Get>
-constexpr Field<Uses, Get> field(const char* name, const char* sql, CsvFormat csv,
-                                 const char* doc, Get get) {
+constexpr Field<Uses, Get> field(const char* name, const char* sql, CsvFormat csv, const char* doc,
+                                 Get get) {
   return {name, sql, csv, doc, get};
 }
 
 /// The member `m` of whatever record is given, const or not.
-#define TELLTALE_MEMBER(m) [](auto& r) -> auto& { return r.m; }
+#define TELLTALE_MEMBER(m) \
+  [](auto& r) -> auto& { return r.m; }
 
 /// The attitude sample, table `attitude`: AttitudeSample (stored), AttitudeRow (read back).
 inline constexpr auto kAttitudeFields = std::make_tuple(
@@ -88,8 +89,8 @@ inline constexpr auto kAttitudeFields = std::make_tuple(
 /// The GNSS fix, table `fixes`: FixSample (stored and read back). The exported fields are those
 /// of the fix current at each attitude sample's time, joined into the sample exports.
 inline constexpr auto kFixFields = std::make_tuple(
-    field<kStored | kRead>("seq", "INTEGER NOT NULL", CsvFormat::kNumber,
-                           "per-boat fix counter", TELLTALE_MEMBER(seq)),
+    field<kStored | kRead>("seq", "INTEGER NOT NULL", CsvFormat::kNumber, "per-boat fix counter",
+                           TELLTALE_MEMBER(seq)),
     field<kStored | kRead>("gnss_utc_ns", "INTEGER NOT NULL", CsvFormat::kNumber,
                            "the receiver's time of the fix; 0 when it gave none",
                            TELLTALE_MEMBER(gnss_utc_ns)),
@@ -129,7 +130,7 @@ constexpr void for_each_field(const Table& table, F&& f) {
       table);
 }
 
-/// "a, b, c": the names of the fields with `Uses`, each after `prefix`.
+/// "a, b, c": the names of the fields with `Uses`, in order, between `separator`s.
 template <unsigned Uses, class Table>
 std::string field_names(const Table& table, const char* separator = ", ") {
   std::string out;
@@ -145,9 +146,8 @@ template <class Table>
 std::string create_table_sql(const char* table_name, const Table& table) {
   std::string sql = std::string("CREATE TABLE IF NOT EXISTS ") + table_name +
                     " (\n  boat_id TEXT NOT NULL,\n  t_utc_ns INTEGER NOT NULL,\n";
-  for_each_field<kStored>(table, [&](const auto& f) {
-    sql += std::string("  ") + f.name + " " + f.sql + ",\n";
-  });
+  for_each_field<kStored>(
+      table, [&](const auto& f) { sql += std::string("  ") + f.name + " " + f.sql + ",\n"; });
   return sql + "  PRIMARY KEY (boat_id, t_utc_ns)\n) WITHOUT ROWID;\n";
 }
 

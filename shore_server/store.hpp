@@ -83,19 +83,6 @@ struct SessionInfo {
   std::int64_t samples = 0;
 };
 
-struct AttitudeRow {
-  std::uint64_t t_utc_ns = 0;
-  std::uint64_t seq = 0;
-  double heel_deg = 0.0;
-  double pitch_deg = 0.0;
-  double heading_deg = 0.0;  ///< NaN when absent
-  double heel_rate_deg_s = 0.0;
-  double pitch_rate_deg_s = 0.0;
-  double yaw_rate_deg_s = 0.0;
-  double accel_weight = 0.0;
-  double quality = 0.0;
-};
-
 /// Widths of the chart tiers' time buckets, finest first (Store::attitude_tier).
 inline constexpr std::array<std::uint64_t, 2> kTierWidths_s = {1, 16};
 

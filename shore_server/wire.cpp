@@ -2,9 +2,7 @@
 
 namespace telltale::shore {
 
-bool known_fix_kind(std::string_view name) {
-  return wire_of(kFixKinds, name).has_value();
-}
+bool known_fix_kind(std::string_view name) { return wire_of(kFixKinds, name).has_value(); }
 
 AttitudeSample from_wire(const msg::BoatAttitude& m) {
   AttitudeSample s;
@@ -40,8 +38,8 @@ msg::BoatAttitude to_wire(const AttitudeSample& s) {
   m.heel_rate_deg_s(s.heel_rate_deg_s);
   m.pitch_rate_deg_s(s.pitch_rate_deg_s);
   m.yaw_rate_deg_s(s.yaw_rate_deg_s);
-  m.accel_weight(s.accel_weight);
-  m.quality(s.quality);
+  m.accel_weight(static_cast<float>(s.accel_weight));
+  m.quality(static_cast<float>(s.quality));
   m.leds().left_leds(s.leds[0]);
   m.leds().right_leds(s.leds[1]);
   m.leds().up_leds(s.leds[2]);

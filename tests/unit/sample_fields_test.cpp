@@ -129,19 +129,18 @@ TEST_F(SampleFieldsTest, TheTablesKeepTheColumnsOfSchemaVersion3) {
   const std::vector<std::string> fixes = columns_of(db, "fixes");
   sqlite3_close(db);
   const std::vector<std::string> v3_attitude = {
-      "boat_id|TEXT|1||1",        "t_utc_ns|INTEGER|1||2",       "seq|INTEGER|1||0",
-      "heel_deg|REAL|1||0",       "pitch_deg|REAL|1||0",         "heading_deg|REAL|0||0",
+      "boat_id|TEXT|1||1",         "t_utc_ns|INTEGER|1||2",      "seq|INTEGER|1||0",
+      "heel_deg|REAL|1||0",        "pitch_deg|REAL|1||0",        "heading_deg|REAL|0||0",
       "heel_rate_deg_s|REAL|0||0", "pitch_rate_deg_s|REAL|0||0", "yaw_rate_deg_s|REAL|0||0",
-      "accel_weight|REAL|0||0",   "quality|REAL|0||0",           "boot_id|INTEGER|1|0|0"};
+      "accel_weight|REAL|0||0",    "quality|REAL|0||0",          "boot_id|INTEGER|1|0|0"};
   const std::vector<std::string> v3_fixes = {
-      "boat_id|TEXT|1||1",    "t_utc_ns|INTEGER|1||2", "seq|INTEGER|1||0",
-      "gnss_utc_ns|INTEGER|1||0", "lat_deg|REAL|0||0", "lon_deg|REAL|0||0",
-      "sog_m_s|REAL|0||0",    "cog_deg|REAL|0||0",     "fix|TEXT|1||0",
-      "satellites|INTEGER|1||0", "hdop|REAL|0||0",     "boot_id|INTEGER|1||0"};
+      "boat_id|TEXT|1||1",        "t_utc_ns|INTEGER|1||2", "seq|INTEGER|1||0",
+      "gnss_utc_ns|INTEGER|1||0", "lat_deg|REAL|0||0",     "lon_deg|REAL|0||0",
+      "sog_m_s|REAL|0||0",        "cog_deg|REAL|0||0",     "fix|TEXT|1||0",
+      "satellites|INTEGER|1||0",  "hdop|REAL|0||0",        "boot_id|INTEGER|1||0"};
   ASSERT_GE(attitude.size(), v3_attitude.size());
   ASSERT_GE(fixes.size(), v3_fixes.size());
-  EXPECT_EQ(std::vector<std::string>(attitude.begin(),
-                                     attitude.begin() + std::ssize(v3_attitude)),
+  EXPECT_EQ(std::vector<std::string>(attitude.begin(), attitude.begin() + std::ssize(v3_attitude)),
             v3_attitude);
   EXPECT_EQ(std::vector<std::string>(fixes.begin(), fixes.begin() + std::ssize(v3_fixes)),
             v3_fixes);
