@@ -202,6 +202,9 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
   callbacks.on_status = [&](const std::string& id, const NodeStatusInfo& st) {
     fleet.update_status(id, st);
   };
+  // Every boat and wearable joins the shore: it announces itself again after each newcomer, who
+  // may have missed its first answer (join_announcer.hpp).
+  o.dds.announce_on_join = true;
   ShoreDds dds(o.dds, callbacks);
   alarms.start({[&](const std::vector<AlarmRule>& rules) { dds.publish_rules(rules); },
                 [&](const AlarmEvent& e) { dds.publish_event(e); }});

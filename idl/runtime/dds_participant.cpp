@@ -10,6 +10,7 @@
 #include <mutex>
 
 #include "dds_security.hpp"
+#include "join_announcer.hpp"
 
 namespace telltale::dds {
 
@@ -96,8 +97,13 @@ Participant::Participant(const DdsOptions& options, const std::string& name)
   if (options.customize) options.customize(qos);
   secured_ = !options.security_dir.empty();
   if (secured_) apply_security(options.security_dir, qos);
+  fdds::DomainParticipantListener* listener = options.listener;
+  if (options.announce_on_join) {
+    announcer_ = std::make_unique<JoinAnnouncer>(options.listener);
+    listener = announcer_.get();
+  }
   participant_ = factory->create_participant(static_cast<fdds::DomainId_t>(domain_), qos,
-                                             options.listener, fdds::StatusMask::none());
+                                             listener, fdds::StatusMask::none());
   if (!participant_)
     throw DdsError("cannot create DDS participant on domain " + std::to_string(domain_) +
                    (secured_ ? " (DDS Security refused the files in " + options.security_dir +
@@ -110,14 +116,17 @@ Participant::Participant(const DdsOptions& options, const std::string& name)
   publisher_ = participant_->create_publisher(pub_qos);
   subscriber_ = participant_->create_subscriber(sub_qos);
   if (!publisher_ || !subscriber_) {
+    if (announcer_) announcer_->stop();
     participant_->delete_contained_entities();
     factory->delete_participant(participant_);
     throw DdsError("cannot create DDS publisher/subscriber");
   }
+  if (announcer_) announcer_->start(participant_);
 }
 
 Participant::~Participant() {
   if (!participant_) return;
+  if (announcer_) announcer_->stop();
   participant_->delete_contained_entities();
   DomainParticipantFactory::get_instance()->delete_participant(participant_);
 }

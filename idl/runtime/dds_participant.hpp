@@ -16,12 +16,15 @@
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace telltale::dds {
+
+class JoinAnnouncer;
 
 /// Topic names of the wire contract (idl/README.md).
 inline constexpr const char* kTopicBoatAttitude = "telltale_boat_attitude";
@@ -57,6 +60,10 @@ struct DdsOptions {
   std::vector<std::string> subscriber_partitions;
   /// Discovery callbacks (on_publisher_discovery etc.); no status callbacks. Not owned.
   eprosima::fastdds::dds::DomainParticipantListener* listener = nullptr;
+  /// Announce this participant again shortly after another one joins (join_announcer.hpp): a
+  /// newcomer that missed our first answer meets us in ~50 ms, not at our next periodic
+  /// announcement (2 s). The shore sets it: every boat meets it.
+  bool announce_on_join = false;
 };
 
 /// The domain of a binary started with neither `--domain` nor TELLTALE_DOMAIN: every Telltale
@@ -106,6 +113,7 @@ class Participant {
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
   std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
+  std::unique_ptr<JoinAnnouncer> announcer_;  ///< the participant's listener when it announces
 };
 
 /// The fixed-size string of the IDL from a std::string; throws DdsError when it does not fit.
