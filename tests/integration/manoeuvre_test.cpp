@@ -52,6 +52,23 @@ TEST_F(ManoeuvreTest, ASimBoatsSessionListsItsTack) {
   auto none = c.Get("/api/v1/sessions/999999/manoeuvres", bearer());
   ASSERT_TRUE(none);
   EXPECT_EQ(none->status, 404);
+
+  // `from` (the fleet view's live poll): the manoeuvres from then on, computed from the data of
+  // the 45 s before it, and how far the data reaches (a metric is final 20 s after t0). From the
+  // session's start the tack is there, measured alike; from the end of the data it is not.
+  const std::string start = sessions[0]["start"].get<std::string>();
+  const json since = get_json(base + "/manoeuvres?wind_from_deg=255&from=" + start);
+  ASSERT_FALSE(since["manoeuvres"].empty()) << since.dump();
+  EXPECT_EQ(since["manoeuvres"][0]["kind"], "tack");
+  EXPECT_NEAR(since["manoeuvres"][0]["turn_deg"].get<double>(), m["turn_deg"].get<double>(), 3.0);
+  EXPECT_EQ(since["from_utc"], start);
+  ASSERT_TRUE(since["data_to_utc"].is_string()) << since.dump();
+  EXPECT_GT(since["data_to_utc"].get<std::string>(), m["t_utc"].get<std::string>());
+  const json later = get_json(base + "/manoeuvres?from=" + since["data_to_utc"].get<std::string>());
+  EXPECT_TRUE(later["manoeuvres"].empty()) << later.dump();
+  auto bad_from = c.Get(base + "/manoeuvres?from=yesterday", bearer());
+  ASSERT_TRUE(bad_from);
+  EXPECT_EQ(bad_from->status, 400);
 }
 
 }  // namespace
