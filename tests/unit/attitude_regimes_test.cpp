@@ -78,23 +78,25 @@ TEST(Regimes, DinghyWithGnssSpeedWithinTarget) {
 }
 
 // Given a node started while sailing (bow-mounted, waves, gyro bias up to 10 deg/s unknown, no
-// rest, GNSS speed and course), then after 15 s its RMS error is within 1 deg (the baselines:
-// each >= 2.2 deg). Seen failing without the course rate (the turn taken from the gyro alone,
-// whose bias about the vertical a start under way cannot know): 1.80 and 1.86 deg RMS.
+// rest, GNSS speed and course), then after 15 s its RMS error is within 0.5 deg (measured: 0.40
+// and 0.39, 3 seeds; the baselines: each >= 2.2 deg). Seen failing against the filter before the
+// start's Kalman filter and the course's bias update (commit 752b1fc, the same conditions run on
+// its source): 0.97 and 0.79 deg RMS; and without the course rate in the turn: 1.80 and 1.86.
 TEST(Regimes, StartedUnderWayBeatsTheBaselines) {
   const TiltErrorStats s = run("underway-15", 25.0, 3);
-  EXPECT_LE(s.heel_rms_deg, 1.1);
-  EXPECT_LE(s.pitch_rms_deg, 1.0);
+  EXPECT_LE(s.heel_rms_deg, 0.5);
+  EXPECT_LE(s.pitch_rms_deg, 0.5);
 }
 
-// Given the same start under way, then the worst error after 5 s and after 15 s stays at what the
-// filter measures today (6.2 and 4.5 deg, 3 seeds, 25 and 100 Hz): a regression shows. The goal
-// is 2 and 1 deg; what stands in the way is the gyro bias (up to 10 deg/s, unknown at the start)
-// learnt overconfidently in motion.
-TEST(Regimes, StartedUnderWayWorstErrorDoesNotGrow) {
+// Given the same start under way, then the worst error after 5 s is within 2.8 deg and after 15 s
+// within 1.9 deg (measured: 2.64 / 2.67 and 1.67 / 1.78, 3 seeds, 25 / 100 Hz). Seen failing
+// against the filter of commit 752b1fc: 6.07 / 6.19 and 4.46 / 4.26. The goal is 2 and
+// 1 deg; the filter given the exact bias at the start reaches 1.3-1.6 deg over these 60 s (the
+// tacks), so 1 deg after 15 s is not a start-up matter (docs/attitude.md).
+TEST(Regimes, StartedUnderWayWorstErrorWithinBounds) {
   for (const double rate_hz : {25.0, 100.0}) {
-    EXPECT_LE(max_of(run("underway-5", rate_hz, 3)), 6.5) << rate_hz << " Hz";
-    EXPECT_LE(max_of(run("underway-15", rate_hz, 3)), 4.7) << rate_hz << " Hz";
+    EXPECT_LE(max_of(run("underway-5", rate_hz, 3)), 2.8) << rate_hz << " Hz";
+    EXPECT_LE(max_of(run("underway-15", rate_hz, 3)), 1.9) << rate_hz << " Hz";
   }
 }
 

@@ -29,10 +29,10 @@ Target target_for(const std::string& scenario) {
   // acceleration is taken off; the target, 0.6 / 2.0 deg (0.37 / 1.54 measured over 10 seeds).
   // Without the speed it was 1.0 / 3.7.
   if (scenario == "dinghy") return {0.6, 2.0};
-  // Started under way with a gyro bias of up to 10 deg/s unknown: the goal (2 deg after 5 s,
-  // 1 deg after 15 s, attitude_regimes_test) is not met yet; this is what holds (1.5 RMS and
-  // 6.6 max over 10 seeds), still below every baseline's RMS.
-  if (scenario.starts_with("underway-")) return {1.6, 7.0};
+  // Started under way with a gyro bias of up to 10 deg/s unknown: 0.47 RMS and 2.64 max over
+  // 10 seeds at 25 Hz (before the start's Kalman filter and the course's bias update: 1.5 and
+  // 6.6). The goal, 2 deg after 5 s and 1 after 15 s, is not met (attitude_regimes_test).
+  if (scenario.starts_with("underway-")) return {0.6, 2.8};
   return {0.4, 1.0};  // pendulum (every amplitude, both mountings), turntable, desk
 }
 

@@ -15,12 +15,17 @@
 ///     maps it to "up"), seen in the body through the gyro quaternion;
 ///   - the gyro bias is a Kalman state with its own 3x3 covariance: learnt at rest (rest = the
 ///     gyro AND the accelerometer steady about their own 0.5 s means, AND the gyro reading what
-///     the bias can be: a constant rotation is not rest), and in motion from how fast the
-///     low-passed vertical drifts in I (horizontal components only: the bias about the vertical
-///     does not move the vertical);
-///   - fast start: for the first tau_acc_s the low-pass is the mean of everything seen since the
-///     start (the best estimate of a constant from a growing window), so a filter started under
-///     way converges in seconds; the same after a gap too long to integrate;
+///     the bias can be: a constant rotation is not rest, nor a boat the GNSS sees making way),
+///     in motion from how fast the low-passed vertical drifts in I (horizontal components only:
+///     the bias about the vertical does not move the vertical), and about the vertical from the
+///     GNSS course when it is given (the gyro's turn against the course's over tau_acc_s);
+///   - start: for the first start_fit_s after the first sample (until a rest, if one comes
+///     first) the vertical and the bias are one Kalman filter on 5 states, the least-squares
+///     line through the specific force in I (intercept: the tilt, slope: the bias), its
+///     acceleration noise measured as it goes; the low-pass then takes over in its steady state
+///     with that bias and covariance. After a gap too long to integrate the low-pass restarts
+///     as the mean of everything seen since (the best estimate of a constant from a growing
+///     window) for tau_acc_s;
 ///   - the boat's own acceleration, when its speed is known (set_speed, from GNSS): a boat
 ///     turning at w about the vertical at speed v accelerates at w v toward the inside of the
 ///     turn, and speeding up at dv/dt along its heading. A tack's few seconds of that are one
@@ -29,7 +34,8 @@
 ///   - non-uniform time steps, dropped samples, saturated samples, NaN/Inf.
 ///
 /// Call order: update() once per sample, time strictly increasing; read output() afterwards.
-/// Cannot observe: the gyro bias about the vertical (heading drift; irrelevant to heel/pitch),
+/// Cannot observe: the gyro bias about the vertical without GNSS course (heading drift;
+/// irrelevant to heel/pitch until the boat heels the other way or turns),
 /// an accelerometer offset (it becomes a tilt error of offset/g rad), a linear acceleration that
 /// is sustained in one earth direction for longer than ~tau_acc_s (its mean is a tilt) unless it
 /// is the turn and speed change of a boat whose speed is given.
@@ -61,6 +67,9 @@ struct TelltaleAttitudeParams {
   /// on each axis, and never further than this floor below it (a steady turn of more than
   /// 0.5 deg/s is a turn, not a rest).
   double rest_bias_gate_rad_s = 0.5 * M_PI / 180.0;
+  /// Never at rest while the GNSS speed (set_speed) is above this: ten times a receiver's
+  /// velocity noise (0.05 m/s), the boat is moving and rocks with the water.
+  double rest_max_speed_m_s = 0.5;
   /// Bias Kalman filter (units rad/s). Initial sigma: the zero-rate spread of an uncalibrated
   /// MEMS gyro (L3G4200D +-10 deg/s uniform -> 5.8 deg/s); at rest the gyro mean is a
   /// measurement of 0.03 deg/s; in motion the steady-state sigma is 0.1 deg/s; the bias is
@@ -87,6 +96,21 @@ struct TelltaleAttitudeParams {
   /// the low-pass's window, and the bow and the track part by a few degrees of leeway that
   /// changes over a tack: 1 deg/s.
   double cog_rate_sigma_rad_s = 1.0 * M_PI / 180.0;
+  /// Start (see update): for the first start_fit_s after the first sample, unless a rest comes
+  /// first, the vertical and the gyro bias are one Kalman filter (the least-squares line through
+  /// the specific force in I) instead of the low-pass and its drift. 5 s: two periods of the
+  /// slowest sea the low-pass is built for (0.3-0.5 Hz), so that the line's slope is not one
+  /// wave's half swing, and the first mark.
+  double start_fit_s = 5.0;
+  /// The horizontal acceleration of the sensor before any sample has been seen, one axis: a
+  /// boat's in a seaway (waves' heave, surge and sway ~1.5 m/s^2 at the bow). The first sample's
+  /// tilt is known to this / g, and it is the prior of the acceleration's variance.
+  double start_acc_sigma_m_s2 = 2.0;
+  /// How long a seaway's acceleration keeps its direction (its correlation time): 1 / omega of a
+  /// 0.5 Hz wave, the quickest the low-pass is built for. The start's filter counts the samples
+  /// within it as one measurement (their variance times this over dt), so that 100 Hz is not
+  /// believed four times better than 25 Hz.
+  double wave_corr_s = 0.3;
 };
 
 class TelltaleAttitudeFilter final : public AttitudeFilter {
@@ -124,6 +148,20 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
     double speed_m_s = std::numeric_limits<double>::quiet_NaN();
     double speed_rate_m_s2 = 0.0;
     double yaw_rate_cog_rad_s = std::numeric_limits<double>::quiet_NaN();  ///< - cog rate
+    /// The start's Kalman filter (update): running, its covariance (the tilt of up_i about two
+    /// horizontal axes, rad, then the bias, rad/s), its age and the variance of the horizontal
+    /// specific force it measures (one axis, in units of g^2).
+    bool start_fit = false;
+    Eigen::Matrix<double, 5, 5> start_cov = Eigen::Matrix<double, 5, 5>::Zero();
+    double start_elapsed_s = 0.0;
+    double start_acc_var = 0.0;
+    /// The bias about the vertical against the GNSS course: over the current window, its length,
+    /// the raw gyro integrated about the vertical, the course's turn (-cog) and the vertical in
+    /// the body integrated (rad, rad, s).
+    double course_window_s = 0.0;
+    double course_gyro_rad = 0.0;
+    double course_turn_rad = 0.0;
+    Eigen::Vector3d course_up_s = Eigen::Vector3d::Zero();
   };
   /// The gate's counts (gaps: not integrated, the low-pass restarted; accelerometer saturated:
   /// not used for the bias or rest) and the samples spent learning the bias at rest.
@@ -157,6 +195,15 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
 
  private:
   void initialise(const ImuSample& s);
+  /// One sample of the start's Kalman filter (tilt of up_i and bias); r: body -> I, f: the
+  /// specific force without the boat's own acceleration. Not inlined: it runs for the first
+  /// seconds only, and inlined into update() it crowds out the inlining of the steady path's
+  /// small products (callgrind: +90 instructions per update).
+  [[gnu::noinline]] void start_fit_update(const Eigen::Matrix3d& r, const Eigen::Vector3d& f,
+                                          double dt);
+  /// The bias about the vertical from the GNSS course (every tau_acc_s while the course is
+  /// known). Called only while the course is known or a window is open; not inlined (the same).
+  [[gnu::noinline]] void course_update(const Eigen::Vector3d& gyro_raw, bool usable, double dt);
   Params params_;
   ImuGateParams gate_;  ///< the sensor's ranges and the longest gap, from params_
   State state_;
