@@ -15,8 +15,8 @@ AttitudeSample from_wire(const msg::BoatAttitude& m) {
   s.heel_rate_deg_s = m.heel_rate_deg_s();
   s.pitch_rate_deg_s = m.pitch_rate_deg_s();
   s.yaw_rate_deg_s = m.yaw_rate_deg_s();
-  s.accel_weight = m.accel_weight();
-  s.quality = m.quality();
+  s.accel_weight = static_cast<double>(m.accel_weight());  // exact: every float is a double
+  s.quality = static_cast<double>(m.quality());
   s.leds[0] = m.leds().left_leds();
   s.leds[1] = m.leds().right_leds();
   s.leds[2] = m.leds().up_leds();
