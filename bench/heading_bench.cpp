@@ -1,4 +1,4 @@
-// Time per HeadingFusion::update for N = 3 and N = 8 sensors, every method (issue 4).
+// Time per HeadingFusion::update for N = 3 and N = 8 sensors, every method.
 // Readings come from the dinghy scenario (tacks, one sensor at 5 Hz), replayed in a loop so the
 // monitor and every fusion branch run as they do on the water.
 #include <benchmark/benchmark.h>

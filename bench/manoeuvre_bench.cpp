@@ -1,4 +1,4 @@
-// Manoeuvres (issue 21): detection and metrics for a 2 h session of one boat (72 000 fixes at
+// Manoeuvres: detection and metrics for a 2 h session of one boat (72 000 fixes at
 // 10 Hz from the race simulator with drills, heel at 25 Hz). Target: <= 50 ms.
 #include <benchmark/benchmark.h>
 

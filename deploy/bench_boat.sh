@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# CPU and memory of one boat node (issue 6): 100 Hz simulated IMU, 25 Hz publishing to a shore,
+# CPU and memory of one boat node: 100 Hz simulated IMU, 25 Hz publishing to a shore,
 # session log on, for SECONDS (default 60). Loopback only. --secure: both with DDS Security (a
 # fleet PKI made in the temporary folder by deploy/security/make_fleet_pki.sh).
 set -euo pipefail

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Load benchmark (issue 7): N boats x 25 Hz attitude + 10 Hz GNSS fixes (fleet_load's defaults) for
+# Load benchmark: N boats x 25 Hz attitude + 10 Hz GNSS fixes (fleet_load's defaults) for
 # S seconds through real DDS into one shore, with SSE clients connected; optionally wrk against
 # GET /api/v1/boats meanwhile. Loopback only.
 #   deploy/bench_fleet.sh [BOATS] [SECONDS] [SSE_CLIENTS] [WRK_SECONDS]

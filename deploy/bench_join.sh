@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Join benchmark (issue 24): boats joining a running shore one after another, each timed from
+# Join benchmark: boats joining a running shore one after another, each timed from
 # its "boat_node ready" line (DDS participant and writers up, the first sample about to go out)
 # to the shore answering GET /api/v1/boats/ID. Loopback only, its own domain and ports.
 #   deploy/bench_join.sh [JOINS (20)] [RUNNING_BOATS (0): boats already sailing beside]

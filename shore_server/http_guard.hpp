@@ -1,11 +1,10 @@
 #pragma once
 /// \file
-/// cpp-httplib's server with bounds on what one connection may hold (issue 25, findings 6, 7,
-/// 13). The library (0.11.4, Debian's shared build) serves each connection on one pool thread for
-/// its whole life: an idle keep-alive connection holds a thread for the keep-alive timeout, a
-/// slowloris holds one forever (its read timeout is per recv), and headers are read without a
-/// limit on their number. So a few dozen sockets could take every thread, and with them the
-/// dashboard and /healthz.
+/// cpp-httplib's server with bounds on what one connection may hold. The library (0.11.4, Debian's
+/// shared build) serves each connection on one pool thread for its whole life: an idle keep-alive
+/// connection holds a thread for the keep-alive timeout, a slowloris holds one forever (its read
+/// timeout is per recv), and headers are read without a limit on their number. So a few dozen
+/// sockets could take every thread, and with them the dashboard and /healthz.
 ///
 /// GuardedServer replaces the per-connection loop (process_and_close_socket, which the library
 /// made virtual for its TLS server) and the socket stream; parsing, routing and responses stay the

@@ -21,7 +21,7 @@ void register_manoeuvre_eval(CLI::App& app) {
   cmd->add_option("--seed", o->seed, "first seed")->capture_default_str();
   cmd->add_option("--seeds", o->seeds, "number of seeds")->capture_default_str();
   cmd->add_option("--minutes", o->minutes, "minutes of racing per seed")->capture_default_str();
-  cmd->add_option("--min-turn-deg", o->min_turn_deg, "detection threshold (issue 21: 60)")
+  cmd->add_option("--min-turn-deg", o->min_turn_deg, "detection threshold (course change over the 10 s either side)")
       ->capture_default_str();
   cmd->add_flag("--verbose", o->verbose, "list every miss, false detection and turn error > 5 deg");
   cmd->callback([o] {

@@ -1,4 +1,4 @@
-// Manoeuvres on the dashboard (issue 21), against two simulated boats of one race whose seeds
+// Manoeuvres on the dashboard, against two simulated boats of one race whose seeds
 // tack early (seed 10: ~28 s after the node starts, seed 328: ~25 s): the live fleet card shows
 // the tack within 30 s of its exit; in the review, a list row's time moves the scrubber to its
 // t0, two tacks (one per boat) overlay aligned each at its own t0, and the boats are ranked by

@@ -1,4 +1,4 @@
-// Losing nothing on a flaky link (issue 6): a boat sails through a shore crash and through a cut
+// Losing nothing on a flaky link: a boat sails through a shore crash and through a cut
 // link; afterwards the shore's recording holds every sample the boat published, with no gap
 // longer than two publish periods. Real processes, real DDS, real SQLite.
 #include <signal.h>

@@ -1,4 +1,4 @@
-// Crash safety (issue 9, part 3): a shore ingesting three boats is SIGKILLed at random moments
+// Crash safety: a shore ingesting three boats is SIGKILLed at random moments
 // (seeded, printed; TELLTALE_CRASH_SEED repeats a run) 20 times and restarted on the same
 // database each time. After every kill: the database the restart opens passes
 // PRAGMA integrity_check, the alarm acknowledgements answered before the kill are still there,

@@ -1,4 +1,4 @@
-// Manoeuvres end to end (issue 21): a simulated boat sails its race course (seed 10 tacks ~28 s
+// Manoeuvres end to end: a simulated boat sails its race course (seed 10 tacks ~28 s
 // after the start) into a real shore; the session's /manoeuvres lists the tack, in JSON and CSV.
 #include "shore_fixture.hpp"
 

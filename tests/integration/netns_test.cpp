@@ -1,4 +1,4 @@
-// Faults across hosts (issue 9, part 2): the shore and each boat in a network namespace of their
+// Faults across hosts: the shore and each boat in a network namespace of their
 // own, multicast dropped everywhere (discovery by unicast initial peers, profile telltale_lan),
 // real shore_server and boat_node processes. After each fault: the shore's recording holds every
 // sample the boat published (seq 1..N, each once), the live view shows fresh data again without

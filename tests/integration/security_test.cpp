@@ -1,4 +1,4 @@
-// Secured mode (issue 9, "must show"): real shore_server and boat_node processes with DDS
+// Secured mode: real shore_server and boat_node processes with DDS
 // Security, each test with its own PKI made by deploy/security/make_fleet_pki.sh in a temporary
 // folder, its own DDS domain and HTTP port.
 #include <arpa/inet.h>

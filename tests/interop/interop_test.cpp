@@ -1,4 +1,4 @@
-// The wire, read by another vendor (issue 20 section 3): an Eclipse Cyclone DDS reader built from
+// The wire, read by another vendor: an Eclipse Cyclone DDS reader built from
 // Cyclone's own idlc output for idl/telltale.idl must receive and decode every Telltale topic,
 // written by the real Fast DDS binaries (boat_node: attitude, backfill, status; shore_server:
 // receipts, alarm rules, alarm events; wearable_node: wearable motion and status) and, for

@@ -1,7 +1,8 @@
 // The production filter on six real recordings with optical ground truth (BROAD, CC BY 4.0,
-// tests/data/broad/README.md): mean inclination RMSE <= 0.45 deg, every trial < 0.6 (issue 18:
-// 0.39 mean, worst 0.49; VQF 6D and the filter before issue 18 ~0.53 on these six, Madgwick's
-// ~2.6 deg). Seen failing: the filter before issue 18 gives a mean of ~0.54 here.
+// tests/data/broad/README.md): mean inclination RMSE <= 0.45 deg, every trial < 0.6 (measured:
+// 0.39 mean, worst 0.49; VQF 6D and the filter before the VQF-style rebuild ~0.53 on these six,
+// Madgwick's ~2.6 deg). Seen failing: the filter before the VQF-style rebuild gives a mean of ~0.54
+// here.
 #include <gtest/gtest.h>
 #include <zlib.h>
 

@@ -8,7 +8,7 @@
 // When a change is intended, regenerate and commit the file with the change:
 //   TELLTALE_UPDATE_GOLDEN=1 build/bin/fusion_core_tests --gtest_filter='AttitudeGolden.*'
 // (it writes the file in the source tree and fails once, saying so).
-// Seen failing: run against the filter before issue 18, every row after the first differs.
+// Seen failing: run against the filter before the VQF-style rebuild, every row after the first differs.
 #include <gtest/gtest.h>
 
 #include <cmath>

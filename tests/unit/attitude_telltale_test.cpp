@@ -122,7 +122,7 @@ TEST(TelltaleAttitudeFilter, NonUniformAndDroppedSamples) {
     // Issue 18: 1.0 -> 1.7 deg. The reworked filter reaches 1.39-1.59 deg here (0.59 without
     // the jitter and drops); not yet explained (suspects: the Butterworth's per-sample
     // coefficients under +-3 ms jitter, the 2.5 ms group-delay extrapolation, which this
-    // simulated sensor does not have). The +-1 deg target stands (issue 18, open).
+    // simulated sensor does not have). The +-1 deg target stands (open).
     EXPECT_LT(max_err / kDeg, 1.7) << "seed " << seed;
   }
 }

@@ -1,4 +1,4 @@
-// HandheldPdr (issue 19 item 2) on synthetic phone walks that carry what the IPIN 2023 walks
+// HandheldPdr on synthetic phone walks that carry what the IPIN 2023 walks
 // showed (the real logs may not be copied here): a phone handled at random first (rotations of
 // 2-7 rad/s, the hand's jerks), then held in front of a walker standing still (hand tremor, a
 // slow yaw wander), then a closed loop walked with the phone held in front (tilted 50 deg toward

@@ -1,4 +1,4 @@
-// The shore's door (issue 25, findings 1, 11, 12): every sample of every topic is checked against
+// The shore's door: every sample of every topic is checked against
 // the wire contract before anything believes it; refusals are counted, never stored, never fatal.
 #include "ingest.hpp"
 
@@ -264,19 +264,43 @@ TEST_F(IngestTest, FixesOffTheContractAreRefusedAndCounted) {
   EXPECT_EQ(got.fixes[1].fix, "none");
 
   std::vector<msg::BoatFix> bad;
-  auto m = good_fix(); m.lat_deg(91.0); bad.push_back(m);
-  m = good_fix(); m.lon_deg(std::nan("")); bad.push_back(m);
-  m = good_fix(); m.lon_deg(-180.5); bad.push_back(m);
-  m = good_fix(); m.sog_m_s(-1.0); bad.push_back(m);
-  m = good_fix(); m.sog_m_s(std::numeric_limits<double>::infinity()); bad.push_back(m);
-  m = good_fix(); m.cog_deg(400.0); bad.push_back(m);
-  m = good_fix(); m.hdop(-1.0f); bad.push_back(m);
-  m = good_fix(); m.fix(static_cast<msg::FixKind>(9)); bad.push_back(m);
-  m = good_fix(); m.fix(msg::FIX_KIND_NONE); bad.push_back(m);  // none, yet a position
+  auto m = good_fix();
+  m.lat_deg(91.0);
+  bad.push_back(m);
+  m = good_fix();
+  m.lon_deg(std::nan(""));
+  bad.push_back(m);
+  m = good_fix();
+  m.lon_deg(-180.5);
+  bad.push_back(m);
+  m = good_fix();
+  m.sog_m_s(-1.0);
+  bad.push_back(m);
+  m = good_fix();
+  m.sog_m_s(std::numeric_limits<double>::infinity());
+  bad.push_back(m);
+  m = good_fix();
+  m.cog_deg(400.0);
+  bad.push_back(m);
+  m = good_fix();
+  m.hdop(-1.0f);
+  bad.push_back(m);
+  m = good_fix();
+  m.fix(static_cast<msg::FixKind>(9));
+  bad.push_back(m);
+  m = good_fix();
+  m.fix(msg::FIX_KIND_NONE);
+  bad.push_back(m);  // none, yet a position
   for (const auto& b : bad) EXPECT_EQ(ingest.fix(b), Reject::kValue) << b.lat_deg();
-  m = good_fix(); m.boat_id("bad id"); EXPECT_EQ(ingest.fix(m), Reject::kId);
-  m = good_fix(); m.t_utc_ns(1); EXPECT_EQ(ingest.fix(m), Reject::kTime);
-  m = good_fix(); m.gnss_utc_ns(5); EXPECT_EQ(ingest.fix(m), Reject::kTime);
+  m = good_fix();
+  m.boat_id("bad id");
+  EXPECT_EQ(ingest.fix(m), Reject::kId);
+  m = good_fix();
+  m.t_utc_ns(1);
+  EXPECT_EQ(ingest.fix(m), Reject::kTime);
+  m = good_fix();
+  m.gnss_utc_ns(5);
+  EXPECT_EQ(ingest.fix(m), Reject::kTime);
   EXPECT_EQ(got.fixes.size(), 2u);
   EXPECT_EQ(ingest.counters().accepted(Topic::kFix), 2u);
   EXPECT_EQ(ingest.counters().rejected(Topic::kFix, Reject::kValue), bad.size());

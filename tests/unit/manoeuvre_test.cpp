@@ -1,4 +1,4 @@
-// Manoeuvres (issue 21): detection, classification, wind, metrics; the simulator's truth.
+// Manoeuvres: detection, classification, wind, metrics; the simulator's truth.
 #include "telltale/fusion/manoeuvres.hpp"
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The field tables (issue 20, section 1): the store writes and reads back every field of them, a
+// The field tables: the store writes and reads back every field of them, a
 // database made before a field existed gets its column, the columns of schema version 3 stay as
 // they were, and openapi.json describes exactly the fields the exports write.
 #include "sample_fields.hpp"

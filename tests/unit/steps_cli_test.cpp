@@ -1,4 +1,4 @@
-// fusion_cli steps / pdr on real files as they come (issue 19): repeated time stamps are merged
+// fusion_cli steps / pdr on real files as they come: repeated time stamps are merged
 // and counted in the JSON summary; time going backwards is one line naming file, line and
 // column, exit status 2.
 #include <gtest/gtest.h>

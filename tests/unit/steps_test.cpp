@@ -263,7 +263,7 @@ TEST(SwingStepDetector, IgnoresNaNAndTimeThatDoesNotAdvance) {
   EXPECT_NEAR(static_cast<double>(n), 17.0, 1.0);  // 18 turns, the first half swing from rest
 }
 
-// --- a real walk's first and last steps (issue 19) ---------------------------------------------
+// --- a real walk's first and last steps ---------------------------------------------
 // Given a person standing still, then walking, then stopping, as on the IPOL recordings: the
 // first step from standing is short and slow (the foot turns ~15 deg, not 45), and so is the
 // step that closes the walk beside the other foot. When a detector runs on it at 50, 100 and

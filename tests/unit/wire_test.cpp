@@ -1,4 +1,4 @@
-// The shore's wire module (issue 20, section 1): every topic type's to_wire and from_wire give
+// The shore's wire module: every topic type's to_wire and from_wire give
 // each other's input back, for every value of every enum, NaN staying NaN; every enum table has
 // each wire literal once, in the IDL's order.
 #include "wire.hpp"

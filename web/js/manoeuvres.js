@@ -1,4 +1,4 @@
-// Manoeuvres in the session review (issue 21): the session's tacks, gybes, bear-aways,
+// Manoeuvres in the session review: the session's tacks, gybes, bear-aways,
 // round-ups and penalty turns as a list (a row's time jumps the scrubber to its t0), marked on
 // the charts' timeline and on the track; several ticked (one boat, or several boats of the same
 // race: their sessions overlap this one in time) overlaid as heel, SOG and turn rate from

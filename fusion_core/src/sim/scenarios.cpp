@@ -475,7 +475,7 @@ std::unique_ptr<ImuScenario> make_scenario(std::string_view name, std::uint64_t 
   if (name == "underway-5" || name == "underway-15") {
     // The dinghy joined 100 + 20 * u seconds into its script (ashore 10 s, under way from ~15 s):
     // sailing in waves, instrument on the bow, no rest before the first sample. Scored from
-    // 5 s or from 15 s after the start (issue 18: within 2 deg after 5 s, 1 deg after 15 s).
+    // 5 s or from 15 s after the start (the target: within 2 deg after 5 s, 1 deg after 15 s).
     const double offset = 100.0 + 20.0 * hash_uniform(seed, 30, 0);
     const double warmup = name == "underway-5" ? 5.0 : 15.0;
     return std::make_unique<ImuScenario>(

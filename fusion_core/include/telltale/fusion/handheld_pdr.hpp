@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// Pedestrian dead reckoning for a phone held in front of the walker (the reading / texting pose
-/// of real phone walks, issue 19 item 2), in stages, each with its Params and State:
+/// of real phone walks), in stages, each with its Params and State:
 ///
 ///   1. tilt: the up direction in the phone's frame from TelltaleAttitudeFilter (attitude_telltale);
 ///   2. StandBiasLearner: the gyro bias from the walker standing still (a hand, not a table);

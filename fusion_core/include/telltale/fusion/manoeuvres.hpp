@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// Tacks, gybes and other manoeuvres found in a boat's course and measured (issue 21). Pure.
+/// Tacks, gybes and other manoeuvres found in a boat's course and measured. Pure.
 ///
 /// Input: time-ordered GNSS samples (COG, SOG; a heading when a compass gives one) and
 /// optionally attitude samples (heel, pitch). Everything is put on a 10 Hz grid (the latest

@@ -240,7 +240,7 @@ class PeakValleyStepDetector final : public StepDetector {
   int n_ = 0;
 };
 
-/// Gait phases, for real walks that start and stop (issue 19). The adaptive and peak-valley
+/// Gait phases, for real walks that start and stop. The adaptive and peak-valley
 /// detectors need a few steps of history before their thresholds describe the walk, so on real
 /// recordings (stand, walk 10 m, turn, walk back, stop) they lost the first steps after standing
 /// and the last before stopping, 2-4 a walk. This detector needs no history: every rule is a
