@@ -333,7 +333,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
     if (n2 > 0.25) {  // the bow within 60 deg of horizontal (else its direction means nothing)
       const double inv_n = 1.0 / std::sqrt(n2);
       double w_up = gyro.dot(u);
-      if (st.yaw_rate_cog_rad_s == st.yaw_rate_cog_rad_s) {
+      if (!std::isnan(st.yaw_rate_cog_rad_s)) {
         // The gyro's error about the vertical is its bias there (variance u^T P u); the course
         // rate's is cog_rate_sigma. Their variance-weighted mean (the Kalman update of one
         // measurement of the other).
@@ -351,7 +351,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   }
   // The course measures the bias about the vertical when it is known (course_update).
   const bool course_known = !gap && st.speed_m_s >= 0.0 &&
-                            st.yaw_rate_cog_rad_s == st.yaw_rate_cog_rad_s &&
+                            !std::isnan(st.yaw_rate_cog_rad_s) &&
                             1.0 - st.up_body.x() * st.up_body.x() > 0.25;
   // --- The start (start_fit_update) until start_fit_s have passed, or a rest or a gap comes
   // first (a rest measures the bias far better; over a gap the line breaks). Then the low-pass
