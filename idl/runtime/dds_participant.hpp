@@ -35,6 +35,8 @@ inline constexpr const char* kTopicWearableMotion = "telltale_wearable_motion";
 inline constexpr const char* kTopicBoatBackfill = "telltale_boat_backfill";
 inline constexpr const char* kTopicShoreAck = "telltale_shore_ack";
 inline constexpr const char* kTopicBoatFix = "telltale_boat_fix";
+inline constexpr const char* kTopicBoatFixBackfill = "telltale_boat_fix_backfill";
+inline constexpr const char* kTopicShoreFixAck = "telltale_shore_fix_ack";
 
 /// Setup failure (profile file, participant, topic, entity): main() prints it and exits non-zero.
 class DdsError : public std::runtime_error {
@@ -94,7 +96,8 @@ class Participant {
       eprosima::fastdds::dds::Topic* topic, const std::string& profile,
       eprosima::fastdds::dds::DataWriterListener* listener = nullptr);
   /// A reader with the named QoS profile. The listener gets every status (data, deadline,
-  /// liveliness). Throws DdsError.
+  /// liveliness) and must outlive this participant: Fast DDS may call it until the reader is
+  /// deleted by ~Participant. Throws DdsError.
   eprosima::fastdds::dds::DataReader* reader(eprosima::fastdds::dds::Topic* topic,
                                              const std::string& profile,
                                              eprosima::fastdds::dds::DataReaderListener* listener);

@@ -322,12 +322,15 @@ TEST_F(SecurityTest, SecuredShoreListsTwoSecuredBoatsAndAWearableWithLiveData) {
 TEST_F(SecurityTest, UnauthenticatedParticipantCanNeitherReadNorInject) {
   start_node("alpha", "alpha");
   start_node("intruder", "");  // plain boat_node, no certificate
-  // A plain DDS reader in this process, on every partition and the default one.
+  // A plain DDS reader in this process, on every partition and the default one. The listener is
+  // declared first so that it outlives the participant: locals are destroyed in reverse order,
+  // and Fast DDS may still deliver a sample while ~Participant deletes the reader (seen once
+  // under ASan: the receive thread called through the destroyed listener's vtable).
+  CountingListener counter;
   dds::DdsOptions options;
   options.domain = domain_;
   options.subscriber_partitions = {"*", ""};
   dds::Participant spy(options, "spy");
-  CountingListener counter;
   spy.reader(
       spy.topic(dds::kTopicBoatAttitude, fdds::TypeSupport(new msg::BoatAttitudePubSubType())),
       "attitude_reader", &counter);
