@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <type_traits>
 
 namespace telltale::boat {
 
@@ -15,24 +16,29 @@ std::int64_t steady_ns() {
 }
 }  // namespace
 
-Backfiller::Backfiller(BackfillConfig config, SessionLogReader reader,
-                       std::function<bool(const LogRecord&)> send)
+template <class Codec>
+BasicBackfiller<Codec>::BasicBackfiller(BackfillConfig config, BasicSessionLogReader<Codec> reader,
+                                        std::function<bool(const Record&)> send)
     : config_(config), reader_(std::move(reader)), send_(std::move(send)) {
   progress_ns_.store(steady_ns());
   thread_ = std::thread([this] { run(); });
 }
 
-double Backfiller::seconds_since_progress() const {
+template <class Codec>
+double BasicBackfiller<Codec>::seconds_since_progress() const {
   return static_cast<double>(steady_ns() - progress_ns_.load()) * 1e-9;
 }
 
-Backfiller::~Backfiller() {
+template <class Codec>
+BasicBackfiller<Codec>::~BasicBackfiller() {
   stop_.store(true);
   cv_.notify_all();
   thread_.join();
 }
 
-void Backfiller::on_ack(std::uint64_t boot_id, std::uint64_t acked_seq, bool new_shore) {
+template <class Codec>
+void BasicBackfiller<Codec>::on_ack(std::uint64_t boot_id, std::uint64_t acked_seq,
+                                    bool new_shore) {
   // Receipts come every second; after a silence (a cut link, a shore restart) the shore is back
   // and the range it missed goes at once instead of at the next resend_after.
   const std::int64_t now_ns = steady_ns();
@@ -62,7 +68,8 @@ void Backfiller::on_ack(std::uint64_t boot_id, std::uint64_t acked_seq, bool new
   cv_.notify_all();
 }
 
-std::uint64_t Backfiller::send_range(std::uint64_t first, std::uint64_t last) {
+template <class Codec>
+std::uint64_t BasicBackfiller<Codec>::send_range(std::uint64_t first, std::uint64_t last) {
   constexpr std::uint64_t kChunk = 250;
   const auto chunk_period = std::chrono::milliseconds(
       static_cast<long>(1000 * kChunk / std::max<std::size_t>(config_.max_per_second, 1)));
@@ -83,7 +90,8 @@ std::uint64_t Backfiller::send_range(std::uint64_t first, std::uint64_t last) {
   return last;
 }
 
-void Backfiller::run() {
+template <class Codec>
+void BasicBackfiller<Codec>::run() {
   std::uint64_t last_acked = 0;
   auto acked_moved_at = std::chrono::steady_clock::now();
   std::chrono::steady_clock::time_point full_resend_at{};
@@ -128,7 +136,9 @@ void Backfiller::run() {
   }
 }
 
-bool Backfiller::drain(std::chrono::milliseconds quiet, std::chrono::milliseconds patience) {
+template <class Codec>
+bool BasicBackfiller<Codec>::drain(std::chrono::milliseconds quiet,
+                                   std::chrono::milliseconds patience) {
   draining_.store(true);
   force_resend_.store(true);  // the run thread may resend at once
   const auto started = std::chrono::steady_clock::now();
@@ -143,13 +153,14 @@ bool Backfiller::drain(std::chrono::milliseconds quiet, std::chrono::millisecond
   }
 }
 
-EarlierRuns::EarlierRuns(std::filesystem::path dir, std::string boat_id, std::uint64_t current_boot,
-                         std::chrono::hours max_age, Send send,
-                         std::function<void(const std::string&)> report,
-                         std::chrono::seconds give_up)
+template <class Codec>
+BasicEarlierRuns<Codec>::BasicEarlierRuns(std::filesystem::path dir, std::string boat_id,
+                                          std::uint64_t current_boot, std::chrono::hours max_age,
+                                          Send send, std::function<void(const std::string&)> report,
+                                          std::chrono::seconds give_up)
     : dir_(std::move(dir)),
       boat_id_(std::move(boat_id)),
-      runs_(undelivered_runs(dir_, boat_id_, current_boot, max_age)),
+      runs_(undelivered_runs<Codec>(dir_, boat_id_, current_boot, max_age)),
       send_(std::move(send)),
       report_(std::move(report)),
       give_up_(give_up) {
@@ -157,26 +168,30 @@ EarlierRuns::EarlierRuns(std::filesystem::path dir, std::string boat_id, std::ui
   if (!runs_.empty()) thread_ = std::thread([this] { run(); });
 }
 
-EarlierRuns::~EarlierRuns() {
+template <class Codec>
+BasicEarlierRuns<Codec>::~BasicEarlierRuns() {
   stop_.store(true);
   cv_.notify_all();
   if (thread_.joinable()) thread_.join();
 }
 
-void EarlierRuns::on_ack(std::uint64_t boot_id, std::uint64_t acked_seq, bool new_shore) {
+template <class Codec>
+void BasicEarlierRuns<Codec>::on_ack(std::uint64_t boot_id, std::uint64_t acked_seq,
+                                     bool new_shore) {
   std::lock_guard lock(mutex_);
   if (active_) active_->on_ack(boot_id, acked_seq, new_shore);
 }
 
-void EarlierRuns::run() {
+template <class Codec>
+void BasicEarlierRuns<Codec>::run() {
   for (const std::uint64_t boot : runs_) {
-    SessionLogReader reader(dir_, boat_id_, boot);
+    BasicSessionLogReader<Codec> reader(dir_, boat_id_, boot);
     const std::uint64_t last = reader.last_seq();
     {
       std::lock_guard lock(mutex_);
-      active_ = std::make_unique<Backfiller>(
+      active_ = std::make_unique<BasicBackfiller<Codec>>(
           BackfillConfig{boot, 0, 2500, std::chrono::milliseconds(5000)}, std::move(reader),
-          [this, boot](const LogRecord& r) { return send_(boot, r); });
+          [this, boot](const typename Codec::Record& r) { return send_(boot, r); });
       active_->on_published(last);
     }
     std::string outcome;
@@ -200,13 +215,18 @@ void EarlierRuns::run() {
       active_.reset();
     }
     if (outcome.empty()) return;  // stopping: the run stays pending for the next start
-    mark_delivered(dir_, boat_id_, boot);
+    mark_delivered<Codec>(dir_, boat_id_, boot);
     pending_.fetch_sub(1);
     char hex[17];
     std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(boot));
-    report_("earlier run " + std::string(hex) + " (" + std::to_string(last) +
-            " samples): " + outcome);
+    report_("earlier run " + std::string(hex) + " (" + std::to_string(last) + " " +
+            (std::is_same_v<Codec, FixCodec> ? "fixes" : "samples") + "): " + outcome);
   }
 }
+
+template class BasicBackfiller<AttitudeCodec>;
+template class BasicBackfiller<FixCodec>;
+template class BasicEarlierRuns<AttitudeCodec>;
+template class BasicEarlierRuns<FixCodec>;
 
 }  // namespace telltale::boat

@@ -1,6 +1,9 @@
 #pragma once
 /// \file
 /// Backfill: resends from the session log what the shore's receipts say it does not have.
+/// The same code for both record kinds (session_log.hpp): attitude on "telltale_boat_backfill"
+/// against the receipts on "telltale_shore_ack", fixes on "telltale_boat_fix_backfill" against
+/// "telltale_shore_fix_ack"; each kind has its own seq, so its own receipts and its own thread.
 ///
 /// The shore acknowledges, per boat run, the highest seq up to which every sample is stored.
 /// When the node is more than `lag` samples ahead of that receipt (the newest samples may still
@@ -33,12 +36,14 @@ struct BackfillConfig {
   std::chrono::milliseconds resend_after{5000};
 };
 
-class Backfiller {
+template <class Codec>
+class BasicBackfiller {
  public:
+  using Record = typename Codec::Record;
   /// `send` writes one record on the backfill topic (returns false if it could not).
-  Backfiller(BackfillConfig config, SessionLogReader reader,
-             std::function<bool(const LogRecord&)> send);
-  ~Backfiller();
+  BasicBackfiller(BackfillConfig config, BasicSessionLogReader<Codec> reader,
+                  std::function<bool(const Record&)> send);
+  ~BasicBackfiller();
 
   void on_published(std::uint64_t seq) { published_.store(seq); }
   /// A receipt for this boat, any run: each one shows the shore is there; one for this run sets
@@ -67,8 +72,8 @@ class Backfiller {
   std::uint64_t send_range(std::uint64_t first, std::uint64_t last);
 
   BackfillConfig config_;
-  SessionLogReader reader_;
-  std::function<bool(const LogRecord&)> send_;
+  BasicSessionLogReader<Codec> reader_;
+  std::function<bool(const Record&)> send_;
   std::atomic<std::uint64_t> published_{0};
   std::atomic<std::uint64_t> acked_{0};
   std::atomic<std::uint64_t> resent_{0};
@@ -92,15 +97,17 @@ class Backfiller {
 /// when the shore's receipt for it reaches the last seq on disk, or when the shore is heard but
 /// its receipt has not moved for `give_up` (samples the disk policy deleted leave a hole the
 /// receipt cannot pass).
-class EarlierRuns {
+template <class Codec>
+class BasicEarlierRuns {
  public:
-  using Send = std::function<bool(std::uint64_t boot_id, const LogRecord&)>;
+  using Send = std::function<bool(std::uint64_t boot_id, const typename Codec::Record&)>;
   /// `report` gets one line per finished run (from the delivery thread).
   /// Offers the runs of `undelivered_runs(dir, boat_id, current_boot, max_age)`.
-  EarlierRuns(std::filesystem::path dir, std::string boat_id, std::uint64_t current_boot,
-              std::chrono::hours max_age, Send send, std::function<void(const std::string&)> report,
-              std::chrono::seconds give_up = std::chrono::seconds(60));
-  ~EarlierRuns();
+  BasicEarlierRuns(std::filesystem::path dir, std::string boat_id, std::uint64_t current_boot,
+                   std::chrono::hours max_age, Send send,
+                   std::function<void(const std::string&)> report,
+                   std::chrono::seconds give_up = std::chrono::seconds(60));
+  ~BasicEarlierRuns();
 
   void on_ack(std::uint64_t boot_id, std::uint64_t acked_seq, bool new_shore);
   /// Runs not delivered yet (including the one in progress).
@@ -119,8 +126,13 @@ class EarlierRuns {
   std::atomic<bool> stop_{false};
   std::mutex mutex_;  ///< guards active_ (the DDS listener forwards receipts to it)
   std::condition_variable cv_;
-  std::unique_ptr<Backfiller> active_;
+  std::unique_ptr<BasicBackfiller<Codec>> active_;
   std::thread thread_;
 };
+
+using Backfiller = BasicBackfiller<AttitudeCodec>;
+using FixBackfiller = BasicBackfiller<FixCodec>;
+using EarlierRuns = BasicEarlierRuns<AttitudeCodec>;
+using FixEarlierRuns = BasicEarlierRuns<FixCodec>;
 
 }  // namespace telltale::boat

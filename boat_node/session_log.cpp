@@ -12,8 +12,6 @@
 namespace telltale::boat {
 namespace {
 
-constexpr std::uint32_t kMagic = 0x544c4c54;  // "TLLT"
-
 std::uint32_t crc32(const unsigned char* p, std::size_t n) {
   std::uint32_t c = 0xFFFFFFFFu;
   for (std::size_t i = 0; i < n; ++i) {
@@ -42,12 +40,23 @@ std::string file_prefix(const std::string& boat_id, std::uint64_t boot_id) {
   return boat_id + "-" + hex + "-";
 }
 
-/// `<boat>-<16 hex>-<12 digits>.tlog` of this boat: its boot id, or nothing (another boat whose
-/// id starts with this one's has a '-' where the hex digits are).
-std::optional<std::uint64_t> boot_of(const std::string& name, const std::string& boat_id) {
-  constexpr std::size_t kTail = 1 + 16 + 1 + 12 + 5;
-  if (name.size() != boat_id.size() + kTail || name.rfind(boat_id + "-", 0) != 0 ||
-      !name.ends_with(".tlog") || name[boat_id.size() + 17] != '-')
+/// The kinds' file suffixes: the disk budget covers them all.
+constexpr const char* kLogSuffixes[] = {AttitudeCodec::kSuffix, FixCodec::kSuffix};
+
+bool is_log_file(const std::filesystem::path& p) {
+  const auto ext = p.extension();
+  for (const char* s : kLogSuffixes)
+    if (ext == s) return true;
+  return false;
+}
+
+/// `<boat>-<16 hex>-<12 digits><suffix>` of this boat: its boot id, or nothing (another boat
+/// whose id starts with this one's has a '-' where the hex digits are).
+std::optional<std::uint64_t> boot_of(const std::string& name, const std::string& boat_id,
+                                     const std::string& suffix) {
+  const std::size_t tail = 1 + 16 + 1 + 12 + suffix.size();
+  if (name.size() != boat_id.size() + tail || name.rfind(boat_id + "-", 0) != 0 ||
+      !name.ends_with(suffix) || name[boat_id.size() + 17] != '-')
     return std::nullopt;
   const std::string hex = name.substr(boat_id.size() + 1, 16);
   if (hex.find_first_not_of("0123456789abcdef") != std::string::npos) return std::nullopt;
@@ -55,34 +64,56 @@ std::optional<std::uint64_t> boot_of(const std::string& name, const std::string&
 }
 
 std::filesystem::path delivered_marker(const std::filesystem::path& dir, const std::string& boat_id,
-                                       std::uint64_t boot_id) {
+                                       std::uint64_t boot_id, const std::string& marker) {
   std::string prefix = file_prefix(boat_id, boot_id);
-  prefix.back() = '.';
-  return dir / (prefix + "delivered");
+  prefix.pop_back();
+  return dir / (prefix + marker);
 }
 
-/// First sequence number encoded in a log file name, or nothing.
-std::optional<std::uint64_t> first_seq_of(const std::filesystem::path& p,
-                                          const std::string& prefix) {
+/// First sequence number encoded in a log file name of the kind with `suffix`, or nothing.
+std::optional<std::uint64_t> first_seq_of(const std::filesystem::path& p, const std::string& prefix,
+                                          const std::string& suffix) {
   const std::string name = p.filename().string();
-  if (name.rfind(prefix, 0) != 0 || p.extension() != ".tlog") return std::nullopt;
+  if (name.rfind(prefix, 0) != 0 || p.extension() != suffix ||
+      name.size() <= prefix.size() + suffix.size())
+    return std::nullopt;
   try {
-    return std::stoull(name.substr(prefix.size(), name.size() - prefix.size() - 5));
+    return std::stoull(name.substr(prefix.size(), name.size() - prefix.size() - suffix.size()));
   } catch (const std::exception&) {
     return std::nullopt;
   }
+}
+
+template <class Codec>
+void encode_frame(const typename Codec::Record& r, unsigned char* out) {
+  std::memset(out, 0, kLogRecordBytes);
+  Codec::encode(r, out + kLogHeaderBytes);
+  unsigned char* h = out;
+  put(h, Codec::kMagic);
+  put(h, crc32(out + kLogHeaderBytes, kLogRecordBytes - kLogHeaderBytes));
+}
+
+template <class Codec>
+std::optional<typename Codec::Record> decode_frame(const unsigned char* in) {
+  const unsigned char* h = in;
+  if (get<std::uint32_t>(h) != Codec::kMagic) return std::nullopt;
+  if (get<std::uint32_t>(h) != crc32(in + kLogHeaderBytes, kLogRecordBytes - kLogHeaderBytes))
+    return std::nullopt;
+  return Codec::decode(in + kLogHeaderBytes);
 }
 
 /// Records in `bytes` with first <= seq <= last, in file order. Where the bytes at a record
 /// boundary are not a valid record (torn by a crash or a full disk), it moves on byte by byte to
 /// the next valid magic + CRC: nothing intact after a torn record is skipped. `clean` is set
 /// false if it had to.
-std::vector<LogRecord> scan_records(const unsigned char* bytes, std::size_t n, std::uint64_t first,
-                                    std::uint64_t last, bool& clean) {
-  std::vector<LogRecord> out;
+template <class Codec>
+std::vector<typename Codec::Record> scan_records(const unsigned char* bytes, std::size_t n,
+                                                 std::uint64_t first, std::uint64_t last,
+                                                 bool& clean) {
+  std::vector<typename Codec::Record> out;
   std::size_t pos = 0;
   while (pos + kLogRecordBytes <= n) {
-    const auto r = decode_record(bytes + pos);
+    const auto r = decode_frame<Codec>(bytes + pos);
     if (!r) {
       clean = false;
       ++pos;
@@ -109,15 +140,16 @@ std::vector<unsigned char> read_all(const std::filesystem::path& p) {
 
 /// True if the file is on the record grid: a whole number of records, the last of which holds
 /// the seq its position says (checked by reading that one record).
+template <class Codec>
 bool intact(const std::filesystem::path& p, std::uint64_t first_seq, std::uint64_t size) {
   if (size % kLogRecordBytes != 0) return false;
   if (size == 0) return true;
-  std::optional<LogRecord> tail;
+  std::optional<typename Codec::Record> tail;
   if (std::FILE* f = std::fopen(p.c_str(), "rb")) {
     unsigned char buf[kLogRecordBytes];
     if (std::fseek(f, static_cast<long>(size - kLogRecordBytes), SEEK_SET) == 0 &&
         std::fread(buf, 1, sizeof buf, f) == sizeof buf)
-      tail = decode_record(buf);
+      tail = decode_frame<Codec>(buf);
     std::fclose(f);
   }
   return tail && tail->seq == first_seq + size / kLogRecordBytes - 1;
@@ -125,9 +157,8 @@ bool intact(const std::filesystem::path& p, std::uint64_t first_seq, std::uint64
 
 }  // namespace
 
-void encode_record(const LogRecord& r, unsigned char* out) {
-  std::memset(out, 0, kLogRecordBytes);
-  unsigned char* p = out + 8;  // magic and CRC last
+void AttitudeCodec::encode(const Record& r, unsigned char* body) {
+  unsigned char* p = body;
   put(p, r.seq);
   put(p, r.t_utc_ns);
   put(p, r.heel_deg);
@@ -141,17 +172,11 @@ void encode_record(const LogRecord& r, unsigned char* out) {
   for (auto l : r.leds) put(p, l);
   put(p, r.led_count);
   put(p, r.level);
-  unsigned char* h = out;
-  put(h, kMagic);
-  put(h, crc32(out + 8, kLogRecordBytes - 8));
 }
 
-std::optional<LogRecord> decode_record(const unsigned char* in) {
-  const unsigned char* h = in;
-  if (get<std::uint32_t>(h) != kMagic) return std::nullopt;
-  if (get<std::uint32_t>(h) != crc32(in + 8, kLogRecordBytes - 8)) return std::nullopt;
+LogRecord AttitudeCodec::decode(const unsigned char* body) {
   LogRecord r;
-  const unsigned char* p = in + 8;
+  const unsigned char* p = body;
   r.seq = get<std::uint64_t>(p);
   r.t_utc_ns = get<std::uint64_t>(p);
   r.heel_deg = get<double>(p);
@@ -168,7 +193,49 @@ std::optional<LogRecord> decode_record(const unsigned char* in) {
   return r;
 }
 
-SessionLog::SessionLog(SessionLogConfig config) : config_(std::move(config)) {
+static_assert(8 * 7 + 1 + 1 + 4 <= kLogRecordBytes - kLogHeaderBytes, "a fix fits a frame");
+
+void FixCodec::encode(const Record& r, unsigned char* body) {
+  unsigned char* p = body;
+  put(p, r.seq);
+  put(p, r.t_utc_ns);
+  put(p, r.gnss_utc_ns);
+  put(p, r.lat_deg);
+  put(p, r.lon_deg);
+  put(p, r.sog_m_s);
+  put(p, r.cog_deg);
+  put(p, r.fix);
+  put(p, r.satellites);
+  put(p, r.hdop);
+}
+
+FixRecord FixCodec::decode(const unsigned char* body) {
+  FixRecord r;
+  const unsigned char* p = body;
+  r.seq = get<std::uint64_t>(p);
+  r.t_utc_ns = get<std::uint64_t>(p);
+  r.gnss_utc_ns = get<std::uint64_t>(p);
+  r.lat_deg = get<double>(p);
+  r.lon_deg = get<double>(p);
+  r.sog_m_s = get<double>(p);
+  r.cog_deg = get<double>(p);
+  r.fix = get<std::uint8_t>(p);
+  r.satellites = get<std::uint8_t>(p);
+  r.hdop = get<float>(p);
+  return r;
+}
+
+void encode_record(const LogRecord& r, unsigned char* out) { encode_frame<AttitudeCodec>(r, out); }
+void encode_record(const FixRecord& r, unsigned char* out) { encode_frame<FixCodec>(r, out); }
+std::optional<LogRecord> decode_record(const unsigned char* in) {
+  return decode_frame<AttitudeCodec>(in);
+}
+std::optional<FixRecord> decode_fix_record(const unsigned char* in) {
+  return decode_frame<FixCodec>(in);
+}
+
+template <class Codec>
+BasicSessionLog<Codec>::BasicSessionLog(SessionLogConfig config) : config_(std::move(config)) {
   std::error_code ec;
   std::filesystem::create_directories(config_.dir, ec);
   if (ec)
@@ -177,7 +244,8 @@ SessionLog::SessionLog(SessionLogConfig config) : config_(std::move(config)) {
   // The directory may exist and still refuse files (a read-only mount, permissions): find out
   // now, before the node says it is ready. A full disk is not a refusal: the log holds records
   // until it has room again.
-  const auto probe = config_.dir / ("." + file_prefix(config_.boat_id, config_.boot_id) + "probe");
+  const auto probe = config_.dir / ("." + file_prefix(config_.boat_id, config_.boot_id) + "probe-" +
+                                    std::string(Codec::kSuffix).substr(1));
   const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) {
     const int err = errno;
@@ -191,25 +259,29 @@ SessionLog::SessionLog(SessionLogConfig config) : config_(std::move(config)) {
   }
 }
 
-SessionLog::~SessionLog() {
+template <class Codec>
+BasicSessionLog<Codec>::~BasicSessionLog() {
   (void)write_pending();
   if (fd_ >= 0) ::close(fd_);
 }
 
-void SessionLog::fail(int err) {
+template <class Codec>
+void BasicSessionLog<Codec>::fail(int err) {
   ++write_errors_;
   last_error_ = std::strerror(err);
 }
 
-SessionLogHealth SessionLog::health() const {
+template <class Codec>
+SessionLogHealth BasicSessionLog<Codec>::health() const {
   return {pending_.size() / kLogRecordBytes, dropped_, write_errors_, last_error_};
 }
 
-bool SessionLog::open_next(std::uint64_t first_seq) {
+template <class Codec>
+bool BasicSessionLog<Codec>::open_next(std::uint64_t first_seq) {
   if (fd_ >= 0) ::close(fd_);
   char seq[24];
   std::snprintf(seq, sizeof seq, "%012llu", static_cast<unsigned long long>(first_seq));
-  current_ = config_.dir / (file_prefix(config_.boat_id, config_.boot_id) + seq + ".tlog");
+  current_ = config_.dir / (file_prefix(config_.boat_id, config_.boot_id) + seq + Codec::kSuffix);
   // A file of this name can only be an earlier attempt that holds no record (a roll lands on a
   // seq no file holds yet): start it afresh.
   fd_ = ::open(current_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
@@ -223,7 +295,8 @@ bool SessionLog::open_next(std::uint64_t first_seq) {
   return true;
 }
 
-bool SessionLog::append(const LogRecord& record) {
+template <class Codec>
+bool BasicSessionLog<Codec>::append(const Record& record) {
   const std::uint64_t held = pending_.size() / kLogRecordBytes;
   if (held > 0 && record.seq != pending_first_seq_ + held) {
     // Not the next seq (the caller broke the contract): what is held cannot share a file grid
@@ -236,7 +309,7 @@ bool SessionLog::append(const LogRecord& record) {
   if (pending_.empty()) pending_first_seq_ = record.seq;
   const std::size_t at = pending_.size();
   pending_.resize(at + kLogRecordBytes);
-  encode_record(record, pending_.data() + at);
+  encode_frame<Codec>(record, pending_.data() + at);
   if (pending_.size() > std::max(config_.max_pending_bytes, kLogRecordBytes)) {
     // Writes have failed for long: the oldest held record goes (the file rolls past the hole).
     pending_.erase(pending_.begin(),
@@ -250,9 +323,13 @@ bool SessionLog::append(const LogRecord& record) {
   return true;
 }
 
-bool SessionLog::flush() { return write_pending(); }
+template <class Codec>
+bool BasicSessionLog<Codec>::flush() {
+  return write_pending();
+}
 
-bool SessionLog::write_pending() {
+template <class Codec>
+bool BasicSessionLog<Codec>::write_pending() {
   while (!pending_.empty()) {
     if (fd_ < 0 || in_file_ >= config_.records_per_file ||
         pending_first_seq_ != file_first_seq_ + in_file_) {
@@ -293,7 +370,8 @@ bool SessionLog::write_pending() {
   return true;
 }
 
-void SessionLog::enforce_limit() {
+template <class Codec>
+void BasicSessionLog<Codec>::enforce_limit() {
   struct Entry {
     std::filesystem::path path;
     std::filesystem::file_time_type mtime;
@@ -302,11 +380,21 @@ void SessionLog::enforce_limit() {
   std::vector<Entry> files;
   std::uintmax_t total = 0;
   std::error_code ec;
+  // One budget over every kind. The file this run writes of each kind (its latest of that
+  // suffix) is never deleted: the other kind's log has it open, and records written to a
+  // deleted file are lost without an error.
+  const std::string own = file_prefix(config_.boat_id, config_.boot_id);
+  std::map<std::string, std::pair<std::uint64_t, std::filesystem::path>> writing;  // by suffix
   for (const auto& e : std::filesystem::directory_iterator(config_.dir, ec)) {
-    if (e.path().extension() != ".tlog") continue;
+    if (!is_log_file(e.path())) continue;
     const auto size = e.file_size(ec);
     files.push_back({e.path(), e.last_write_time(ec), size});
     total += size;
+    const std::string suffix = e.path().extension().string();
+    if (const auto first = first_seq_of(e.path(), own, suffix)) {
+      auto& w = writing[suffix];
+      if (w.second.empty() || *first >= w.first) w = {*first, e.path()};
+    }
   }
   // Room for the file just opened to fill up.
   total += config_.records_per_file * kLogRecordBytes;
@@ -314,7 +402,9 @@ void SessionLog::enforce_limit() {
             [](const Entry& a, const Entry& b) { return a.mtime < b.mtime; });
   for (const auto& f : files) {
     if (total <= config_.max_bytes) break;
-    if (f.path == current_) continue;
+    if (f.path == current_ || std::any_of(writing.begin(), writing.end(),
+                                          [&](const auto& w) { return w.second.second == f.path; }))
+      continue;
     std::filesystem::remove(f.path, ec);
     if (!ec) {
       total -= f.size;
@@ -323,17 +413,20 @@ void SessionLog::enforce_limit() {
   }
 }
 
-SessionLogReader::SessionLogReader(std::filesystem::path dir, std::string boat_id,
-                                   std::uint64_t boot_id)
+template <class Codec>
+BasicSessionLogReader<Codec>::BasicSessionLogReader(std::filesystem::path dir, std::string boat_id,
+                                                    std::uint64_t boot_id)
     : dir_(std::move(dir)), prefix_(file_prefix(boat_id, boot_id)) {}
 
-std::vector<LogRecord> SessionLogReader::read(std::uint64_t first_seq, std::uint64_t last_seq) {
-  std::vector<LogRecord> out;
+template <class Codec>
+std::vector<typename Codec::Record> BasicSessionLogReader<Codec>::read(std::uint64_t first_seq,
+                                                                       std::uint64_t last_seq) {
+  std::vector<Record> out;
   if (first_seq > last_seq) return out;
   std::vector<std::pair<std::uint64_t, std::filesystem::path>> files;
   std::error_code ec;
   for (const auto& e : std::filesystem::directory_iterator(dir_, ec))
-    if (auto s = first_seq_of(e.path(), prefix_)) files.emplace_back(*s, e.path());
+    if (auto s = first_seq_of(e.path(), prefix_, Codec::kSuffix)) files.emplace_back(*s, e.path());
   std::sort(files.begin(), files.end());
   for (std::size_t i = 0; i < files.size(); ++i) {
     const std::uint64_t start = files[i].first;
@@ -342,9 +435,9 @@ std::vector<LogRecord> SessionLogReader::read(std::uint64_t first_seq, std::uint
     const auto& path = files[i].second;
     const std::uint64_t size = std::filesystem::file_size(path, ec);
     if (ec) continue;
-    std::vector<LogRecord> got;
+    std::vector<Record> got;
     bool clean = true;
-    if (intact(path, start, size)) {
+    if (intact<Codec>(path, start, size)) {
       // Seq s sits at (s - start) records: read just the range.
       const std::uint64_t from = std::max(first_seq, start);
       const std::uint64_t records = size / kLogRecordBytes;
@@ -357,38 +450,40 @@ std::vector<LogRecord> SessionLogReader::read(std::uint64_t first_seq, std::uint
           n = std::fread(bytes.data(), 1, bytes.size(), f);
         std::fclose(f);
       }
-      got = scan_records(bytes.data(), n, first_seq, last_seq, clean);
+      got = scan_records<Codec>(bytes.data(), n, first_seq, last_seq, clean);
     } else {
       // Off the grid (a torn record, lost records): scan all of it.
       const auto all = read_all(path);
-      got = scan_records(all.data(), all.size(), first_seq, last_seq, clean);
+      got = scan_records<Codec>(all.data(), all.size(), first_seq, last_seq, clean);
     }
     out.insert(out.end(), got.begin(), got.end());
   }
   return out;
 }
 
-std::uint64_t SessionLogReader::last_seq() const {
+template <class Codec>
+std::uint64_t BasicSessionLogReader<Codec>::last_seq() const {
   std::uint64_t last = 0;
   std::error_code ec;
   for (const auto& e : std::filesystem::directory_iterator(dir_, ec)) {
-    const auto first = first_seq_of(e.path(), prefix_);
+    const auto first = first_seq_of(e.path(), prefix_, Codec::kSuffix);
     if (!first) continue;
     const auto size = e.file_size(ec);
     const auto records = size / kLogRecordBytes;
     if (ec || records == 0) continue;
-    if (intact(e.path(), *first, size)) {
+    if (intact<Codec>(e.path(), *first, size)) {
       last = std::max(last, *first + records - 1);
       continue;
     }
     const auto all = read_all(e.path());
     bool clean = true;
-    const auto got = scan_records(all.data(), all.size(), 0, UINT64_MAX, clean);
+    const auto got = scan_records<Codec>(all.data(), all.size(), 0, UINT64_MAX, clean);
     if (!got.empty()) last = std::max(last, got.back().seq);
   }
   return last;
 }
 
+template <class Codec>
 std::vector<std::uint64_t> undelivered_runs(const std::filesystem::path& dir,
                                             const std::string& boat_id, std::uint64_t current_boot,
                                             std::chrono::hours max_age) {
@@ -402,18 +497,20 @@ std::vector<std::uint64_t> undelivered_runs(const std::filesystem::path& dir,
   std::error_code ec;
   for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
     const std::string name = e.path().filename().string();
-    if (const auto boot = boot_of(name, boat_id)) {
+    if (const auto boot = boot_of(name, boat_id, Codec::kSuffix)) {
       Run& r = runs[*boot];
       r.has_log = true;
       r.newest = std::max(r.newest, e.last_write_time(ec));
     }
   }
   for (auto& [boot, r] : runs)
-    r.delivered = std::filesystem::exists(delivered_marker(dir, boat_id, boot), ec);
+    r.delivered =
+        std::filesystem::exists(delivered_marker(dir, boat_id, boot, Codec::kDelivered), ec);
   // Markers whose run is gone (disk policy) would pile up.
+  const std::string marker = Codec::kDelivered;
   for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
     const std::string name = e.path().filename().string();
-    if (!name.ends_with(".delivered") || name.size() != boat_id.size() + 27 ||
+    if (!name.ends_with(marker) || name.size() != boat_id.size() + 17 + marker.size() ||
         name.rfind(boat_id + "-", 0) != 0)
       continue;
     const std::string hex = name.substr(boat_id.size() + 1, 16);
@@ -431,10 +528,28 @@ std::vector<std::uint64_t> undelivered_runs(const std::filesystem::path& dir,
   return out;
 }
 
+template <class Codec>
 void mark_delivered(const std::filesystem::path& dir, const std::string& boat_id,
                     std::uint64_t boot_id) {
-  if (std::FILE* f = std::fopen(delivered_marker(dir, boat_id, boot_id).c_str(), "w"))
+  if (std::FILE* f =
+          std::fopen(delivered_marker(dir, boat_id, boot_id, Codec::kDelivered).c_str(), "w"))
     std::fclose(f);
 }
+
+template class BasicSessionLog<AttitudeCodec>;
+template class BasicSessionLog<FixCodec>;
+template class BasicSessionLogReader<AttitudeCodec>;
+template class BasicSessionLogReader<FixCodec>;
+template std::vector<std::uint64_t> undelivered_runs<AttitudeCodec>(const std::filesystem::path&,
+                                                                    const std::string&,
+                                                                    std::uint64_t,
+                                                                    std::chrono::hours);
+template std::vector<std::uint64_t> undelivered_runs<FixCodec>(const std::filesystem::path&,
+                                                               const std::string&, std::uint64_t,
+                                                               std::chrono::hours);
+template void mark_delivered<AttitudeCodec>(const std::filesystem::path&, const std::string&,
+                                            std::uint64_t);
+template void mark_delivered<FixCodec>(const std::filesystem::path&, const std::string&,
+                                       std::uint64_t);
 
 }  // namespace telltale::boat

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -198,6 +199,175 @@ TEST_F(SessionLogRuns, ReaderResynchronisesAfterATornRecord) {
 TEST_F(SessionLogFaults, ReadOnlyDirectoryIsRefused) {
   if (!mount_tmpfs("size=64k", MS_RDONLY)) FAIL() << "needs root and mount namespaces (a fault test fails, never skips, without them)";
   EXPECT_THROW(SessionLog({dir_, "ro", 0x1, 100000, 1ULL << 30}), std::runtime_error);
+}
+
+// --- GNSS fixes: the same log, another record kind --------------------------------------------
+
+FixRecord fix_record(std::uint64_t seq) {
+  FixRecord r;
+  r.seq = seq;
+  r.t_utc_ns = 1'700'000'000'000'000'000ULL + seq * 100'000'000;
+  r.gnss_utc_ns = r.t_utc_ns - 250'000'000;
+  r.lat_deg = 54.3 + static_cast<double>(seq) * 1e-5;
+  r.lon_deg = 10.1 - static_cast<double>(seq) * 1e-5;
+  r.sog_m_s = 3.5;
+  r.cog_deg = static_cast<double>(seq % 360);
+  r.fix = 3;
+  r.satellites = 11;
+  r.hdop = 0.9f;
+  return r;
+}
+
+bool same_fix(const FixRecord& a, const FixRecord& b) {
+  return a.seq == b.seq && a.t_utc_ns == b.t_utc_ns && a.gnss_utc_ns == b.gnss_utc_ns &&
+         a.lat_deg == b.lat_deg && a.lon_deg == b.lon_deg && a.sog_m_s == b.sog_m_s &&
+         a.cog_deg == b.cog_deg && a.fix == b.fix && a.satellites == b.satellites &&
+         a.hdop == b.hdop;
+}
+
+// Given fixes appended across several files beside the attitude of the same run, every fix reads
+// back bit for bit, and neither kind's reader sees the other's records.
+TEST_F(SessionLogRuns, FixesRoundTripBesideTheAttitude) {
+  write_run("fx", 0x21, 12, 5);
+  {
+    FixLog log({dir_, "fx", 0x21, 7, 1ULL << 30});  // three files: 1, 8, 15
+    for (std::uint64_t seq = 1; seq <= 20; ++seq) ASSERT_TRUE(log.append(fix_record(seq)));
+    ASSERT_TRUE(log.flush());
+  }
+  ASSERT_TRUE(std::filesystem::exists(dir_ / "fx-0000000000000021-000000000008.tfix"));
+  FixLogReader fixes(dir_, "fx", 0x21);
+  const auto back = fixes.read(1, 20);
+  ASSERT_EQ(back.size(), 20u);
+  for (std::uint64_t i = 0; i < back.size(); ++i)
+    EXPECT_TRUE(same_fix(back[i], fix_record(i + 1))) << "seq " << i + 1;
+  // A NaN position (no fix) survives as NaN.
+  {
+    FixRecord none = fix_record(1);
+    none.lat_deg = none.lon_deg = none.sog_m_s = none.cog_deg = std::nan("");
+    none.fix = 0;
+    unsigned char frame[kLogRecordBytes];
+    encode_record(none, frame);
+    const auto got = decode_fix_record(frame);
+    ASSERT_TRUE(got);
+    EXPECT_TRUE(std::isnan(got->lat_deg) && std::isnan(got->cog_deg));
+    // A fix frame is not an attitude frame (its own magic), and the reverse.
+    EXPECT_FALSE(decode_record(frame));
+    encode_record(LogRecord{.seq = 1, .t_utc_ns = 1}, frame);
+    EXPECT_FALSE(decode_fix_record(frame));
+  }
+  EXPECT_EQ(fixes.last_seq(), 20u);
+  EXPECT_EQ(fixes.read(9, 16).size(), 8u);
+  EXPECT_EQ(SessionLogReader(dir_, "fx", 0x21).last_seq(), 12u);
+  EXPECT_EQ(SessionLogReader(dir_, "fx", 0x21).read(1, 100).size(), 12u);
+  // Each kind is delivered and marked on its own.
+  EXPECT_EQ(undelivered_runs<FixCodec>(dir_, "fx", 0x99, kWeek), std::vector<std::uint64_t>{0x21});
+  mark_delivered(dir_, "fx", 0x21);
+  EXPECT_EQ(undelivered_runs(dir_, "fx", 0x99, kWeek), std::vector<std::uint64_t>{});
+  EXPECT_EQ(undelivered_runs<FixCodec>(dir_, "fx", 0x99, kWeek), std::vector<std::uint64_t>{0x21});
+  mark_delivered<FixCodec>(dir_, "fx", 0x21);
+  EXPECT_EQ(undelivered_runs<FixCodec>(dir_, "fx", 0x99, kWeek), std::vector<std::uint64_t>{});
+}
+
+// Given a fix file with a torn record in the middle, the reader finds every intact fix after it.
+TEST_F(SessionLogRuns, FixReaderResynchronisesAfterATornRecord) {
+  {
+    FixLog log({dir_, "tf", 0x8, 100000, 1ULL << 30});
+    for (std::uint64_t seq = 1; seq <= 10; ++seq) ASSERT_TRUE(log.append(fix_record(seq)));
+  }
+  const auto file = dir_ / "tf-0000000000000008-000000000001.tfix";
+  ASSERT_TRUE(std::filesystem::exists(file));
+  {
+    std::ofstream out(file, std::ios::binary | std::ios::app);
+    unsigned char buf[kLogRecordBytes];
+    encode_record(fix_record(11), buf);
+    out.write(reinterpret_cast<const char*>(buf), 61);  // torn
+    for (std::uint64_t seq = 11; seq <= 20; ++seq) {
+      encode_record(fix_record(seq), buf);
+      out.write(reinterpret_cast<const char*>(buf), sizeof buf);
+    }
+  }
+  FixLogReader reader(dir_, "tf", 0x8);
+  const auto all = reader.read(1, 20);
+  ASSERT_EQ(all.size(), 20u);
+  for (std::uint64_t i = 0; i < all.size(); ++i) EXPECT_TRUE(same_fix(all[i], fix_record(i + 1)));
+  EXPECT_EQ(reader.read(12, 15).size(), 4u);
+  EXPECT_EQ(reader.last_seq(), 20u);
+}
+
+// Given both kinds in one directory under one budget, the oldest files go first whatever their
+// kind, and neither log loses the file it is writing to the other's deletions.
+TEST_F(SessionLogRuns, OneDiskBudgetOverBothKinds) {
+  // An earlier run of each kind, made old.
+  write_run("bd", 0x1, 50, 10);  // five attitude files of 960 bytes
+  {
+    FixLog old({dir_, "bd", 0x1, 10, 1ULL << 30});
+    for (std::uint64_t seq = 1; seq <= 50; ++seq) ASSERT_TRUE(old.append(fix_record(seq)));
+  }
+  const auto old_time = std::filesystem::file_time_type::clock::now() - std::chrono::hours(5);
+  for (const auto& e : std::filesystem::directory_iterator(dir_))
+    std::filesystem::last_write_time(e.path(), old_time);
+  // The current run: a budget of 6 files of 960 bytes (one reserved for the file being opened).
+  constexpr std::uint64_t kBudget = 6 * 960;
+  SessionLog att({dir_, "bd", 0x2, 10, kBudget});
+  FixLog fixes({dir_, "bd", 0x2, 10, kBudget});
+  for (std::uint64_t seq = 1; seq <= 35; ++seq) {
+    LogRecord r;
+    r.seq = seq;
+    r.t_utc_ns = seq;
+    ASSERT_TRUE(att.append(r));
+    ASSERT_TRUE(fixes.append(fix_record(seq)));
+    att.flush();
+    fixes.flush();
+  }
+  std::uintmax_t total = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir_)) total += e.file_size();
+  EXPECT_LE(total, kBudget + 2 * 960) << "the budget, give or take the files being filled";
+  EXPECT_GT(att.bytes_deleted() + fixes.bytes_deleted(), 0u);
+  // The earlier run's files went first, of both kinds; the current run is whole in both.
+  EXPECT_EQ(SessionLogReader(dir_, "bd", 0x1).read(1, 50).size(), 0u);
+  EXPECT_EQ(FixLogReader(dir_, "bd", 0x1).read(1, 50).size(), 0u);
+  EXPECT_EQ(FixLogReader(dir_, "bd", 0x2).read(31, 35).size(), 5u);
+  EXPECT_EQ(SessionLogReader(dir_, "bd", 0x2).read(31, 35).size(), 5u);
+}
+
+// Given a fix log on a small real filesystem, when the disk fills for a while and is then given
+// back, every fix appended before, during and after the spell reads back in order: the fixes
+// were held in memory and written later.
+TEST_F(SessionLogFaults, FixesHeldWhileTheDiskIsFullAndWrittenLater) {
+  if (!mount_tmpfs("size=256k,mode=0755"))
+    FAIL() << "needs root and mount namespaces (a fault test fails, never skips, without them)";
+  const auto ballast = dir_ / "ballast";
+  {
+    const int fd = ::open(ballast.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ASSERT_GE(fd, 0);
+    std::vector<char> block(4096, 'x');
+    while (::write(fd, block.data(), block.size()) > 0) {
+    }
+    ::close(fd);
+  }
+  std::filesystem::resize_file(ballast, std::filesystem::file_size(ballast) - 6000);
+  FixLog log({dir_, "ff", 0xf2, 100000, 1ULL << 30});
+  std::uint64_t seq = 0;
+  for (; seq < 400; ++seq) {
+    (void)log.append(fix_record(seq + 1));
+    if (seq % 10 == 9) log.flush();
+  }
+  const SessionLogHealth during = log.health();
+  EXPECT_GT(during.pending_records, 0u);
+  EXPECT_TRUE(during.failing());
+  EXPECT_NE(during.last_error.find("No space"), std::string::npos) << during.last_error;
+  std::filesystem::remove(ballast);
+  for (; seq < 600; ++seq) {
+    (void)log.append(fix_record(seq + 1));
+    if (seq % 10 == 9) log.flush();
+  }
+  EXPECT_TRUE(log.flush());
+  EXPECT_FALSE(log.health().failing());
+  EXPECT_EQ(log.health().dropped_records, 0u);
+  FixLogReader reader(dir_, "ff", 0xf2);
+  const auto back = reader.read(1, 600);
+  ASSERT_EQ(back.size(), 600u);
+  for (std::uint64_t i = 0; i < back.size(); ++i) ASSERT_TRUE(same_fix(back[i], fix_record(i + 1)));
 }
 
 }  // namespace
