@@ -106,15 +106,34 @@ void TelltaleAttitudeFilter::initialise(const ImuSample& s) {
   state_.acc_rest_lp_m_s2 = s.acc_body_m_s2;
   state_.initialised = true;
   state_.up_body = r.transpose() * state_.up_i;
-  // The start's Kalman filter: the first sample's tilt is known to the acceleration a boat can
-  // have (start_acc_sigma / g per horizontal axis), the bias to its spread, uncorrelated; the
-  // acceleration's variance starts at the same prior.
+  // The start's line fit waits for evidence that the sensor is on a hull under way (update).
+  state_.start_pending = params_.start_fit_s > 0.0;
+}
+
+void TelltaleAttitudeFilter::begin_start_fit() {
+  // The GNSS speed says the sensor is under way: the start is a hull's in a seaway, and the
+  // growing mean the filter began with is the wrong model there (its first values are single
+  // samples, one wave's acceleration, and the drift between them was read as a bias of several
+  // deg/s and believed). So the line fit starts now, from the vertical and the bias as they are
+  // (any linearisation point will do: the fit bends its line about the estimate), with the
+  // priors of a first sample: the tilt known to the acceleration a boat can have
+  // (start_acc_sigma / g per horizontal axis), the bias to its spread (what the drift learnt
+  // under way is worth nothing), uncorrelated; the acceleration's variance starts at the same
+  // prior. Its window starts now too, not at the first sample: the line's slope needs
+  // start_fit_s of sea (two periods of the slowest wave) whenever the receiver's first fix
+  // comes, and a fix a few seconds late (a receiver's cold start) would otherwise leave it one
+  // wave's half swing. The cost is the start ending that much later, at most start_fit_s.
+  State& st = state_;
   const double a0 = params_.start_acc_sigma_m_s2 / params_.g_m_s2;
-  state_.start_fit = params_.start_fit_s > 0.0;
-  state_.start_cov.setZero();
-  state_.start_cov(0, 0) = state_.start_cov(1, 1) = a0 * a0;
-  state_.start_cov.block<3, 3>(2, 2) = state_.bias_cov;
-  state_.start_acc_var = a0 * a0;
+  const double var0 = params_.bias_sigma_init_rad_s * params_.bias_sigma_init_rad_s;
+  st.start_pending = false;
+  st.start_fit = true;
+  st.start_elapsed_s = 0.0;
+  st.bias_cov = var0 * Eigen::Matrix3d::Identity();
+  st.start_cov.setZero();
+  st.start_cov(0, 0) = st.start_cov(1, 1) = a0 * a0;
+  st.start_cov.block<3, 3>(2, 2) = st.bias_cov;
+  st.start_acc_var = a0 * a0;
 }
 
 void TelltaleAttitudeFilter::start_fit_update(const Eigen::Matrix3d& r, const Eigen::Vector3d& f,
@@ -353,9 +372,26 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   const bool course_known = !gap && st.speed_m_s >= 0.0 &&
                             !std::isnan(st.yaw_rate_cog_rad_s) &&
                             1.0 - st.up_body.x() * st.up_body.x() > 0.25;
-  // --- The start (start_fit_update) until start_fit_s have passed, or a rest or a gap comes
-  // first (a rest measures the bias far better; over a gap the line breaks). Then the low-pass
-  // takes over below, in its steady state at the start's vertical, with its bias covariance.
+  // --- The start. Every filter begins with the growing mean below. The line fit
+  // (start_fit_update) models a hull in a seaway, and it is that which decides whether it may
+  // run: only a GNSS speed above rest_max_speed (the platform making way; the same evidence that
+  // vetoes a rest) within start_fit_s of the first sample engages it. Not the speed at the first
+  // sample: a receiver's first fix comes after the IMU's first samples. A handled phone turns
+  // through hundreds of degrees in its first seconds and the fit would take that for a bias;
+  // a phone or a bench has no GNSS, and never enters it. A rest ends the wait (it measures the
+  // bias far better, and a platform at rest is in no seaway); a gap does not (the fit starts
+  // from the estimate whenever it starts), but the fit never starts at one.
+  if (st.start_pending) {
+    st.start_elapsed_s += dt;
+    if (at_rest || st.start_elapsed_s >= p.start_fit_s) {
+      st.start_pending = false;
+    } else if (!gap && st.speed_m_s > p.rest_max_speed_m_s) {
+      begin_start_fit();
+    }
+  }
+  // The fit runs until start_fit_s have passed since it began, or a rest or a gap comes first
+  // (a rest measures the bias far better; over a gap the line breaks). Then the low-pass takes
+  // over below, in its steady state at the start's vertical, with its bias covariance.
   const bool start_ends = st.start_fit && (at_rest || gap || st.start_elapsed_s >= p.start_fit_s);
   if (st.start_fit && !start_ends) {
     start_fit_update(r, f, dt);

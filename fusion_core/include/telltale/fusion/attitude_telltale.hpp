@@ -19,13 +19,15 @@
 ///     in motion from how fast the low-passed vertical drifts in I (horizontal components only:
 ///     the bias about the vertical does not move the vertical), and about the vertical from the
 ///     GNSS course when it is given (the gyro's turn against the course's over tau_acc_s);
-///   - start: for the first start_fit_s after the first sample (until a rest, if one comes
-///     first) the vertical and the bias are one Kalman filter on 5 states, the least-squares
-///     line through the specific force in I (intercept: the tilt, slope: the bias), its
-///     acceleration noise measured as it goes; the low-pass then takes over in its steady state
-///     with that bias and covariance. After a gap too long to integrate the low-pass restarts
-///     as the mean of everything seen since (the best estimate of a constant from a growing
-///     window) for tau_acc_s;
+///   - start: the low-pass starts as the mean of everything seen since (the best estimate of a
+///     constant from a growing window) for tau_acc_s, as it does after a gap too long to
+///     integrate. If within the first start_fit_s (and before any rest or gap) the GNSS speed
+///     shows the sensor under way, the start is a hull's in a seaway: from then on, for
+///     start_fit_s, the vertical and the bias are one Kalman filter on 5 states, the
+///     least-squares line through the specific force in I (intercept: the tilt, slope: the
+///     bias), its acceleration noise measured as it goes; the low-pass then takes over in its
+///     steady state with that bias and covariance. Without GNSS (a phone, a bench) the line
+///     fit never runs;
 ///   - the boat's own acceleration, when its speed is known (set_speed, from GNSS): a boat
 ///     turning at w about the vertical at speed v accelerates at w v toward the inside of the
 ///     turn, and speeding up at dv/dt along its heading. A tack's few seconds of that are one
@@ -96,11 +98,12 @@ struct TelltaleAttitudeParams {
   /// the low-pass's window, and the bow and the track part by a few degrees of leeway that
   /// changes over a tack: 1 deg/s.
   double cog_rate_sigma_rad_s = 1.0 * M_PI / 180.0;
-  /// Start (see update): for the first start_fit_s after the first sample, unless a rest comes
-  /// first, the vertical and the gyro bias are one Kalman filter (the least-squares line through
-  /// the specific force in I) instead of the low-pass and its drift. 5 s: two periods of the
-  /// slowest sea the low-pass is built for (0.3-0.5 Hz), so that the line's slope is not one
-  /// wave's half swing, and the first mark.
+  /// Start (see update): when the GNSS speed shows the sensor under way (above
+  /// rest_max_speed_m_s) within start_fit_s of the first sample, before any rest or gap, the
+  /// vertical and the gyro bias are one Kalman filter (the least-squares line through the
+  /// specific force in I) instead of the low-pass and its drift, for start_fit_s from then.
+  /// 5 s: two periods of the slowest sea the low-pass is built for (0.3-0.5 Hz), so that the
+  /// line's slope is not one wave's half swing. 0: never.
   double start_fit_s = 5.0;
   /// The horizontal acceleration of the sensor before any sample has been seen, one axis: a
   /// boat's in a seaway (waves' heave, surge and sway ~1.5 m/s^2 at the bow). The first sample's
@@ -148,9 +151,11 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
     double speed_m_s = std::numeric_limits<double>::quiet_NaN();
     double speed_rate_m_s2 = 0.0;
     double yaw_rate_cog_rad_s = std::numeric_limits<double>::quiet_NaN();  ///< - cog rate
-    /// The start's Kalman filter (update): running, its covariance (the tilt of up_i about two
-    /// horizontal axes, rad, then the bias, rad/s), its age and the variance of the horizontal
-    /// specific force it measures (one axis, in units of g^2).
+    /// The start's Kalman filter (update): still possible (no GNSS speed under way yet, no rest,
+    /// no gap, start_elapsed_s the time since the first sample), running, its covariance (the
+    /// tilt of up_i about two horizontal axes, rad, then the bias, rad/s), its age and the
+    /// variance of the horizontal specific force it measures (one axis, in units of g^2).
+    bool start_pending = false;
     bool start_fit = false;
     Eigen::Matrix<double, 5, 5> start_cov = Eigen::Matrix<double, 5, 5>::Zero();
     double start_elapsed_s = 0.0;
@@ -195,6 +200,9 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
 
  private:
   void initialise(const ImuSample& s);
+  /// The GNSS speed says the sensor is under way: the start's line fit begins (update). Once per
+  /// start: not inlined.
+  [[gnu::noinline]] void begin_start_fit();
   /// One sample of the start's Kalman filter (tilt of up_i and bias); r: body -> I, f: the
   /// specific force without the boat's own acceleration. Not inlined: it runs for the first
   /// seconds only, and inlined into update() it crowds out the inlining of the steady path's

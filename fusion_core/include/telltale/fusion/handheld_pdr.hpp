@@ -250,24 +250,13 @@ struct WalkRatioParams {
   return p.ratio_per_height_min * height_m * 60.0 * step_hz;
 }
 
-// ---------------------------------------------------------------------------------------------
-/// The attitude filter's parameters for a phone in the hand: the boat's, without the start's line
-/// fit (TelltaleAttitudeParams::start_fit_s). That fit models a hull in a seaway (an acceleration
-/// that keeps its direction for a third of a second, 2 m/s^2 across); a phone handled for its
-/// first seconds turns through hundreds of degrees, and the fit takes that for a gyro bias it then
-/// believes. Measured on the eight IPIN walks: loop closure 4.25 % mean with the growing-mean
-/// start, 5.90 % with the fit (one walk 6.4 -> 14.9 %). So the phone starts from the growing mean.
-[[nodiscard]] inline TelltaleAttitudeParams hand_held_attitude_params() {
-  TelltaleAttitudeParams p;
-  p.start_fit_s = 0.0;
-  return p;
-}
-
 struct HandheldPdrParams {
   double height_m = 1.75;
   double step_scale = 1.0;  ///< personal factor on the walk-ratio step length (1: population)
   WalkRatioParams length;
-  TelltaleAttitudeParams attitude = hand_held_attitude_params();
+  /// The boat's filter as it is: with no GNSS speed its start's line fit (a hull's in a seaway)
+  /// never runs, and the phone starts from the growing mean.
+  TelltaleAttitudeParams attitude;
   StandBiasParams bias;
   WalkStepParams steps;
   /// The magnetometer orients the track once, from its mean over the stand before the first
