@@ -16,8 +16,11 @@ double wrap360(double a) {
   a = std::fmod(a, 360.0);
   return a < 0 ? a + 360.0 : a;
 }
+// a - b in (-180, 180] for any a and b: b is often the unwrapped course, which a 720 or a day of
+// rounding marks one way takes past +-540, where fmod(a - b + 540) went negative and the course
+// jumped by 360 (a later turn then measured, or taken for a penalty, by where the data began).
 double diff180(double a, double b) {
-  double d = std::fmod(a - b + 540.0, 360.0) - 180.0;
+  const double d = std::remainder(a - b, 360.0);
   return d == -180.0 ? 180.0 : d;
 }
 

@@ -106,6 +106,36 @@ TEST(Manoeuvre, APenaltyTurnIsOneManoeuvreNotTacksAndGybes) {
   EXPECT_NEAR(rep.manoeuvres[0].turn_deg, 720.0, 15.0);
 }
 
+// The course is unwrapped through every turn of the session, so hours of rounding marks one way
+// (or a 720) take it far past +-540 deg: a turn must be measured alike whether the data begins
+// at the session's start or a minute before it (the shore's live window). Seed 3 with drills:
+// its rounding at ~722 s was taken for a penalty turn, from the start only.
+TEST(Manoeuvre, ATurnIsMeasuredAlikeWhereverTheDataBegins) {
+  sim::CourseParams p;
+  p.drills = true;
+  sim::CourseSim course(3, p);
+  std::vector<CourseSample> all;
+  for (int k = 0; k <= 8000; ++k) {
+    const auto s = course.at(k * 0.1);
+    all.push_back({s.t_s, s.cog_deg, s.sog_m_s});
+  }
+  ManoeuvreOptions o;
+  o.wind_from_deg = 255.0;
+  const auto whole = analyse_manoeuvres(all, {}, o);
+  const auto late = analyse_manoeuvres(std::span(all).subspan(5000), {}, o);
+  std::vector<Manoeuvre> from_whole;
+  for (const auto& m : whole.manoeuvres)
+    if (m.t0_s > 560.0) from_whole.push_back(m);
+  ASSERT_EQ(from_whole.size(), late.manoeuvres.size());
+  ASSERT_FALSE(late.manoeuvres.empty());
+  for (std::size_t i = 0; i < late.manoeuvres.size(); ++i) {
+    EXPECT_EQ(from_whole[i].kind, late.manoeuvres[i].kind) << "at " << late.manoeuvres[i].t0_s;
+    EXPECT_NEAR(from_whole[i].t0_s, late.manoeuvres[i].t0_s, 1e-6);
+    EXPECT_NEAR(from_whole[i].turn_deg, late.manoeuvres[i].turn_deg, 1e-6);
+    EXPECT_NEAR(from_whole[i].distance_lost_m, late.manoeuvres[i].distance_lost_m, 1e-6);
+  }
+}
+
 TEST(Manoeuvre, HeelThatDoesNotFlipIsFlaggedNotOverruled) {
   ManoeuvreOptions o;
   o.wind_from_deg = 0.0;
