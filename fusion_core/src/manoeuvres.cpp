@@ -223,6 +223,51 @@ ManoeuvreKind classify(double before_deg, double total_deg, double wind_from, bo
   return std::abs(ra) > std::abs(rb) ? ManoeuvreKind::kBearAway : ManoeuvreKind::kRoundUp;
 }
 
+/// What the wind estimate needs of a measured turn: the unwrapped mean course before it, its
+/// signed turn (after - before), whether it is a penalty turn, and its bisector.
+struct WindTurn {
+  double before = 0.0, total = 0.0;
+  bool penalty = false;
+  double bisector = 0.0;
+};
+
+/// The wind estimated from the turns (see the file comment): the axis from the doubled bisectors
+/// of the turns of 50-140 deg, its sign from the tacks turning more than the gybes, then twice
+/// the median of the tacks' bisectors and the gybes' inverted.
+std::optional<double> wind_from_turns(const std::vector<WindTurn>& turns) {
+  std::vector<double> doubled;
+  for (const auto& m : turns) {
+    const double t = std::abs(m.total);
+    if (!m.penalty && t >= 50.0 && t <= 140.0) doubled.push_back(wrap360(2.0 * m.bisector));
+  }
+  if (doubled.empty()) return std::nullopt;
+  std::optional<double> wind;
+  const double axis = circular_median(doubled) / 2.0;
+  double best_score = -1e300;
+  for (double cand : {axis, wrap360(axis + 180.0)}) {
+    double score = 0.0;
+    for (const auto& m : turns) {
+      const auto k = classify(wrap360(m.before), m.total, cand, m.penalty);
+      const double t = std::abs(m.total);
+      if (k == ManoeuvreKind::kTack) score += t - 72.0;
+      if (k == ManoeuvreKind::kGybe) score -= t - 72.0;
+    }
+    if (score > best_score) best_score = score, wind = cand;
+  }
+  // The median of the tacks' bisectors and the gybes' inverted, twice.
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<double> b;
+    for (const auto& m : turns) {
+      const auto k = classify(wrap360(m.before), m.total, *wind, m.penalty);
+      if (k == ManoeuvreKind::kTack) b.push_back(m.bisector);
+      if (k == ManoeuvreKind::kGybe) b.push_back(wrap360(m.bisector + 180.0));
+    }
+    if (b.empty()) break;
+    wind = circular_median(b);
+  }
+  return wind;
+}
+
 }  // namespace
 
 const char* to_string(ManoeuvreKind k) {
@@ -335,36 +380,9 @@ ManoeuvreReport analyse_manoeuvres(std::span<const CourseSample> course,
   if (wind) {
     rep.wind_given = true;
   } else {
-    std::vector<double> doubled;
-    for (const auto& m : valid) {
-      const double t = std::abs(m.after - m.before);
-      if (!m.penalty && t >= 50.0 && t <= 140.0) doubled.push_back(wrap360(2.0 * bisector(m)));
-    }
-    if (!doubled.empty()) {
-      const double axis = circular_median(doubled) / 2.0;
-      double best_score = -1e300;
-      for (double cand : {axis, wrap360(axis + 180.0)}) {
-        double score = 0.0;
-        for (const auto& m : valid) {
-          const auto k = classify(wrap360(m.before), m.after - m.before, cand, m.penalty);
-          const double t = std::abs(m.after - m.before);
-          if (k == ManoeuvreKind::kTack) score += t - 72.0;
-          if (k == ManoeuvreKind::kGybe) score -= t - 72.0;
-        }
-        if (score > best_score) best_score = score, wind = cand;
-      }
-      // The median of the tacks' bisectors and the gybes' inverted, twice.
-      for (int pass = 0; pass < 2; ++pass) {
-        std::vector<double> b;
-        for (const auto& m : valid) {
-          const auto k = classify(wrap360(m.before), m.after - m.before, *wind, m.penalty);
-          if (k == ManoeuvreKind::kTack) b.push_back(bisector(m));
-          if (k == ManoeuvreKind::kGybe) b.push_back(wrap360(bisector(m) + 180.0));
-        }
-        if (b.empty()) break;
-        wind = circular_median(b);
-      }
-    }
+    std::vector<WindTurn> wt;
+    for (const auto& m : valid) wt.push_back({m.before, m.after - m.before, m.penalty, bisector(m)});
+    wind = wind_from_turns(wt);
   }
   rep.wind_from_deg = wind;
 
@@ -493,6 +511,14 @@ ManoeuvreReport analyse_manoeuvres(std::span<const CourseSample> course,
   else if (!rep.wind_given && wind)
     rep.wind_uncertainty_deg = 90.0;
   return rep;
+}
+
+std::optional<double> estimate_wind(std::span<const Manoeuvre> list) {
+  std::vector<WindTurn> wt;
+  for (const auto& m : list)
+    wt.push_back({m.course_before_deg, m.turn_dir * m.turn_deg, m.kind == ManoeuvreKind::kPenalty,
+                  m.bisector_deg});
+  return wind_from_turns(wt);
 }
 
 std::vector<ManoeuvreSummary> summarise(const std::vector<Manoeuvre>& list) {

@@ -161,6 +161,11 @@ TEST(Manoeuvre, WindIsEstimatedFromTheTacksAndGivenWindOverridesIt) {
   EXPECT_LT(std::abs(*rep.wind_from_deg - 255.0), 5.0);
   EXPECT_GT(rep.wind_uncertainty_deg, 0.0);
   EXPECT_LT(rep.wind_uncertainty_deg, 5.0);
+  // The same estimate from the measured manoeuvres alone (what the shore's live tracker passes
+  // back as the wind).
+  const auto again = estimate_wind(rep.manoeuvres);
+  ASSERT_TRUE(again.has_value());
+  EXPECT_NEAR(*again, *rep.wind_from_deg, 1e-9);
   ASSERT_FALSE(rep.wind_over_time.empty());
   EXPECT_EQ(rep.wind_over_time.back().n,
             static_cast<int>(std::count_if(rep.manoeuvres.begin(), rep.manoeuvres.end(), [](auto& m) {

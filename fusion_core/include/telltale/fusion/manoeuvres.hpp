@@ -135,6 +135,12 @@ ManoeuvreReport analyse_manoeuvres(std::span<const CourseSample> course,
                                    std::span<const HeelSample> heel,
                                    const ManoeuvreOptions& options = {});
 
+/// The wind (from) as analyse_manoeuvres estimates it, from manoeuvres it has already measured:
+/// a live boat's so far, passed back as `wind_from_deg` so that a short window of data is
+/// classified against the session's wind, not against its own one or two turns. nullopt
+/// without a turn of 50-140 deg.
+std::optional<double> estimate_wind(std::span<const Manoeuvre> list);
+
 /// Per kind (those present): count and distance lost (mean, best = least, worst = most).
 std::vector<ManoeuvreSummary> summarise(const std::vector<Manoeuvre>& list);
 
