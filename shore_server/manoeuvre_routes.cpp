@@ -36,6 +36,35 @@ std::uint64_t to_ns(std::uint64_t base_ns, double t_s) {
 
 }  // namespace
 
+json manoeuvre_object(const fusion::Manoeuvre& m, std::uint64_t t0_utc_ns) {
+  return {{"kind", fusion::to_string(m.kind)},
+          {"t_utc", iso8601(t0_utc_ns)},
+          {"turn_deg", finite_or_null(m.turn_deg)},
+          {"turn_dir", m.turn_dir},
+          {"distance_lost_m", finite_or_null(m.distance_lost_m)},
+          {"vmg_lost_m", finite_or_null(m.vmg_lost_m)},
+          {"heel_peak_deg", finite_or_null(m.heel_peak_deg)},
+          {"heel_peak_windward_deg", finite_or_null(m.heel_peak_windward_deg)},
+          {"heel_peak_leeward_deg", finite_or_null(m.heel_peak_leeward_deg)},
+          {"heel_zero_s", finite_or_null(m.heel_zero_s)},
+          {"exit_heel_deg", finite_or_null(m.exit_heel_deg)},
+          {"entry_sog_m_s", finite_or_null(m.entry_sog_m_s)},
+          {"min_sog_m_s", finite_or_null(m.min_sog_m_s)},
+          {"exit_sog_m_s", finite_or_null(m.exit_sog_m_s)},
+          {"speed_loss_m_s", finite_or_null(m.speed_loss_m_s)},
+          {"turn_duration_s", finite_or_null(m.turn_duration_s)},
+          {"recovery_s", finite_or_null(m.recovery_s)},
+          {"max_turn_rate_deg_s", finite_or_null(m.max_turn_rate_deg_s)},
+          {"mean_turn_rate_deg_s", finite_or_null(m.mean_turn_rate_deg_s)},
+          {"pitch_min_deg", finite_or_null(m.pitch_min_deg)},
+          {"pitch_max_deg", finite_or_null(m.pitch_max_deg)},
+          {"pitch_mean_deg", finite_or_null(m.pitch_mean_deg)},
+          {"course_before_deg", finite_or_null(m.course_before_deg)},
+          {"course_after_deg", finite_or_null(m.course_after_deg)},
+          {"unsteady_entry", m.unsteady_entry},
+          {"heel_flip_agrees", m.heel_flip_agrees ? json(*m.heel_flip_agrees) : json(nullptr)}};
+}
+
 void register_manoeuvre_routes(httplib::Server& server, ShoreContext& ctx) {
   server.Get(R"(/api/v1/sessions/([^/]+)/manoeuvres)", [&ctx](const httplib::Request& req,
                                                              httplib::Response& res) {
@@ -108,33 +137,7 @@ void register_manoeuvre_routes(httplib::Server& server, ShoreContext& ctx) {
     }
     json list = json::array();
     for (const auto& m : rep.manoeuvres) {
-      list.push_back({{"kind", fusion::to_string(m.kind)},
-                      {"t_utc", iso8601(to_ns(base, m.t0_s))},
-                      {"turn_deg", finite_or_null(m.turn_deg)},
-                      {"turn_dir", m.turn_dir},
-                      {"distance_lost_m", finite_or_null(m.distance_lost_m)},
-                      {"vmg_lost_m", finite_or_null(m.vmg_lost_m)},
-                      {"heel_peak_deg", finite_or_null(m.heel_peak_deg)},
-                      {"heel_peak_windward_deg", finite_or_null(m.heel_peak_windward_deg)},
-                      {"heel_peak_leeward_deg", finite_or_null(m.heel_peak_leeward_deg)},
-                      {"heel_zero_s", finite_or_null(m.heel_zero_s)},
-                      {"exit_heel_deg", finite_or_null(m.exit_heel_deg)},
-                      {"entry_sog_m_s", finite_or_null(m.entry_sog_m_s)},
-                      {"min_sog_m_s", finite_or_null(m.min_sog_m_s)},
-                      {"exit_sog_m_s", finite_or_null(m.exit_sog_m_s)},
-                      {"speed_loss_m_s", finite_or_null(m.speed_loss_m_s)},
-                      {"turn_duration_s", finite_or_null(m.turn_duration_s)},
-                      {"recovery_s", finite_or_null(m.recovery_s)},
-                      {"max_turn_rate_deg_s", finite_or_null(m.max_turn_rate_deg_s)},
-                      {"mean_turn_rate_deg_s", finite_or_null(m.mean_turn_rate_deg_s)},
-                      {"pitch_min_deg", finite_or_null(m.pitch_min_deg)},
-                      {"pitch_max_deg", finite_or_null(m.pitch_max_deg)},
-                      {"pitch_mean_deg", finite_or_null(m.pitch_mean_deg)},
-                      {"course_before_deg", finite_or_null(m.course_before_deg)},
-                      {"course_after_deg", finite_or_null(m.course_after_deg)},
-                      {"unsteady_entry", m.unsteady_entry},
-                      {"heel_flip_agrees",
-                       m.heel_flip_agrees ? json(*m.heel_flip_agrees) : json(nullptr)}});
+      list.push_back(manoeuvre_object(m, to_ns(base, m.t0_s)));
     }
     json summary = json::array();
     for (const auto& k : fusion::summarise(rep.manoeuvres))

@@ -10,10 +10,19 @@
 
 #include <httplib.h>
 
+#include <cstdint>
+#include <nlohmann/json.hpp>
+
 #include "http_api.hpp"
+#include "telltale/fusion/manoeuvres.hpp"
 
 namespace telltale::shore {
 
 void register_manoeuvre_routes(httplib::Server& server, ShoreContext& ctx);
+
+/// One manoeuvre as the API lists it (`t_utc` its t0, at `t0_utc_ns`): the row of this endpoint
+/// and the `manoeuvre` event of the live stream (manoeuvre_live.hpp), so both name every metric
+/// alike.
+[[nodiscard]] nlohmann::json manoeuvre_object(const fusion::Manoeuvre& m, std::uint64_t t0_utc_ns);
 
 }  // namespace telltale::shore
