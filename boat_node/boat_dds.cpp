@@ -20,12 +20,15 @@ class BoatDds::Listener : public fdds::DataReaderListener {
   void on_data_available(fdds::DataReader* reader) override {
     fdds::SampleInfo info;
     const std::string& topic = reader->get_topicdescription()->get_name();
-    if (topic == dds::kTopicShoreAck) {
+    if (topic == dds::kTopicShoreAck || topic == dds::kTopicShoreFixAck) {
+      const bool fixes = topic == dds::kTopicShoreFixAck;
+      const auto& on_ack = fixes ? cb_.on_fix_ack : cb_.on_ack;
+      auto& writers = fixes ? fix_ack_writers_ : ack_writers_;
       msg::ShoreAck m;
       while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK)
-        if (info.valid_data && m.boat_id().to_string() == boat_id_ && cb_.on_ack) {
-          const bool new_shore = ack_writers_.insert(info.sample_identity.writer_guid()).second;
-          cb_.on_ack(m.boot_id(), m.acked_seq(), new_shore);
+        if (info.valid_data && m.boat_id().to_string() == boat_id_ && on_ack) {
+          const bool new_shore = writers.insert(info.sample_identity.writer_guid()).second;
+          on_ack(m.boot_id(), m.acked_seq(), new_shore);
         }
     } else if (topic == dds::kTopicAlarmRules) {
       msg::AlarmRule m;
@@ -68,6 +71,7 @@ class BoatDds::Listener : public fdds::DataReaderListener {
   const BoatDdsCallbacks& cb_;
   std::map<std::string, fusion::AlarmRule> rules_;          ///< listener thread only
   std::set<eprosima::fastrtps::rtps::GUID_t> ack_writers_;  ///< shore writers heard; listener only
+  std::set<eprosima::fastrtps::rtps::GUID_t> fix_ack_writers_;
 };
 
 BoatDds::BoatDds(const dds::DdsOptions& options, const std::string& boat_id,
@@ -93,6 +97,10 @@ void BoatDds::join() {
   fix_writer_ = participant_->writer(
       participant_->topic(dds::kTopicBoatFix, fdds::TypeSupport(new msg::BoatFixPubSubType())),
       "fix_writer");
+  fix_backfill_writer_ =
+      participant_->writer(participant_->topic(dds::kTopicBoatFixBackfill,
+                                               fdds::TypeSupport(new msg::BoatFixPubSubType())),
+                           "fix_backfill_writer");
   status_writer_ =
       participant_->writer(participant_->topic(dds::kTopicNodeStatus,
                                                fdds::TypeSupport(new msg::NodeStatusPubSubType())),
@@ -100,6 +108,9 @@ void BoatDds::join() {
   participant_->reader(
       participant_->topic(dds::kTopicShoreAck, fdds::TypeSupport(new msg::ShoreAckPubSubType())),
       "ack_reader", listener_.get());
+  participant_->reader(
+      participant_->topic(dds::kTopicShoreFixAck, fdds::TypeSupport(new msg::ShoreAckPubSubType())),
+      "fix_ack_reader", listener_.get());
   participant_->reader(
       participant_->topic(dds::kTopicAlarmRules, fdds::TypeSupport(new msg::AlarmRulePubSubType())),
       "alarm_reader", listener_.get());
@@ -113,12 +124,14 @@ BoatDds::~BoatDds() { participant_.reset(); }
 void BoatDds::rejoin() {
   std::unique_lock lock(mutex_);
   participant_.reset();  // its readers go first: no callback runs during the swap
-  attitude_writer_ = backfill_writer_ = status_writer_ = fix_writer_ = nullptr;
+  attitude_writer_ = backfill_writer_ = status_writer_ = fix_writer_ = fix_backfill_writer_ =
+      nullptr;
   try {
     join();
   } catch (const dds::DdsError&) {
     participant_.reset();
-    attitude_writer_ = backfill_writer_ = status_writer_ = fix_writer_ = nullptr;
+    attitude_writer_ = backfill_writer_ = status_writer_ = fix_writer_ = fix_backfill_writer_ =
+        nullptr;
   }
 }
 
@@ -133,6 +146,10 @@ bool BoatDds::backfill(msg::BoatAttitude& sample) {
 bool BoatDds::publish(msg::BoatFix& fix) {
   std::shared_lock lock(mutex_);
   return fix_writer_ && fix_writer_->write(&fix);
+}
+bool BoatDds::backfill(msg::BoatFix& fix) {
+  std::shared_lock lock(mutex_);
+  return fix_backfill_writer_ && fix_backfill_writer_->write(&fix);
 }
 bool BoatDds::publish(msg::NodeStatus& status) {
   std::shared_lock lock(mutex_);

@@ -1,8 +1,9 @@
 #pragma once
 /// \file
 /// The boat node's DDS role. Publishes BoatAttitude and BoatFix (live, best effort: the write
-/// never blocks the sensor loop), backfill (reliable, from the backfill thread only) and NodeStatus; listens to
-/// the shore's receipts for this boat and to the alarm rules and events the shore pushes.
+/// never blocks the sensor loop), the backfill of each (reliable, from the backfill threads only)
+/// and NodeStatus; listens to the shore's receipts for this boat (attitude and fixes) and to the
+/// alarm rules and events the shore pushes.
 /// Constructor creates the entities and throws DdsError; destructor deletes them.
 
 #include <functional>
@@ -22,6 +23,8 @@ struct BoatDdsCallbacks {
   /// `new_shore`: the first receipt from a shore writer not heard before (a restarted shore:
   /// whatever was in flight to the old one is gone).
   std::function<void(std::uint64_t boot_id, std::uint64_t acked_seq, bool new_shore)> on_ack;
+  /// The same for the fixes ("telltale_shore_fix_ack": acked_seq is a fix seq).
+  std::function<void(std::uint64_t boot_id, std::uint64_t acked_seq, bool new_shore)> on_fix_ack;
   /// The complete current rule set, whenever it changes.
   std::function<void(std::vector<fusion::AlarmRule>)> on_rules;
   /// An alarm event about this boat changed phase on the shore.
@@ -39,6 +42,8 @@ class BoatDds {
   /// Reliable; may block up to the profile's max_blocking_time when the shore is slow.
   bool backfill(msg::BoatAttitude& sample);
   bool publish(msg::BoatFix& fix);
+  /// A fix resent from the log ("telltale_boat_fix_backfill"); reliable, like backfill().
+  bool backfill(msg::BoatFix& fix);
   bool publish(msg::NodeStatus& status);
   [[nodiscard]] int domain() const { return domain_; }
 
@@ -63,6 +68,7 @@ class BoatDds {
   eprosima::fastdds::dds::DataWriter* backfill_writer_ = nullptr;
   eprosima::fastdds::dds::DataWriter* status_writer_ = nullptr;
   eprosima::fastdds::dds::DataWriter* fix_writer_ = nullptr;
+  eprosima::fastdds::dds::DataWriter* fix_backfill_writer_ = nullptr;
 };
 
 }  // namespace telltale::boat

@@ -1,5 +1,6 @@
 // boat_node: runs the fusion core on a boat's sensors and publishes heel, pitch and heading over
-// DDS; logs every published sample to disk and backfills the shore after a link outage.
+// DDS; logs every published sample and GNSS fix to disk and backfills the shore after a link
+// outage.
 #include <arpa/inet.h>
 #include <fastdds/rtps/transport/test_UDPv4TransportDescriptor.h>
 #include <ifaddrs.h>
@@ -16,6 +17,7 @@
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fstream>
 #include <functional>
+#include <future>
 #include <limits>
 #include <random>
 #include <regex>
@@ -190,6 +192,9 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       (static_cast<std::uint64_t>(rd()) << 32) ^ rd() ^ static_cast<std::uint64_t>(getpid());
   telltale::boat::SessionLog log({o.log_dir, o.boat_id, boot_id, 100000,
                                   static_cast<std::uint64_t>(o.log_max_mb * 1024 * 1024)});
+  // The fixes beside it, in the same directory under the same budget (session_log.hpp).
+  telltale::boat::FixLog fix_log({o.log_dir, o.boat_id, boot_id, 100000,
+                                  static_cast<std::uint64_t>(o.log_max_mb * 1024 * 1024)});
 
   telltale::fusion::AlarmEngine alarms;
   alarms.set_rules(default_rules(o), 0);
@@ -198,10 +203,16 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
 
   std::unique_ptr<telltale::boat::Backfiller> backfiller;
   std::unique_ptr<telltale::boat::EarlierRuns> earlier;
+  std::unique_ptr<telltale::boat::FixBackfiller> fix_backfiller;
+  std::unique_ptr<telltale::boat::FixEarlierRuns> earlier_fixes;
   telltale::boat::BoatDdsCallbacks callbacks;
   callbacks.on_ack = [&](std::uint64_t boot, std::uint64_t acked, bool new_shore) {
     if (backfiller) backfiller->on_ack(boot, acked, new_shore);
     if (earlier) earlier->on_ack(boot, acked, new_shore);
+  };
+  callbacks.on_fix_ack = [&](std::uint64_t boot, std::uint64_t acked, bool new_shore) {
+    if (fix_backfiller) fix_backfiller->on_ack(boot, acked, new_shore);
+    if (earlier_fixes) earlier_fixes->on_ack(boot, acked, new_shore);
   };
   callbacks.on_rules = [&](std::vector<telltale::fusion::AlarmRule> rules) {
     shore_rules = true;
@@ -256,6 +267,42 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
         std::printf("boat_node %s\n", line.c_str());
         std::fflush(stdout);
       });
+  // The fixes go the same way on their own topics, against their own receipts.
+  const auto fill_fix = [&](const telltale::boat::FixRecord& r, std::uint64_t run,
+                            telltale::msg::BoatFix& m) {
+    m.boat_id(o.boat_id);
+    m.boot_id(run);
+    m.seq(r.seq);
+    m.t_utc_ns(r.t_utc_ns);
+    m.gnss_utc_ns(r.gnss_utc_ns);
+    m.lat_deg(r.lat_deg);
+    m.lon_deg(r.lon_deg);
+    m.sog_m_s(r.sog_m_s);
+    m.cog_deg(r.cog_deg);
+    m.fix(static_cast<telltale::msg::FixKind>(r.fix));
+    m.satellites(r.satellites);
+    m.hdop(r.hdop);
+  };
+  // Lag: 2 s at the fastest receiver (25 Hz); the live fix of the last seconds may be in flight.
+  fix_backfiller = std::make_unique<telltale::boat::FixBackfiller>(
+      telltale::boat::BackfillConfig{boot_id, 50, 2500, std::chrono::milliseconds(5000)},
+      telltale::boat::FixLogReader(o.log_dir, o.boat_id, boot_id),
+      [&fill_fix, &dds, boot_id,
+       msg = telltale::msg::BoatFix()](const telltale::boat::FixRecord& r) mutable {
+        fill_fix(r, boot_id, msg);
+        return dds.backfill(msg);
+      });
+  earlier_fixes = std::make_unique<telltale::boat::FixEarlierRuns>(
+      o.log_dir, o.boat_id, boot_id, std::chrono::hours(24 * o.deliver_earlier_days),
+      [&fill_fix, &dds, msg = telltale::msg::BoatFix()](
+          std::uint64_t run, const telltale::boat::FixRecord& r) mutable {
+        fill_fix(r, run, msg);
+        return dds.backfill(msg);
+      },
+      [](const std::string& line) {
+        std::printf("boat_node fixes: %s\n", line.c_str());
+        std::fflush(stdout);
+      });
 
   telltale::msg::NodeStatus status;
   status.node_id(o.boat_id);
@@ -274,10 +321,11 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
 
   std::printf(
       "boat_node ready: boat=%s domain=%d source=%s gnss=%s rate=%gHz boot=%016llx log=%s "
-      "earlier_runs=%zu\n",
+      "earlier_runs=%zu earlier_fix_runs=%zu\n",
       o.boat_id.c_str(), dds.domain(), source->describe().c_str(),
       gnss ? gnss->describe().c_str() : (course ? "sim:course" : "none"), o.rate_hz,
-      static_cast<unsigned long long>(boot_id), o.log_dir.c_str(), earlier->pending());
+      static_cast<unsigned long long>(boot_id), o.log_dir.c_str(), earlier->pending(),
+      earlier_fixes->pending());
   std::fflush(stdout);
 
   const auto start = Clock::now();
@@ -299,24 +347,28 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   auto next_flush = start + std::chrono::seconds(1);
   std::string addresses = local_addresses();
   telltale::msg::BoatFix fix_msg;
-  fix_msg.boat_id(o.boat_id);
-  fix_msg.boot_id(boot_id);
   std::uint64_t fix_seq = 0;
   std::vector<telltale::boat::GnssFix> fixes;
   telltale::fusion::GroundSpeedHold ground_speed;
   double next_course_s = 0.0;
+  // Every fix is logged before it is published, as the attitude is: what the link loses, the
+  // fix backfill resends from the log.
   const auto publish_fix = [&](const telltale::boat::GnssFix& f, unsigned long long t_utc_ns) {
-    fix_msg.seq(++fix_seq);
-    fix_msg.t_utc_ns(t_utc_ns);
-    fix_msg.gnss_utc_ns(f.gnss_utc_ns);
-    fix_msg.lat_deg(f.lat_deg);
-    fix_msg.lon_deg(f.lon_deg);
-    fix_msg.sog_m_s(f.sog_m_s);
-    fix_msg.cog_deg(f.cog_deg);
-    fix_msg.fix(static_cast<telltale::msg::FixKind>(f.fix));
-    fix_msg.satellites(static_cast<std::uint8_t>(f.satellites));
-    fix_msg.hdop(static_cast<float>(f.hdop));
+    telltale::boat::FixRecord r;
+    r.seq = ++fix_seq;
+    r.t_utc_ns = t_utc_ns;
+    r.gnss_utc_ns = f.gnss_utc_ns;
+    r.lat_deg = f.lat_deg;
+    r.lon_deg = f.lon_deg;
+    r.sog_m_s = f.sog_m_s;
+    r.cog_deg = f.cog_deg;
+    r.fix = static_cast<std::uint8_t>(f.fix);
+    r.satellites = static_cast<std::uint8_t>(f.satellites);
+    r.hdop = static_cast<float>(f.hdop);
+    (void)fix_log.append(r);  // on failure held in memory, retried, reported in the status
+    fill_fix(r, boot_id, fix_msg);
     if (!dds.publish(fix_msg)) ++write_failures;
+    fix_backfiller->on_published(r.seq);
   };
 
   while (!shutdown.stop_requested()) {
@@ -426,6 +478,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
     if (now >= next_flush) {
       next_flush = now + std::chrono::seconds(1);
       log.flush();
+      fix_log.flush();
     }
     if (now >= next_status) {
       next_status = now + std::chrono::seconds(1);
@@ -442,7 +495,13 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       if (diag.gyro_saturated || diag.acc_saturated) h |= telltale::msg::SENSOR_SATURATED;
       // The log's trouble first: it is what loses data for good (the text is cut at 128). The
       // bit is what the shore's dashboard shows as a badge; the text says how much is at risk.
-      const auto log_health = log.health();
+      // Both kinds' logs as one: the same disk, the same risk.
+      auto log_health = log.health();
+      const auto fix_health = fix_log.health();
+      log_health.pending_records += fix_health.pending_records;
+      log_health.dropped_records += fix_health.dropped_records;
+      log_health.write_errors += fix_health.write_errors;
+      if (log_health.last_error.empty()) log_health.last_error = fix_health.last_error;
       if (log_health.failing()) h |= telltale::msg::SENSOR_LOG_FAILING;
       std::string text;
       if (log_health.failing()) {
@@ -457,7 +516,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       if (log_health.write_errors)
         text += "; session log write errors " + std::to_string(log_health.write_errors);
       if (!backfiller->shore_seen()) text += "; no shore receipt yet";
-      if (const auto n = earlier->pending())
+      if (const auto n = earlier->pending() + earlier_fixes->pending())
         text += "; delivering " + std::to_string(n) + " earlier run(s) from the log";
       if (gnss) {
         const auto gs = gnss->stats();
@@ -485,30 +544,46 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       health = telltale::msg::SENSOR_OK;  // flags cover the last second
     }
   }
-  if (!log.flush()) {
-    const auto lh = log.health();
+  const auto flush_or_say = [](auto& l, const char* kind) {
+    if (l.flush()) return;
+    const auto lh = l.health();
     std::fprintf(stderr,
-                 "boat_node: session log: %llu records could not be written (%s); %llu were "
+                 "boat_node: session log: %llu %s could not be written (%s); %llu were "
                  "never logged\n",
-                 static_cast<unsigned long long>(lh.pending_records), lh.last_error.c_str(),
+                 static_cast<unsigned long long>(lh.pending_records), kind, lh.last_error.c_str(),
                  static_cast<unsigned long long>(lh.dropped_records));
-  }
+  };
+  flush_or_say(log, "records");
+  flush_or_say(fix_log, "fixes");
   if (o.console && tty) std::printf("\n");
   // Hand the shore what it is missing before going: 3 s if the shore is not heard, up to 10 s
   // while it is (the service manager's stop timeout is longer).
+  // The fixes drain beside the attitude, not after it: the bound stays the same.
+  auto fixes_drained = std::async(std::launch::async, [&] {
+    return fix_backfiller->drain(std::chrono::seconds(3), std::chrono::seconds(10));
+  });
   const bool complete = backfiller->drain(std::chrono::seconds(3), std::chrono::seconds(10));
-  // Otherwise the next start delivers this run from the log.
+  const bool fixes_complete = fixes_drained.get();
+  // Otherwise the next start delivers this run from the log (each kind on its own).
   if (complete) telltale::boat::mark_delivered(o.log_dir, o.boat_id, boot_id);
+  if (fixes_complete)
+    telltale::boat::mark_delivered<telltale::boat::FixCodec>(o.log_dir, o.boat_id, boot_id);
   const std::size_t earlier_pending = earlier->pending();
+  const std::size_t earlier_fixes_pending = earlier_fixes->pending();
   earlier.reset();
+  earlier_fixes.reset();
   std::printf(
       "boat_node stopped: boat=%s published=%llu fixes=%llu resent=%llu shore_has_all=%s "
-      "bad_samples=%u acked=%llu backfill_failures=%llu earlier_runs_pending=%zu\n",
+      "bad_samples=%u acked=%llu backfill_failures=%llu earlier_runs_pending=%zu "
+      "fixes_resent=%llu fixes_acked=%llu shore_has_all_fixes=%s earlier_fix_runs_pending=%zu\n",
       o.boat_id.c_str(), static_cast<unsigned long long>(seq),
       static_cast<unsigned long long>(fix_seq),
       static_cast<unsigned long long>(backfiller->resent()), complete ? "yes" : "no", bad_samples,
       static_cast<unsigned long long>(backfiller->acked()),
-      static_cast<unsigned long long>(backfiller->send_failures()), earlier_pending);
+      static_cast<unsigned long long>(backfiller->send_failures()), earlier_pending,
+      static_cast<unsigned long long>(fix_backfiller->resent()),
+      static_cast<unsigned long long>(fix_backfiller->acked()), fixes_complete ? "yes" : "no",
+      earlier_fixes_pending);
 }
 
 }  // namespace
