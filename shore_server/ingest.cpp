@@ -12,10 +12,10 @@ namespace telltale::shore {
 
 namespace {
 
-constexpr std::array<const char*, kRejectKinds> kRejectNames = {"none", "id",   "time",
+constexpr std::array<const char*, kRejectKinds> kRejectNames = {"none",  "id",   "time",
                                                                 "value", "text", "reader_full"};
 constexpr std::array<const char*, kTopics> kTopicNames = {"attitude", "backfill", "status",
-                                                          "wearable", "fix"};
+                                                          "wearable", "fix",      "fix_backfill"};
 
 bool finite_in(double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; }
 /// NaN ("no value") or within [lo, hi].
@@ -233,11 +233,12 @@ Reject Ingest::wearable(const msg::WearableMotion& m) {
   return r;
 }
 
-Reject Ingest::fix(const msg::BoatFix& m) {
+Reject Ingest::fix(const msg::BoatFix& m, bool backfill) {
   const FixSample f = from_wire(m);
   const Reject r = check(f, now());
-  counters_.count(Topic::kFix, r);
-  if (r == Reject::kNone && sinks_.on_fix) sinks_.on_fix(f);
+  counters_.count(backfill ? Topic::kFixBackfill : Topic::kFix, r);
+  const auto& sink = backfill ? sinks_.on_fix_backfill : sinks_.on_fix;
+  if (r == Reject::kNone && sink) sink(f);
   return r;
 }
 

@@ -45,8 +45,8 @@ inline constexpr std::size_t kRejectKinds = 6;
 [[nodiscard]] const char* reject_name(Reject r);
 
 /// The topics the shore reads.
-enum class Topic : std::uint8_t { kAttitude, kBackfill, kStatus, kWearable, kFix };
-inline constexpr std::size_t kTopics = 5;
+enum class Topic : std::uint8_t { kAttitude, kBackfill, kStatus, kWearable, kFix, kFixBackfill };
+inline constexpr std::size_t kTopics = 6;
 [[nodiscard]] const char* topic_name(Topic t);
 
 /// Valid UTF-8 (shortest forms, no surrogates, at most U+10FFFF).
@@ -92,6 +92,8 @@ struct IngestSinks {
   std::function<void(const std::string& node_id, const NodeStatusInfo&)> on_status;
   std::function<void(const WearableSample&)> on_wearable;
   std::function<void(const FixSample&)> on_fix;
+  /// Fixes a boat resends from its session log: the same checks, another sink.
+  std::function<void(const FixSample&)> on_fix_backfill;
 };
 
 class Ingest {
@@ -103,7 +105,7 @@ class Ingest {
   Reject attitude(const msg::BoatAttitude& m, bool backfill);
   Reject status(const msg::NodeStatus& m);
   Reject wearable(const msg::WearableMotion& m);
-  Reject fix(const msg::BoatFix& m);
+  Reject fix(const msg::BoatFix& m, bool backfill = false);
 
   [[nodiscard]] const IngestCounters& counters() const { return counters_; }
   [[nodiscard]] IngestCounters& counters() { return counters_; }

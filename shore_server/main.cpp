@@ -199,6 +199,8 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
     store.enqueue(f);
     (void)fleet.update_fix(f, std::chrono::steady_clock::now());
   };
+  // Fixes resent from a boat's log: the recording only, as backfilled attitude.
+  callbacks.on_fix_backfill = [&](const FixSample& f) { store.enqueue(f); };
   callbacks.on_status = [&](const std::string& id, const NodeStatusInfo& st) {
     fleet.update_status(id, st);
   };
@@ -234,26 +236,34 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
   // moves (a stopping boat waits for it), and every second anyway (receipts are best effort).
   int tick = 0;
   std::map<std::pair<std::string, std::uint64_t>, std::uint64_t> receipt_sent;  // (boat, run)
+  std::map<std::pair<std::string, std::uint64_t>, std::uint64_t> fix_receipt_sent;
   while (!shutdown.wait_for(std::chrono::milliseconds(200))) {
     for (const auto& v : fleet.sweep(std::chrono::steady_clock::now()))
       hub.publish_sample(v.last.boat_id, [v] { return boat_json(v); });
     for (const auto& a : fleet.sweep_athletes(std::chrono::steady_clock::now()))
       hub.publish_event("wearable", to_json_text(athlete_object(a)), a.last.athlete_id);
     const bool repeat = ++tick % 5 == 0;
-    const auto acks = store.acks();
-    for (const auto& a : acks) {
-      auto [it, added] = receipt_sent.try_emplace({a.boat_id, a.boot_id}, a.acked_seq);
-      if (!repeat && !added && it->second == a.acked_seq) continue;
-      it->second = a.acked_seq;
-      dds.publish_ack(a.boat_id, a.boot_id, a.acked_seq);
-    }
-    if (repeat) {
-      // Runs the store no longer tracks need no receipt: forget them, so this map is bounded by
-      // the store's receipts, not by every run seen since start.
-      std::set<std::pair<std::string, std::uint64_t>> live_runs;
-      for (const auto& a : acks) live_runs.emplace(a.boat_id, a.boot_id);
-      std::erase_if(receipt_sent, [&](const auto& e) { return !live_runs.count(e.first); });
-    }
+    // The fixes' receipts go the same way as the attitude's, on their own topic.
+    const auto send_receipts = [&](const std::vector<Store::Ack>& acks, auto& sent, auto publish) {
+      for (const auto& a : acks) {
+        auto [it, added] = sent.try_emplace({a.boat_id, a.boot_id}, a.acked_seq);
+        if (!repeat && !added && it->second == a.acked_seq) continue;
+        it->second = a.acked_seq;
+        publish(a);
+      }
+      if (repeat) {
+        // Runs the store no longer tracks need no receipt: forget them, so this map is bounded
+        // by the store's receipts, not by every run seen since start.
+        std::set<std::pair<std::string, std::uint64_t>> live_runs;
+        for (const auto& a : acks) live_runs.emplace(a.boat_id, a.boot_id);
+        std::erase_if(sent, [&](const auto& e) { return !live_runs.count(e.first); });
+      }
+    };
+    send_receipts(store.acks(), receipt_sent,
+                  [&](const Store::Ack& a) { dds.publish_ack(a.boat_id, a.boot_id, a.acked_seq); });
+    send_receipts(store.fix_acks(), fix_receipt_sent, [&](const Store::Ack& a) {
+      dds.publish_fix_ack(a.boat_id, a.boot_id, a.acked_seq);
+    });
     try {
       for (const auto& topic : dds.recycle_full_readers(std::chrono::seconds(10)))
         std::fprintf(stderr,

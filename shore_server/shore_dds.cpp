@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <atomic>
-#include <set>
 #include <cstdio>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <set>
 
 #include "dds_security.hpp"
 #include "shutdown.hpp"
@@ -43,20 +43,24 @@ class ShoreDds::Listener : public fdds::DataReaderListener {
     const std::string& topic = reader->get_topicdescription()->get_name();
     if (topic == dds::kTopicBoatAttitude || topic == dds::kTopicBoatBackfill) {
       const bool backfill = topic == dds::kTopicBoatBackfill;
-      take<msg::BoatAttitude>(reader, backfill ? Topic::kBackfill : Topic::kAttitude,
-                              [](const auto& m) { return m.boat_id().to_string(); },
-                              [&](const auto& m) { (void)ingest_.attitude(m, backfill); });
+      take<msg::BoatAttitude>(
+          reader, backfill ? Topic::kBackfill : Topic::kAttitude,
+          [](const auto& m) { return m.boat_id().to_string(); },
+          [&](const auto& m) { (void)ingest_.attitude(m, backfill); });
     } else if (topic == dds::kTopicWearableMotion) {
-      take<msg::WearableMotion>(reader, Topic::kWearable,
-                                [](const auto& m) { return m.athlete_id().to_string(); },
-                                [&](const auto& m) { (void)ingest_.wearable(m); });
-    } else if (topic == dds::kTopicBoatFix) {
-      take<msg::BoatFix>(reader, Topic::kFix, [](const auto& m) { return m.boat_id().to_string(); },
-                         [&](const auto& m) { (void)ingest_.fix(m); });
+      take<msg::WearableMotion>(
+          reader, Topic::kWearable, [](const auto& m) { return m.athlete_id().to_string(); },
+          [&](const auto& m) { (void)ingest_.wearable(m); });
+    } else if (topic == dds::kTopicBoatFix || topic == dds::kTopicBoatFixBackfill) {
+      const bool backfill = topic == dds::kTopicBoatFixBackfill;
+      take<msg::BoatFix>(
+          reader, backfill ? Topic::kFixBackfill : Topic::kFix,
+          [](const auto& m) { return m.boat_id().to_string(); },
+          [&](const auto& m) { (void)ingest_.fix(m, backfill); });
     } else if (topic == dds::kTopicNodeStatus) {
-      take<msg::NodeStatus>(reader, Topic::kStatus,
-                            [](const auto& m) { return m.node_id().to_string(); },
-                            [&](const auto& m) { (void)ingest_.status(m); });
+      take<msg::NodeStatus>(
+          reader, Topic::kStatus, [](const auto& m) { return m.node_id().to_string(); },
+          [&](const auto& m) { (void)ingest_.status(m); });
     }
   }
 
@@ -102,8 +106,8 @@ class ShoreDds::Listener : public fdds::DataReaderListener {
 
   /// DDS topic names in the order of ingest.hpp's Topic.
   static constexpr std::array<const char*, kTopics> kReaderTopics = {
-      dds::kTopicBoatAttitude, dds::kTopicBoatBackfill, dds::kTopicNodeStatus,
-      dds::kTopicWearableMotion, dds::kTopicBoatFix};
+      dds::kTopicBoatAttitude,   dds::kTopicBoatBackfill, dds::kTopicNodeStatus,
+      dds::kTopicWearableMotion, dds::kTopicBoatFix,      dds::kTopicBoatFixBackfill};
 
  private:
   using ReturnCode_t = eprosima::fastrtps::types::ReturnCode_t;
@@ -120,9 +124,9 @@ class ShoreDds::Listener : public fdds::DataReaderListener {
 
 ShoreDds::ShoreDds(const dds::DdsOptions& options, FleetCallbacks callbacks)
     : callbacks_(std::move(callbacks)),
-      ingest_(std::make_unique<Ingest>(IngestSinks{callbacks_.on_attitude, callbacks_.on_backfill,
-                                                   callbacks_.on_status, callbacks_.on_wearable,
-                                                   callbacks_.on_fix})) {
+      ingest_(std::make_unique<Ingest>(
+          IngestSinks{callbacks_.on_attitude, callbacks_.on_backfill, callbacks_.on_status,
+                      callbacks_.on_wearable, callbacks_.on_fix, callbacks_.on_fix_backfill})) {
   dds::DdsOptions opts = options;
   if (!opts.security_dir.empty()) {
     writer_check_ = std::make_unique<WriterCheck>(opts.security_dir);
@@ -142,6 +146,7 @@ ShoreDds::ShoreDds(const dds::DdsOptions& options, FleetCallbacks callbacks)
   add_reader(Topic::kBackfill, new StrictBoatAttitudeType(), "backfill_reader");
   add_reader(Topic::kWearable, new StrictWearableMotionType(), "wearable_reader");
   add_reader(Topic::kFix, new StrictBoatFixType(), "fix_reader");
+  add_reader(Topic::kFixBackfill, new StrictBoatFixType(), "fix_backfill_reader");
   add_reader(Topic::kStatus, new StrictNodeStatusType(), "status_reader");
   rule_writer_ = participant_->writer(
       participant_->topic(dds::kTopicAlarmRules, fdds::TypeSupport(new msg::AlarmRulePubSubType())),
@@ -153,6 +158,9 @@ ShoreDds::ShoreDds(const dds::DdsOptions& options, FleetCallbacks callbacks)
   ack_writer_ = participant_->writer(
       participant_->topic(dds::kTopicShoreAck, fdds::TypeSupport(new msg::ShoreAckPubSubType())),
       "ack_writer");
+  fix_ack_writer_ = participant_->writer(
+      participant_->topic(dds::kTopicShoreFixAck, fdds::TypeSupport(new msg::ShoreAckPubSubType())),
+      "fix_ack_writer");
 }
 
 std::vector<std::string> ShoreDds::recycle_full_readers(std::chrono::seconds min_interval) {
@@ -172,26 +180,37 @@ std::vector<std::string> ShoreDds::recycle_full_readers(std::chrono::seconds min
 
 bool ShoreDds::publish_ack(const std::string& boat_id, std::uint64_t boot_id,
                            std::uint64_t acked_seq) {
+  return publish_receipt(ack_writer_, ack_instances_, boat_id, boot_id, acked_seq);
+}
+
+bool ShoreDds::publish_fix_ack(const std::string& boat_id, std::uint64_t boot_id,
+                               std::uint64_t acked_seq) {
+  return publish_receipt(fix_ack_writer_, fix_ack_instances_, boat_id, boot_id, acked_seq);
+}
+
+bool ShoreDds::publish_receipt(fdds::DataWriter* writer, AckInstances& instances,
+                               const std::string& boat_id, std::uint64_t boot_id,
+                               std::uint64_t acked_seq) {
   msg::ShoreAck m = to_wire(Store::Ack{boat_id, boot_id, acked_seq}, utc_now_ns());
   std::lock_guard lock(write_mutex_);
   const auto now = std::chrono::steady_clock::now();
   const auto key = std::make_pair(boat_id, boot_id);
-  if (!ack_instances_.count(key)) {
+  if (!instances.count(key)) {
     // Make room first: the least recently written receipt instance goes (its run is long
     // delivered or its boat gone; a receipt asked for again is registered anew).
-    while (ack_instances_.size() >= kMaxAckInstances) {
-      auto oldest = ack_instances_.begin();
-      for (auto it = ack_instances_.begin(); it != ack_instances_.end(); ++it)
+    while (instances.size() >= kMaxAckInstances) {
+      auto oldest = instances.begin();
+      for (auto it = instances.begin(); it != instances.end(); ++it)
         if (it->second < oldest->second) oldest = it;
       msg::ShoreAck old;
       old.boat_id(oldest->first.first);
       old.boot_id(oldest->first.second);
-      (void)ack_writer_->unregister_instance(&old, ack_writer_->lookup_instance(&old));
-      ack_instances_.erase(oldest);
+      (void)writer->unregister_instance(&old, writer->lookup_instance(&old));
+      instances.erase(oldest);
     }
   }
-  ack_instances_[key] = now;
-  return ack_writer_->write(&m);
+  instances[key] = now;
+  return writer->write(&m);
 }
 
 std::size_t ShoreDds::ack_instances() const {

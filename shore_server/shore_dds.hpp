@@ -33,6 +33,8 @@ struct FleetCallbacks {
   std::function<void(const WearableSample&)> on_wearable;
   /// A GNSS fix (any kind, "none" included).
   std::function<void(const FixSample&)> on_fix;
+  /// Fixes a boat resends from its session log (reliable fix backfill topic).
+  std::function<void(const FixSample&)> on_fix_backfill;
 };
 
 /// Receipt instances the shore's ack writer keeps registered at most (its profile allows 4096;
@@ -54,6 +56,8 @@ class ShoreDds {
   /// Tells a boat that every sample of run `boot_id` up to `acked_seq` is stored. Thread-safe.
   /// False when the writer refused it (it never should: see kMaxAckInstances).
   bool publish_ack(const std::string& boat_id, std::uint64_t boot_id, std::uint64_t acked_seq);
+  /// The same for the fixes (acked_seq a fix seq), on "telltale_shore_fix_ack". Thread-safe.
+  bool publish_fix_ack(const std::string& boat_id, std::uint64_t boot_id, std::uint64_t acked_seq);
   /// Receipt instances registered now (at most kMaxAckInstances).
   [[nodiscard]] std::size_t ack_instances() const;
   [[nodiscard]] int domain() const { return participant_->domain(); }
@@ -62,11 +66,11 @@ class ShoreDds {
   [[nodiscard]] const IngestCounters& ingest_counters() const { return ingest_->counters(); }
 
   /// Replaces every reader whose table of ids (instances) filled up, at most once per
-  /// `min_interval` per reader; each replacement is counted as "reader_full" in /healthz. Fast DDS frees an
-  /// instance only once no writer holds it, so ids a publisher invented in a burst would keep a
-  /// new boat out for as long as that publisher lives; a new reader starts empty and the boats
-  /// still sailing are back within a sample. Call from one thread (the shore's sweep); returns
-  /// the topics replaced.
+  /// `min_interval` per reader; each replacement is counted as "reader_full" in /healthz. Fast DDS
+  /// frees an instance only once no writer holds it, so ids a publisher invented in a burst would
+  /// keep a new boat out for as long as that publisher lives; a new reader starts empty and the
+  /// boats still sailing are back within a sample. Call from one thread (the shore's sweep);
+  /// returns the topics replaced.
   std::vector<std::string> recycle_full_readers(std::chrono::seconds min_interval);
 
  private:
@@ -87,13 +91,19 @@ class ShoreDds {
   eprosima::fastdds::dds::DataWriter* rule_writer_ = nullptr;
   eprosima::fastdds::dds::DataWriter* event_writer_ = nullptr;
   eprosima::fastdds::dds::DataWriter* ack_writer_ = nullptr;
+  eprosima::fastdds::dds::DataWriter* fix_ack_writer_ = nullptr;
+  using AckInstances =
+      std::map<std::pair<std::string, std::uint64_t>, std::chrono::steady_clock::time_point>;
+  /// Writes one receipt on `writer`, keeping its instances within kMaxAckInstances.
+  bool publish_receipt(eprosima::fastdds::dds::DataWriter* writer, AckInstances& instances,
+                       const std::string& boat_id, std::uint64_t boot_id, std::uint64_t acked_seq);
   mutable std::mutex write_mutex_;
   std::vector<std::string> published_rule_ids_;
   /// Receipt instances the ack writer holds, (boat, run) -> last written: at most
   /// kMaxAckInstances, the least recently written unregistered first (the writer's resource limit
   /// is 4096 instances; without this the 4097th run never got a receipt).
-  std::map<std::pair<std::string, std::uint64_t>, std::chrono::steady_clock::time_point>
-      ack_instances_;
+  AckInstances ack_instances_;
+  AckInstances fix_ack_instances_;  ///< the same for the fix receipts
   std::uint64_t rule_revision_ = 0;
 };
 

@@ -138,9 +138,10 @@ std::string tier_upsert(std::uint64_t width_s, const std::string& select_from) {
 std::string tier_trigger() {
   std::string sql = "CREATE TRIGGER IF NOT EXISTS attitude_tiers AFTER INSERT ON attitude BEGIN ";
   for (const auto w : kTierWidths_s)
-    sql += tier_upsert(w, "FROM (SELECT NEW.boat_id AS boat_id, NEW.t_utc_ns AS t_utc_ns, "
-                          "NEW.heel_deg AS heel_deg, NEW.pitch_deg AS pitch_deg, "
-                          "NEW.heading_deg AS heading_deg) a WHERE true") +
+    sql += tier_upsert(w,
+                       "FROM (SELECT NEW.boat_id AS boat_id, NEW.t_utc_ns AS t_utc_ns, "
+                       "NEW.heel_deg AS heel_deg, NEW.pitch_deg AS pitch_deg, "
+                       "NEW.heading_deg AS heading_deg) a WHERE true") +
            "; ";
   return sql + "END;";
 }
@@ -185,8 +186,8 @@ void rebuild_tiers(sqlite3* db, const std::string& boat_id, std::uint64_t from_n
                    std::uint64_t to_ns) {
   const std::uint64_t widest_ns = kTierWidths_s.back() * 1000000000ULL;
   const std::uint64_t lo = from_ns / widest_ns * widest_ns;
-  const std::uint64_t hi = std::min<std::uint64_t>(
-      to_ns / widest_ns * widest_ns + widest_ns - 1, std::numeric_limits<std::int64_t>::max());
+  const std::uint64_t hi = std::min<std::uint64_t>(to_ns / widest_ns * widest_ns + widest_ns - 1,
+                                                   std::numeric_limits<std::int64_t>::max());
   const std::string match = boat_id.empty() ? "?1 = ''" : "boat_id = ?1";
   for (const auto w : kTierWidths_s) {
     const std::uint64_t w_ns = w * 1000000000ULL;
@@ -415,6 +416,8 @@ bool Store::commit_fixes(const std::vector<FixSample>& batch) {
       ins.step();
     }
     exec(db_, "COMMIT");
+    // On disk now: these fixes may be acknowledged to their boats.
+    for (const auto& f : batch) track_fix_receipt(f);
     std::lock_guard lock(mutex_);
     fixes_committed_ += batch.size();
     return true;
@@ -430,8 +433,8 @@ std::vector<FixSample> Store::fix_page(const std::string& boat_id, std::uint64_t
                                        std::uint64_t to_ns, std::size_t limit) {
   const ReadLease reader(*this);
   static const std::string kSql = "SELECT " + select_columns(kFixFields) +
-                                 " FROM fixes WHERE boat_id = ? AND t_utc_ns > ? AND "
-                                 "t_utc_ns <= ? AND fix <> 'none' ORDER BY t_utc_ns LIMIT ?";
+                                  " FROM fixes WHERE boat_id = ? AND t_utc_ns > ? AND "
+                                  "t_utc_ns <= ? AND fix <> 'none' ORDER BY t_utc_ns LIMIT ?";
   Stmt q(reader.db(), kSql.c_str());
   q.bind(1, boat_id).bind_u(2, after_ns).bind_u(3, to_ns).bind(4, static_cast<std::int64_t>(limit));
   std::vector<FixSample> rows;
@@ -805,46 +808,66 @@ void Store::merge_sessions(const std::string& boat_id) {
   }
 }
 
-void Store::track_receipt(const AttitudeSample& s) {
-  if (s.seq == 0) return;
-  // A run silent this long has nothing more coming: its receipt is dropped (and rebuilt from disk
-  // if the boat sends it again), so the receipts published each second stay few.
-  constexpr auto kIdle = std::chrono::minutes(2);
-  const auto now = std::chrono::steady_clock::now();
-  std::lock_guard lock(receipts_mutex_);
-  auto [it, added] = receipts_.try_emplace({s.boat_id, s.boot_id});
+void Store::note_stored(std::map<std::pair<std::string, std::uint64_t>, Receipt>& receipts,
+                        const char* table, const std::string& boat_id, std::uint64_t boot_id,
+                        std::uint64_t seq, std::chrono::steady_clock::time_point now) {
+  auto [it, added] = receipts.try_emplace({boat_id, boot_id});
   Receipt& r = it->second;
   if (added) {
     // A run not seen since this shore started: what is already stored counts (restart).
     // Under the boat's id, and its run's alias if it has one (a second node's run).
-    const auto alias = aliases_.find({s.boat_id, s.boot_id});
-    Stmt q(db_,
-           "SELECT seq FROM attitude WHERE boat_id IN (?1, ?3) AND boot_id = ?2 ORDER BY seq");
-    q.bind(1, s.boat_id).bind(2, static_cast<std::int64_t>(s.boot_id));
-    q.bind(3, alias == aliases_.end() ? s.boat_id : alias->second);
+    const auto alias = aliases_.find({boat_id, boot_id});
+    Stmt q(db_, (std::string("SELECT seq FROM ") + table +
+                 " WHERE boat_id IN (?1, ?3) AND boot_id = ?2 ORDER BY seq")
+                    .c_str());
+    q.bind(1, boat_id).bind(2, static_cast<std::int64_t>(boot_id));
+    q.bind(3, alias == aliases_.end() ? boat_id : alias->second);
     while (q.step()) {
-      const std::uint64_t seq = q.u64(0);
-      if (seq == r.acked + 1) {
-        r.acked = seq;
-      } else if (seq > r.acked + 1) {
-        r.ahead.insert(seq);
+      const std::uint64_t stored = q.u64(0);
+      if (stored == r.acked + 1) {
+        r.acked = stored;
+      } else if (stored > r.acked + 1) {
+        r.ahead.insert(stored);
       }
     }
   }
   r.touched = now;
-  RunSpan& span = spans_[s.boat_id][s.boot_id];
-  span.min_t_ns = std::min(span.min_t_ns, s.t_utc_ns);
-  span.max_t_ns = std::max(span.max_t_ns, s.t_utc_ns);
-  span.touched = now;
-  if (s.seq > r.acked) {
-    r.ahead.insert(s.seq);
+  if (seq > r.acked) {
+    r.ahead.insert(seq);
     while (!r.ahead.empty() && *r.ahead.begin() <= r.acked + 1) {
       r.acked = std::max(r.acked, *r.ahead.begin());
       r.ahead.erase(r.ahead.begin());
     }
   }
+}
+
+// A run silent this long has nothing more coming: its receipt is dropped (and rebuilt from disk
+// if the boat sends it again), so the receipts published each second stay few.
+constexpr auto kReceiptIdle = std::chrono::minutes(2);
+
+void Store::track_fix_receipt(const FixSample& f) {
+  if (f.seq == 0) return;
+  const auto now = std::chrono::steady_clock::now();
+  std::lock_guard lock(receipts_mutex_);
+  note_stored(fix_receipts_, "fixes", f.boat_id, f.boot_id, f.seq, now);
+  if (++receipt_updates_ % 1024 == 0)
+    std::erase_if(fix_receipts_,
+                  [&](const auto& e) { return now - e.second.touched > kReceiptIdle; });
+}
+
+void Store::track_receipt(const AttitudeSample& s) {
+  if (s.seq == 0) return;
+  constexpr auto kIdle = kReceiptIdle;
+  const auto now = std::chrono::steady_clock::now();
+  std::lock_guard lock(receipts_mutex_);
+  note_stored(receipts_, "attitude", s.boat_id, s.boot_id, s.seq, now);
+  RunSpan& span = spans_[s.boat_id][s.boot_id];
+  span.min_t_ns = std::min(span.min_t_ns, s.t_utc_ns);
+  span.max_t_ns = std::max(span.max_t_ns, s.t_utc_ns);
+  span.touched = now;
   if (++receipt_updates_ % 1024 == 0) {
     std::erase_if(receipts_, [&](const auto& e) { return now - e.second.touched > kIdle; });
+    std::erase_if(fix_receipts_, [&](const auto& e) { return now - e.second.touched > kIdle; });
     for (auto& [boat, runs] : spans_)
       std::erase_if(runs, [&](const auto& e) { return now - e.second.touched > kIdle; });
     std::erase_if(spans_, [](const auto& e) { return e.second.empty(); });
@@ -893,8 +916,7 @@ const std::string& Store::recorded_id(const AttitudeSample& s) {
   return aliases_.emplace(key, alias).first->second;
 }
 
-bool Store::at_once(const RunSpan& a, const RunSpan& b,
-                    std::chrono::steady_clock::time_point now) {
+bool Store::at_once(const RunSpan& a, const RunSpan& b, std::chrono::steady_clock::time_point now) {
   // Both runs storing within this window, and their spans overlapping by more than a second: a
   // restarted boat's runs follow each other in time, two boats with one id interleave.
   constexpr auto kWindow = std::chrono::seconds(30);
@@ -922,6 +944,13 @@ std::vector<Store::Ack> Store::acks() const {
   std::lock_guard lock(receipts_mutex_);
   std::vector<Ack> out;
   for (const auto& [key, r] : receipts_) out.push_back({key.first, key.second, r.acked});
+  return out;
+}
+
+std::vector<Store::Ack> Store::fix_acks() const {
+  std::lock_guard lock(receipts_mutex_);
+  std::vector<Ack> out;
+  for (const auto& [key, r] : fix_receipts_) out.push_back({key.first, key.second, r.acked});
   return out;
 }
 

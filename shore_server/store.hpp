@@ -2,6 +2,8 @@
 /// \file
 /// The shore's recording in SQLite (WAL): attitude samples, GNSS fixes, sessions, alarm rules and
 /// events. A session is a boat and a time span; its fixes are the boat's fixes in that span.
+/// Attitude and fixes each have their receipts (acks(), fix_acks()): per boat run, how far every
+/// record is stored, from which the boats backfill what is missing.
 ///
 /// Writes: the DDS listener queues samples (never blocks on disk); one writer thread commits them
 /// in batches. Durability window: a sample is on disk at most `commit_interval` after it arrived
@@ -63,13 +65,13 @@ struct StoreConfig {
 
 /// The writer's state for /healthz.
 struct StoreHealth {
-  bool failing = false;       ///< the latest commit failed
-  std::size_t backlog = 0;    ///< samples queued, not committed
-  std::uint64_t dropped = 0;  ///< samples refused: backlog full (never acknowledged)
-  std::size_t wearable_backlog = 0;   ///< wearable samples queued, kept while writes fail
-  std::size_t fix_backlog = 0;        ///< GNSS fixes queued, kept while writes fail
-  std::uint64_t wearable_dropped = 0; ///< beyond the bound while failing: lost (no backfill)
-  std::uint64_t fixes_dropped = 0;    ///< the same for fixes
+  bool failing = false;                ///< the latest commit failed
+  std::size_t backlog = 0;             ///< samples queued, not committed
+  std::uint64_t dropped = 0;           ///< samples refused: backlog full (never acknowledged)
+  std::size_t wearable_backlog = 0;    ///< wearable samples queued, kept while writes fail
+  std::size_t fix_backlog = 0;         ///< GNSS fixes queued, kept while writes fail
+  std::uint64_t wearable_dropped = 0;  ///< beyond the bound while failing: lost (no backfill)
+  std::uint64_t fixes_dropped = 0;     ///< the same for fixes
   std::uint64_t failed_commits = 0;
   double retry_in_s = 0.0;  ///< until the next attempt while failing
   std::string last_error;
@@ -97,11 +99,11 @@ struct TierBucket {
 
 /// What the fixes of a span say about the sailing.
 struct FixStats {
-  std::int64_t fixes = 0;         ///< with a position
-  double distance_m = 0.0;        ///< distance sailed: SOG integrated over time (see fix_stats)
+  std::int64_t fixes = 0;   ///< with a position
+  double distance_m = 0.0;  ///< distance sailed: SOG integrated over time (see fix_stats)
   double time_with_fix_s = 0.0;
-  double sog_mean_m_s = 0.0;      ///< distance / time with a fix; NaN without fixes
-  double sog_max_m_s = 0.0;       ///< NaN without fixes
+  double sog_mean_m_s = 0.0;  ///< distance / time with a fix; NaN without fixes
+  double sog_max_m_s = 0.0;   ///< NaN without fixes
 };
 
 struct EventFilter {
@@ -185,6 +187,9 @@ class Store {
     std::uint64_t acked_seq;
   };
   [[nodiscard]] std::vector<Ack> acks() const;
+  /// The same for the GNSS fixes: per boat and run, the highest fix seq with every fix up to it
+  /// stored (a fix stored twice, live and backfilled, is one row: same boat, same time).
+  [[nodiscard]] std::vector<Ack> fix_acks() const;
 
   /// Two runs of one boat id storing samples of the same time span, both within the last
   /// `kDuplicateWindow`: two nodes configured with one id (a restart or an earlier run's delivery
@@ -234,6 +239,7 @@ class Store {
   /// Shore time (ns since 1970) of the batch being committed: the sessions' arrival time.
   std::uint64_t batch_received_ns_ = 0;
   void track_receipt(const AttitudeSample& sample);
+  void track_fix_receipt(const FixSample& fix);
   /// Joins this boat's sessions that backfill has brought within the session gap of each other.
   void merge_sessions(const std::string& boat_id);
   std::set<std::string> backfilled_;  ///< boats with backfill older than their open session
@@ -246,6 +252,13 @@ class Store {
   mutable std::mutex receipts_mutex_;
   /// (boat, run) -> receipt: the boat's current run and earlier runs it is still delivering.
   std::map<std::pair<std::string, std::uint64_t>, Receipt> receipts_;
+  /// The same for the fixes, from the fixes table (under receipts_mutex_, writer thread).
+  std::map<std::pair<std::string, std::uint64_t>, Receipt> fix_receipts_;
+  /// Counts `seq` of (boat, run) as stored in `receipts`; a run not seen since this shore started
+  /// first learns what `table` already holds of it. Caller holds receipts_mutex_.
+  void note_stored(std::map<std::pair<std::string, std::uint64_t>, Receipt>& receipts,
+                   const char* table, const std::string& boat_id, std::uint64_t boot_id,
+                   std::uint64_t seq, std::chrono::steady_clock::time_point now);
   std::uint64_t receipt_updates_ = 0;  ///< under receipts_mutex_
   struct RunSpan {
     std::uint64_t min_t_ns = UINT64_MAX;
@@ -266,9 +279,9 @@ class Store {
   void load_aliases();
 
   StoreConfig config_;
-  sqlite3* db_ = nullptr;      ///< writer connection (samples, sessions, alarms)
+  sqlite3* db_ = nullptr;  ///< writer connection (samples, sessions, alarms)
   sqlite3_stmt* insert_ = nullptr;
-  std::mutex db_mutex_;                               ///< serialises use of db_
+  std::mutex db_mutex_;  ///< serialises use of db_
   /// Read-only connections for queries. SQLite's WAL lets them read side by side and beside the
   /// writer, so a long export no longer queues every chart request behind it: a query takes an
   /// idle one (ReadLease) or waits for one.
