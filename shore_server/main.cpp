@@ -21,6 +21,7 @@
 #include "http_api.hpp"
 #include "json_views.hpp"
 #include "live_hub.hpp"
+#include "manoeuvre_live.hpp"
 #include "query.hpp"
 #include "shore_dds.hpp"
 #include "shutdown.hpp"
@@ -159,6 +160,7 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
   FleetModel fleet(std::chrono::milliseconds(o.stale_ms));
   LiveHub hub(o.http.max_stream_clients, 256, std::chrono::milliseconds(o.stream_interval_ms));
   AlarmService alarms(store, hub, fleet);
+  ManoeuvreLive manoeuvres(hub, fleet, o.session_gap_s);
 
   // Fast DDS calls the listener on its receive thread: it only queues, so reception never waits
   // for the fleet model, the alarms or the dashboards. The recording is queued first; the live
@@ -176,6 +178,7 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
         BoatView view = fleet.update(s, std::chrono::steady_clock::now(), arrival_utc);
         alarms.on_sample(s, view.status ? view.status->group : std::string());
         hub.publish_sample(s.boat_id, [v = std::move(view)] { return boat_json(v); });
+        manoeuvres.on_attitude(s);
       }
     }
   });
@@ -197,7 +200,8 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
     // The dashboards get the position with the boat's next attitude frame (25 Hz): a frame of
     // its own per fix would only add load (and carry the previous attitude's time).
     store.enqueue(f);
-    (void)fleet.update_fix(f, std::chrono::steady_clock::now());
+    // Queued for the manoeuvres, which the live worker finds, never this receive thread.
+    if (fleet.update_fix(f, std::chrono::steady_clock::now())) manoeuvres.queue_fix(f);
   };
   // Fixes resent from a boat's log: the recording only, as backfilled attitude.
   callbacks.on_fix_backfill = [&](const FixSample& f) { store.enqueue(f); };

@@ -1,5 +1,9 @@
 // Manoeuvres end to end: a simulated boat sails its race course (seed 10 tacks ~28 s
-// after the start) into a real shore; the session's /manoeuvres lists the tack, in JSON and CSV.
+// after the start) into a real shore; the session's /manoeuvres lists the tack, in JSON and CSV,
+// and the live stream pushes it, found and then final, measured as the REST endpoint measures it.
+#include <string>
+#include <vector>
+
 #include "shore_fixture.hpp"
 
 namespace telltale::testing {
@@ -69,6 +73,77 @@ TEST_F(ManoeuvreTest, ASimBoatsSessionListsItsTack) {
   auto bad_from = c.Get(base + "/manoeuvres?from=yesterday", bearer());
   ASSERT_TRUE(bad_from);
   EXPECT_EQ(bad_from->status, 400);
+}
+
+// The shore finds the tack itself, from the live samples, and pushes it on /api/v1/stream as
+// an event of type "manoeuvre": first while measuring (final false), then final, with the fields
+// of the REST row and the same values as the session's /manoeuvres.
+TEST_F(ManoeuvreTest, TheStreamPushesTheTackFoundThenFinal) {
+  auto c = client();
+  c.set_read_timeout(10);
+  std::vector<json> events;
+  std::string buffer;
+  const auto started = std::chrono::steady_clock::now();
+  bool boat_started = false;
+  auto res = c.Get("/api/v1/stream", bearer(), [&](const char* data, std::size_t len) {
+    if (!boat_started) {  // the stream is open: nothing the boat sails is missed
+      boat_started = true;
+      start_boat("tack2", {"--seed", "10"});
+    }
+    buffer.append(data, len);
+    std::size_t end;
+    while ((end = buffer.find("\n\n")) != std::string::npos) {
+      const std::string frame = buffer.substr(0, end);
+      buffer.erase(0, end + 2);
+      const auto pos = frame.find("\ndata: ");
+      if (frame.rfind("event: manoeuvre\n", 0) != 0 || pos == std::string::npos) continue;
+      events.push_back(json::parse(frame.substr(pos + 7), nullptr, false));
+    }
+    for (const auto& e : events)
+      if (e.is_object() && e["kind"] == "tack" && e["final"] == true) return false;
+    return std::chrono::steady_clock::now() - started < 90s;
+  });
+  ASSERT_TRUE(boat_started) << "no stream";
+  std::string seen;
+  for (const auto& e : events) seen += e.dump() + "\n";
+  const auto final_at = std::find_if(events.begin(), events.end(), [](const json& e) {
+    return e.is_object() && e["kind"] == "tack" && e["final"] == true;
+  });
+  ASSERT_NE(final_at, events.end()) << "no final tack on the stream in 90 s:\n" << seen;
+  const json& fin = *final_at;
+  // Found first, measuring: the same manoeuvre (t0 within a few seconds) before the final one.
+  const auto found = std::find_if(events.begin(), final_at, [](const json& e) {
+    return e.is_object() && e["final"] == false;
+  });
+  ASSERT_NE(found, final_at) << "the tack came final at once:\n" << seen;
+  EXPECT_EQ((*found)["boat_id"], "tack2");
+  for (const char* field : {"boat_id", "kind", "t_utc", "turn_deg", "turn_dir", "distance_lost_m",
+                            "heel_peak_deg", "entry_sog_m_s", "recovery_s", "final"})
+    EXPECT_TRUE(fin.contains(field)) << field << " missing: " << fin.dump();
+  EXPECT_EQ(fin["boat_id"], "tack2");
+  EXPECT_TRUE(fin["distance_lost_m"].is_number()) << fin.dump();
+  EXPECT_TRUE(fin["heel_peak_deg"].is_number()) << fin.dump();
+
+  // The review of the session: the same tack, the same t0 and metrics.
+  json rest;
+  ASSERT_TRUE(eventually(
+      [&] {
+        const auto s = get_json("/api/v1/sessions?boat=tack2");
+        if (!s.is_array() || s.empty()) return false;
+        rest = get_json("/api/v1/sessions/" + std::to_string(s[0]["id"].get<int>()) + "/manoeuvres");
+        return rest.is_object() && !rest["manoeuvres"].empty();
+      },
+      10s))
+      << rest.dump();
+  const auto& m = rest["manoeuvres"][0];
+  EXPECT_EQ(m["kind"], "tack");
+  EXPECT_EQ(m["t_utc"], fin["t_utc"]) << m.dump() << "\n" << fin.dump();
+  EXPECT_NEAR(m["turn_deg"].get<double>(), fin["turn_deg"].get<double>(), 0.1);
+  EXPECT_NEAR(m["distance_lost_m"].get<double>(), fin["distance_lost_m"].get<double>(), 0.05);
+  EXPECT_NEAR(m["heel_peak_deg"].get<double>(), fin["heel_peak_deg"].get<double>(), 0.05);
+  // The row's every field, no more (one definition of the record), plus boat_id and final.
+  for (const auto& [k, v] : m.items()) EXPECT_TRUE(fin.contains(k)) << k;
+  EXPECT_EQ(fin.size(), m.size() + 2);
 }
 
 }  // namespace
