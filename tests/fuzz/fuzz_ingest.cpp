@@ -57,6 +57,10 @@ Ingest& ingest() {
                              [](const FixSample& f) {
                                FUZZ_CHECK(check(f, kNow) == Reject::kNone);
                                store().enqueue(f);
+                             },
+                             [](const FixSample& f) {
+                               FUZZ_CHECK(check(f, kNow) == Reject::kNone);
+                               store().enqueue(f);
                              }},
                  [] { return kNow; });
   return *i;
@@ -92,7 +96,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   Ingest& door = ingest();
   const auto before = door.counters().rejected_total();
   std::uint64_t accepted_before = 0;
-  for (auto t : {Topic::kAttitude, Topic::kBackfill, Topic::kStatus, Topic::kWearable, Topic::kFix})
+  for (auto t : {Topic::kAttitude, Topic::kBackfill, Topic::kStatus, Topic::kWearable, Topic::kFix,
+                 Topic::kFixBackfill})
     accepted_before += door.counters().accepted(t);
 
   bool handed = true;
@@ -145,7 +150,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       m.fix(static_cast<telltale::msg::FixKind>(in.byte() % 6));
       m.hdop(static_cast<float>(in.raw_double()));
     }
-    if (handed) (void)door.fix(m);
+    if (handed) (void)door.fix(m, (pick & 8) != 0);  // live or resent from the boat's log
   } else {
     telltale::msg::WearableMotion m;
     if (as_cdr) {
@@ -163,7 +168,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (handed) (void)door.wearable(m);
   }
   std::uint64_t accepted_after = 0;
-  for (auto t : {Topic::kAttitude, Topic::kBackfill, Topic::kStatus, Topic::kWearable, Topic::kFix})
+  for (auto t : {Topic::kAttitude, Topic::kBackfill, Topic::kStatus, Topic::kWearable, Topic::kFix,
+                 Topic::kFixBackfill})
     accepted_after += door.counters().accepted(t);
   // Each sample handed to the door is counted exactly once, accepted or refused.
   if (handed)

@@ -33,13 +33,14 @@ struct Sinks {
   std::vector<AttitudeSample> attitude, backfill;
   std::vector<std::pair<std::string, NodeStatusInfo>> status;
   std::vector<WearableSample> wearable;
-  std::vector<FixSample> fixes;
+  std::vector<FixSample> fixes, fix_backfill;
   IngestSinks sinks() {
     return {[this](const AttitudeSample& s) { attitude.push_back(s); },
             [this](const AttitudeSample& s) { backfill.push_back(s); },
             [this](const std::string& id, const NodeStatusInfo& s) { status.emplace_back(id, s); },
             [this](const WearableSample& w) { wearable.push_back(w); },
-            [this](const FixSample& f) { fixes.push_back(f); }};
+            [this](const FixSample& f) { fixes.push_back(f); },
+            [this](const FixSample& f) { fix_backfill.push_back(f); }};
   }
 };
 
@@ -306,6 +307,22 @@ TEST_F(IngestTest, FixesOffTheContractAreRefusedAndCounted) {
   EXPECT_EQ(ingest.counters().rejected(Topic::kFix, Reject::kValue), bad.size());
   EXPECT_EQ(ingest.counters().rejected(Topic::kFix, Reject::kId), 1u);
   EXPECT_EQ(ingest.counters().rejected(Topic::kFix, Reject::kTime), 2u);
+}
+
+// A fix resent from a boat's log passes the same door, into its own sink (the recording only) and
+// its own counters; off the contract it is refused there, as a live one.
+TEST_F(IngestTest, BackfilledFixesPassTheSameDoorIntoTheirOwnSink) {
+  EXPECT_EQ(ingest.fix(good_fix(), true), Reject::kNone);
+  auto m = good_fix();
+  m.lat_deg(91.0);
+  EXPECT_EQ(ingest.fix(m, true), Reject::kValue);
+  EXPECT_TRUE(got.fixes.empty());
+  ASSERT_EQ(got.fix_backfill.size(), 1u);
+  EXPECT_EQ(got.fix_backfill[0].fix, "3d");
+  EXPECT_EQ(ingest.counters().accepted(Topic::kFixBackfill), 1u);
+  EXPECT_EQ(ingest.counters().rejected(Topic::kFixBackfill, Reject::kValue), 1u);
+  EXPECT_EQ(ingest.counters().accepted(Topic::kFix), 0u);
+  EXPECT_TRUE(ingest.counters().to_json()["rejected"].contains("fix_backfill"));
 }
 
 }  // namespace

@@ -193,6 +193,62 @@ TEST_F(StoreTest, ReceiptsSurviveARestart) {
   EXPECT_EQ(store.acks()[0].acked_seq, 7u);
 }
 
+// Fix receipts: per run, the highest fix seq with every fix up to it stored; a fix that comes
+// twice (live, then backfilled from the boat's log) is one row; after a restart the receipt is
+// rebuilt from the fixes on disk; the attitude's receipts are not the fixes'.
+TEST_F(StoreTest, FixReceiptsCountStoredFixesOnceAndSurviveARestart) {
+  const auto fix = [](std::uint64_t boot, std::uint64_t seq) {
+    FixSample f;
+    f.boat_id = "b";
+    f.boot_id = boot;
+    f.seq = seq;
+    f.t_utc_ns = kT0 + seq * kSecond / 10;
+    f.fix = "3d";
+    f.lat_deg = 54.0;
+    f.lon_deg = 10.0;
+    f.sog_m_s = 3.0;
+    f.cog_deg = 90.0;
+    f.satellites = 9;
+    f.hdop = 0.9;
+    return f;
+  };
+  const auto fix_rows = [&] {
+    sqlite3* db = nullptr;
+    EXPECT_EQ(sqlite3_open_v2(config().path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr),
+              SQLITE_OK);
+    sqlite3_stmt* st = nullptr;
+    sqlite3_prepare_v2(db, "SELECT COUNT(*) FROM fixes WHERE boat_id = 'b'", -1, &st, nullptr);
+    sqlite3_step(st);
+    const auto n = sqlite3_column_int64(st, 0);
+    sqlite3_finalize(st);
+    sqlite3_close(db);
+    return n;
+  };
+  {
+    Store store(config());
+    for (std::uint64_t seq : {1u, 2u, 3u, 5u, 6u}) store.enqueue(fix(0x31, seq));
+    store.enqueue(sample("b", 0x31, 1, kT0));
+    store.flush();
+    ASSERT_EQ(store.fix_acks().size(), 1u);
+    EXPECT_EQ(store.fix_acks()[0].boot_id, 0x31u);
+    EXPECT_EQ(store.fix_acks()[0].acked_seq, 3u);  // 4 missing
+    EXPECT_EQ(store.acks()[0].acked_seq, 1u);      // the attitude's own
+    for (std::uint64_t seq : {2u, 3u, 4u})
+      store.enqueue(fix(0x31, seq));  // backfill, 2 and 3 again
+    store.flush();
+    EXPECT_EQ(store.fix_acks()[0].acked_seq, 6u);
+    EXPECT_EQ(fix_rows(), 6);
+  }
+  Store store(config());
+  store.enqueue(fix(0x31, 8));
+  store.flush();
+  EXPECT_EQ(store.fix_acks()[0].acked_seq, 6u);  // 1..6 from disk, 7 missing
+  store.enqueue(fix(0x31, 7));
+  store.flush();
+  EXPECT_EQ(store.fix_acks()[0].acked_seq, 8u);
+  EXPECT_EQ(fix_rows(), 8);
+}
+
 // A link cut longer than the session gap: live data after the cut opens a second session; when
 // the backfill of the cut closes the gap, the two become one session holding every sample.
 TEST_F(StoreTest, BackfillThatClosesTheGapMergesTheSessions) {
@@ -351,7 +407,8 @@ TEST_F(StoreTest, ASlowReadDoesNotHoldUpOtherQueries) {
     });
   });
   holding.get_future().wait();
-  auto other = std::async(std::launch::async, [&] { return store.sessions(std::nullopt, 0, UINT64_MAX); });
+  auto other =
+      std::async(std::launch::async, [&] { return store.sessions(std::nullopt, 0, UINT64_MAX); });
   const bool answered = other.wait_for(std::chrono::seconds(2)) == std::future_status::ready;
   release.set_value();
   slow.join();
@@ -441,7 +498,8 @@ void fill_disk(const std::filesystem::path& path) {
 struct SmallTmpfs {
   explicit SmallTmpfs(const std::filesystem::path& dir) : path(dir) {
     std::filesystem::create_directories(dir);
-    mounted = private_mounts() && ::mount("tmpfs", dir.c_str(), "tmpfs", 0, "size=1m,mode=0755") == 0;
+    mounted =
+        private_mounts() && ::mount("tmpfs", dir.c_str(), "tmpfs", 0, "size=1m,mode=0755") == 0;
   }
   ~SmallTmpfs() {
     if (mounted) ::umount2(path.c_str(), MNT_DETACH);
@@ -555,7 +613,8 @@ TEST_F(StoreTest, FullDiskKeepsWearablesAndFixesAndStoresThemLater) {
   h = store.health();
   EXPECT_FALSE(h.failing) << h.last_error;
   EXPECT_EQ(h.wearable_dropped + h.fixes_dropped, 0u);
-  EXPECT_EQ(store.wearable_track("ann", 0, UINT64_MAX, 100000).size(), static_cast<std::size_t>(kN));
+  EXPECT_EQ(store.wearable_track("ann", 0, UINT64_MAX, 100000).size(),
+            static_cast<std::size_t>(kN));
   EXPECT_EQ(store.track("w", 0, UINT64_MAX, 100000).size(), static_cast<std::size_t>(kN));
 }
 
