@@ -213,5 +213,134 @@ TEST_F(BackfillTest, EarlierRunDeliveredAtTheNextStart) {
   EXPECT_EQ(field(third, "earlier_runs"), "0") << third.output();
 }
 
+// --- GNSS fixes: logged and backfilled like the attitude -----------------------------------------
+
+/// How often the database holds each fix seq of the boat's run `boot_id` (seq -> rows).
+std::map<long, long> stored_fix_seqs(const std::string& db_path, const std::string& boat,
+                                     std::uint64_t boot_id) {
+  std::map<long, long> out;
+  sqlite3* db = nullptr;
+  if (sqlite3_open_v2(db_path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK) {
+    sqlite3_stmt* st = nullptr;
+    if (sqlite3_prepare_v2(db,
+                           "SELECT seq, COUNT(*) FROM fixes WHERE boat_id = ?1 AND boot_id = ?2 "
+                           "GROUP BY seq",
+                           -1, &st, nullptr) == SQLITE_OK) {
+      sqlite3_bind_text(st, 1, boat.c_str(), -1, SQLITE_TRANSIENT);
+      sqlite3_bind_int64(st, 2, static_cast<sqlite3_int64>(boot_id));
+      while (sqlite3_step(st) == SQLITE_ROW)
+        out[static_cast<long>(sqlite3_column_int64(st, 0))] =
+            static_cast<long>(sqlite3_column_int64(st, 1));
+    }
+    sqlite3_finalize(st);
+  }
+  sqlite3_close(db);
+  return out;
+}
+
+/// Every fix seq 1..published of the run stored exactly once; the seqs missing or doubled, as
+/// ranges, in the failure message.
+void expect_fixes_complete(const std::string& db_path, const std::string& boat,
+                           std::uint64_t boot_id, long published) {
+  const auto seqs = stored_fix_seqs(db_path, boat, boot_id);
+  std::string missing, doubled;
+  for (long seq = 1; seq <= published; ++seq) {
+    const auto it = seqs.find(seq);
+    if (it == seqs.end())
+      missing += " " + std::to_string(seq);
+    else if (it->second != 1)
+      doubled += " " + std::to_string(seq);
+  }
+  if (missing.size() > 200) missing = missing.substr(0, 200) + " ...";
+  EXPECT_TRUE(missing.empty()) << "fixes not stored:" << missing;
+  EXPECT_TRUE(doubled.empty()) << "fixes stored twice:" << doubled;
+  EXPECT_EQ(static_cast<long>(seqs.size()), published) << "distinct fix seqs stored vs published";
+}
+
+// Given a boat sailing the simulated course (a fix every 0.1 s), when the shore is killed for 15 s
+// and restarted on the same database, then after the boat stops every fix it published is stored
+// once: the live ones, and the outage's from the boat's log on the fix backfill topic.
+TEST_F(BackfillTest, FixesOfAShoreOutageAreBackfilled) {
+  Process& boat = start_boat("fx1", {"--log-dir", dir_ + "/boatlog"});
+  const std::uint64_t boot = std::stoull(field(boat, "boot"), nullptr, 16);
+  std::this_thread::sleep_for(4s);
+  ASSERT_EQ(shore_->stop(SIGKILL), 128 + SIGKILL);
+  std::this_thread::sleep_for(15s);
+  start_shore();
+  ASSERT_TRUE(eventually([&] { return !boats_by_id().empty(); }, 15s));
+  std::this_thread::sleep_for(6s);
+  ASSERT_EQ(boat.stop(SIGINT, 15s), 0) << boat.output();
+  const auto line = boat.wait_for_line("boat_node stopped: ", 1s);
+  ASSERT_TRUE(line) << boat.output();
+  EXPECT_NE(line->find("shore_has_all_fixes=yes"), std::string::npos) << *line;
+  const long fixes = std::stol(field(boat, "fixes"));
+  ASSERT_GT(fixes, 10 * 20) << *line;
+  std::this_thread::sleep_for(600ms);  // the shore's commit interval
+  expect_fixes_complete(db_path(), "fx1", boot, fixes);
+  // The track the REST API serves has the outage's positions too: no hole of the outage's length
+  // (the simulated course has a position every 0.1 s).
+  const auto track = get_json("/api/v1/boats/fx1/track?max_points=100000");
+  ASSERT_TRUE(track.is_object() && track["t_s"].is_array()) << track;
+  ASSERT_GT(track["t_s"].size(), 10u * 20);
+  double largest_step_s = 0;
+  for (std::size_t i = 1; i < track["t_s"].size(); ++i)
+    largest_step_s =
+        std::max(largest_step_s, track["t_s"][i].get<double>() - track["t_s"][i - 1].get<double>());
+  EXPECT_LT(largest_step_s, 1.0) << "a hole in the track";
+}
+
+// Given a boat whose every outgoing packet is dropped for 15 s, when the link returns, then every
+// fix of the cut is stored once (the fix receipts told the boat what was missing).
+TEST_F(BackfillTest, FixesOfACutLinkAreBackfilled) {
+  Process& boat = start_boat("fx2", {"--log-dir", dir_ + "/boatlog", "--fault-drop-link", "3:15"});
+  const std::uint64_t boot = std::stoull(field(boat, "boot"), nullptr, 16);
+  ASSERT_TRUE(eventually([&] { return boats_by_id().count("fx2") == 1; }, 10s));
+  std::this_thread::sleep_for(22s);  // through the cut and back
+  ASSERT_EQ(boat.stop(SIGINT, 15s), 0) << boat.output();
+  const auto line = boat.wait_for_line("boat_node stopped: ", 1s);
+  ASSERT_TRUE(line) << boat.output();
+  EXPECT_NE(line->find("shore_has_all_fixes=yes"), std::string::npos) << *line;
+  const long fixes = std::stol(field(boat, "fixes"));
+  ASSERT_GT(fixes, 10 * 20) << *line;
+  std::this_thread::sleep_for(600ms);
+  expect_fixes_complete(db_path(), "fx2", boot, fixes);
+}
+
+// Given a boat stopped while the shore was down, when it starts again with the shore up, then it
+// delivers the earlier run's fixes from its log (and marks them delivered), beside its new run.
+TEST_F(BackfillTest, EarlierRunFixesDeliveredAtTheNextStart) {
+  ASSERT_EQ(shore_->stop(SIGTERM), 0);
+  const std::vector<std::string> log = {"--log-dir", dir_ + "/boatlog"};
+  long first_fixes = 0;
+  std::uint64_t first_boot = 0;
+  {
+    Process& boat = start_boat("fx3", log);
+    first_boot = std::stoull(field(boat, "boot"), nullptr, 16);
+    std::this_thread::sleep_for(3s);
+    ASSERT_EQ(boat.stop(SIGINT, 15s), 0) << boat.output();
+    const auto line = boat.wait_for_line("boat_node stopped: ", 1s);
+    ASSERT_TRUE(line) << boat.output();
+    EXPECT_NE(line->find("shore_has_all_fixes=no"), std::string::npos) << *line;
+    first_fixes = std::stol(field(boat, "fixes"));
+    ASSERT_GT(first_fixes, 10);
+  }
+  boats_.clear();
+  start_shore();
+  Process& boat = start_boat("fx3", log);
+  EXPECT_EQ(field(boat, "earlier_fix_runs"), "1") << boat.output();
+  const auto delivered = boat.wait_for_line("boat_node fixes: earlier run ", 30s);
+  ASSERT_TRUE(delivered) << boat.output();
+  EXPECT_NE(delivered->find("delivered"), std::string::npos) << *delivered;
+  std::this_thread::sleep_for(600ms);  // the shore's commit interval
+  expect_fixes_complete(db_path(), "fx3", first_boot, first_fixes);
+  ASSERT_EQ(boat.stop(SIGINT, 15s), 0) << boat.output();
+  const auto line = boat.wait_for_line("boat_node stopped: ", 1s);
+  ASSERT_TRUE(line) << boat.output();
+  EXPECT_NE(line->find("earlier_fix_runs_pending=0"), std::string::npos) << *line;
+  boats_.clear();
+  Process& third = start_boat("fx3", log);
+  EXPECT_EQ(field(third, "earlier_fix_runs"), "0") << third.output();
+}
+
 }  // namespace
 }  // namespace telltale::testing
