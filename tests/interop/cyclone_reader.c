@@ -10,17 +10,17 @@
  *     build/bin/cyclone_reader --domain 0 --seconds 10
  *
  * Output lines (one per line, fields key=value, texts in double quotes):
- *   cyclone_reader ready: domain=D topics=8
+ *   cyclone_reader ready: domain=D topics=10
  *   matched topic=T writers=N               when the number of matched writers changes
  *   incompatible topic=T policy=NAME count=N a writer was refused (a QoS or representation clash)
  *   sample topic=T field=value ...           the first --print samples of each topic
  *   counts T=N T=N ...                       every second
  *   cyclone_reader stopped: T=N T=N ...      at the end
  *
- * Reader QoS: best effort for the best-effort topics (accepts any writer); reliable for backfill;
- * reliable + transient local for status, alarm rules and alarm events (their writers keep the
- * latest per instance for late joiners). No deadline or liveliness: a reader without them
- * matches any writer.
+ * Reader QoS: best effort for the best-effort topics (accepts any writer); reliable for both
+ * backfills (attitude and fixes); reliable + transient local for status, alarm rules and alarm
+ * events (their writers keep the latest per instance for late joiners). No deadline or
+ * liveliness: a reader without them matches any writer.
  */
 #include <inttypes.h>
 #include <signal.h>
@@ -150,6 +150,10 @@ static struct TopicSpec topics[] = {
      print_wearable, 0, 0, 0, 0, 0},
     {"telltale_boat_fix", &telltale_msg_BoatFix_desc, kVolatileBestEffort, print_fix, 0, 0, 0, 0,
      0},
+    {"telltale_boat_fix_backfill", &telltale_msg_BoatFix_desc, kVolatileReliable, print_fix, 0, 0,
+     0, 0, 0},
+    {"telltale_shore_fix_ack", &telltale_msg_ShoreAck_desc, kVolatileBestEffort, print_ack, 0, 0,
+     0, 0, 0},
 };
 enum { kTopicCount = sizeof topics / sizeof topics[0] };
 

@@ -1,7 +1,8 @@
 // The wire, read by another vendor: an Eclipse Cyclone DDS reader built from
 // Cyclone's own idlc output for idl/telltale.idl must receive and decode every Telltale topic,
-// written by the real Fast DDS binaries (boat_node: attitude, backfill, status; shore_server:
-// receipts, alarm rules, alarm events; wearable_node: wearable motion and status) and, for
+// written by the real Fast DDS binaries (boat_node: attitude, backfill, fix backfill, status;
+// shore_server: receipts of both kinds, alarm rules, alarm events; wearable_node: wearable motion
+// and status) and, for
 // BoatFix, both the boat's simulated course and a Fast DDS writer in this test on the production
 // profiles whose every value is known. Everything on a private domain on 127.0.0.1
 // (tests/interop/cyclone_loopback.xml).
@@ -150,9 +151,11 @@ std::vector<Sample> samples_of(const std::string& output) {
 /// Samples each topic must deliver: a second of live data, a run's backfill, a few receipts and
 /// statuses, the one rule and at least one event.
 const std::map<std::string, long> kMinimum = {
-    {"telltale_boat_attitude", 50},  {"telltale_boat_backfill", 20}, {"telltale_shore_ack", 3},
-    {"telltale_node_status", 3},     {"telltale_alarm_rules", 1},    {"telltale_alarm_events", 1},
-    {"telltale_wearable_motion", 3}, {"telltale_boat_fix", 10}};
+    {"telltale_boat_attitude", 50},     {"telltale_boat_backfill", 20},
+    {"telltale_shore_ack", 3},          {"telltale_node_status", 3},
+    {"telltale_alarm_rules", 1},        {"telltale_alarm_events", 1},
+    {"telltale_wearable_motion", 3},    {"telltale_boat_fix", 10},
+    {"telltale_boat_fix_backfill", 10}, {"telltale_shore_fix_ack", 3}};
 
 /// A count of the reader's "counts" line; -1 when the topic is missing.
 long count_of(const std::map<std::string, std::string>& counts, const std::string& topic) {
@@ -198,7 +201,7 @@ TEST_F(InteropTest, CycloneReaderDecodesEveryTopic) {
   const std::string boat_out = boat.output();
   ASSERT_TRUE(std::regex_search(boat_out, m, std::regex(R"(boot=([0-9a-f]{16}))"))) << boat_out;
   const std::uint64_t boot = std::stoull(m[1], nullptr, 16);
-  std::this_thread::sleep_for(4s);  // ~100 samples the shore will lack: backfill
+  std::this_thread::sleep_for(4s);  // ~100 samples and ~40 fixes the shore will lack: backfill
 
   start_shore();
   auto c = client();
@@ -256,6 +259,30 @@ TEST_F(InteropTest, CycloneReaderDecodesEveryTopic) {
       EXPECT_EQ(s.str("boat_id"), kBoat);
       EXPECT_EQ(s.u64("boot_id"), boot);
       EXPECT_TRUE(plausible_time(s.u64("t_utc_ns")));
+    } else if (s.topic == "telltale_shore_fix_ack") {
+      // The boat's fixes and the test writer's are both recorded, so both get receipts.
+      if (s.str("boat_id") == kBoat) {
+        EXPECT_EQ(s.u64("boot_id"), boot);
+      } else {
+        EXPECT_EQ(s.str("boat_id"), kFixBoat);
+        EXPECT_EQ(s.u64("boot_id"), kFixBoot);
+      }
+      EXPECT_TRUE(plausible_time(s.u64("t_utc_ns")));
+    } else if (s.topic == "telltale_boat_fix_backfill") {
+      // The boat's fixes from before the shore started, from its log: every member as sent.
+      EXPECT_EQ(s.str("boat_id"), kBoat);
+      EXPECT_EQ(s.u64("boot_id"), boot);
+      EXPECT_GE(s.u64("seq"), 1U);
+      EXPECT_TRUE(plausible_time(s.u64("t_utc_ns")));
+      const int kind = std::stoi(s.str("fix"));
+      EXPECT_TRUE(kind >= 0 && kind <= 3) << kind;
+      if (kind > 0) {
+        EXPECT_GE(s.num("lat_deg"), -90.0);
+        EXPECT_LE(s.num("lat_deg"), 90.0);
+        EXPECT_GE(s.num("lon_deg"), -180.0);
+        EXPECT_LE(s.num("lon_deg"), 180.0);
+        EXPECT_GE(s.num("sog_m_s"), 0.0);
+      }
     } else if (s.topic == "telltale_node_status") {
       EXPECT_TRUE(s.str("node_id") == kBoat || s.str("node_id") == kAthlete || s.str("kind") == "2")
           << s.str("node_id");
