@@ -17,7 +17,7 @@
 /// directory is kept under `max_bytes` by deleting the oldest files first, whatever their kind
 /// (never a file this run is still writing): a day of positions is worth as much as a day of
 /// heel, and two budgets would each have to be sized for the worst case. At 25 Hz attitude and
-/// 10 Hz fixes the log grows by 12 MB per hour, so the default 1 GiB holds about 3.5 days of
+/// 10 Hz fixes the log grows by 12.1 MB per hour, so the default 1 GiB holds about 3.7 days of
 /// sailing.
 ///
 /// Every write is checked. A write that fails (disk full, I/O error) leaves no torn record: the
