@@ -1,6 +1,6 @@
 // Manoeuvres on the dashboard, against two simulated boats of one race whose seeds
 // tack early (seed 10: ~28 s after the node starts, seed 328: ~25 s): the live fleet card shows
-// the tack within 30 s of its exit; in the review, a list row's time moves the scrubber to its
+// the tack the shore pushes on the stream (no polling) within 30 s of its exit; in the review, a list row's time moves the scrubber to its
 // t0, two tacks (one per boat) overlay aligned each at its own t0, and the boats are ranked by
 // the shore's mean distance lost. The boats keep sailing: the review reads their live sessions.
 import assert from 'node:assert/strict';
@@ -59,20 +59,45 @@ test('review before any manoeuvre, and a failed fetch: one clear message each', 
   }
 });
 
-test('live: the fleet card shows the tack and its distance lost within 30 s of its exit', async (t) => {
+test('live: the fleet card shows the tack the stream pushes, its distance lost within 30 s of its exit, with no polling', async (t) => {
+  // The shore's "manoeuvre" events, recorded on an EventSource of the page's own.
+  await page.evaluate(() => {
+    window.__manoeuvres = [];
+    const es = new EventSource('/api/v1/stream');
+    es.addEventListener('manoeuvre', (e) => window.__manoeuvres.push({ ...JSON.parse(e.data), at: Date.now() / 1000 }));
+  });
+  const asked = []; // the fleet view's REST calls for manoeuvres: one per boat when it opens
+  const onRequest = (r) => { if (/\/manoeuvres(\?|$)/.test(new URL(r.url()).pathname + new URL(r.url()).search)) asked.push(Date.now() / 1000); };
+  page.on('request', onRequest);
   await page.evaluate(() => { location.hash = '#/fleet'; });
+  const openedAt = Date.now() / 1000;
   await page.waitForSelector(`.card[data-boat="${A}"]`, { timeout: 5000 });
   const row = `.card[data-boat="${A}"] .last-manoeuvre`;
   let shownAt = null;
+  let measuring = false;
   const seen = await eventually(async () => {
     const d = await page.$eval(row, (r) => (r.hidden ? null : { ...r.dataset, text: r.textContent }));
     if (d && shownAt === null) shownAt = Date.now() / 1000;
+    if (d?.final === 'false') measuring = true;
     return d?.final === 'true' ? { ...d, at: Date.now() / 1000 } : null;
   }, { timeoutMs: 80000, intervalMs: 250, what: `${A}'s card to show a measured manoeuvre` });
+  page.off('request', onRequest);
   const { m } = await finalTack(A);
   const t0 = secondsOf(m.t_utc);
   assert.equal(seen.kind, 'tack');
   assert.ok(Math.abs(Number(seen.t0) - t0) < 0.01, `card t0 ${seen.t0} vs REST ${t0}`);
+  // Driven by the stream: the card is the shore's final event of that tack, found first.
+  const events = (await page.evaluate(() => window.__manoeuvres)).filter((e) => e.boat_id === A);
+  const fin = events.find((e) => e.final && Math.abs(secondsOf(e.t_utc) - t0) < 12);
+  assert.ok(fin, `a final manoeuvre event for ${A}: ${JSON.stringify(events)}`);
+  assert.equal(fin.kind, seen.kind);
+  assert.equal(secondsOf(fin.t_utc), Number(seen.t0), `card t0 ${seen.t0} vs event ${fin.t_utc}`);
+  assert.equal(fin.distance_lost_m, Number(seen.lost));
+  assert.ok(events.some((e) => !e.final && e.at <= fin.at), 'found (measuring) before final');
+  assert.ok(measuring, 'the card said "measuring" before the distance lost was final');
+  // No polling: at most the one call per boat when the view opened, none later.
+  assert.ok(asked.length <= 2, `${asked.length} REST calls for manoeuvres`);
+  assert.ok(asked.every((at) => at - openedAt < 5), `REST calls after the view opened: ${asked.map((a) => (a - openedAt).toFixed(1))}`);
   // Exit: the end of the turn (90 % of it done), half its 10-90 % duration after t0.
   const exit = t0 + m.turn_duration_s / 2;
   t.diagnostic(`tack shown ${(shownAt - exit).toFixed(1)} s, its distance lost ${(seen.at - exit).toFixed(1)} s after the exit`);

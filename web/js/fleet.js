@@ -110,10 +110,10 @@ export function mountFleet(container, { live }) {
     if (sort.value !== 'id') arrange();
     for (const c of cards.values()) updateManoeuvre(c); // its age
   }, 1000);
-  const stopManoeuvres = has('/sessions/{id}/manoeuvres') ? watchManoeuvres((id, m) => {
+  const stopManoeuvres = watchManoeuvres(live, (id, m) => {
     if (cards.has(id)) updateManoeuvre(cards.get(id), m);
     else pending.set(id, m);
-  }) : () => {};
+  }, { fill: has('/sessions/{id}/manoeuvres') });
 
   return () => {
     live.removeEventListener('boat', onBoat);

@@ -19,6 +19,8 @@ export class Live extends EventTarget {
     this.source.addEventListener('sample', (e) => this.addBoat(JSON.parse(e.data)));
     this.source.addEventListener('alarm', (e) => this.addAlarm(JSON.parse(e.data)));
     this.source.addEventListener('wearable', (e) => this.addAthlete(JSON.parse(e.data)));
+    // A boat's manoeuvre, found or final (manoeuvre_live.js keeps each boat's last).
+    this.source.addEventListener('manoeuvre', (e) => this.emit('manoeuvre', JSON.parse(e.data)));
     this.source.addEventListener('overflow', () => this.emit('overflow', null));
   }
 
