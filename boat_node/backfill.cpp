@@ -139,6 +139,9 @@ void BasicBackfiller<Codec>::run() {
 template <class Codec>
 bool BasicBackfiller<Codec>::drain(std::chrono::milliseconds quiet,
                                    std::chrono::milliseconds patience) {
+  // Nothing published, nothing to hand over: a boat without a GNSS fix (no receiver, no data)
+  // has no fix receipt to wait for, and the shore sends none for a run it has no fix of.
+  if (published_.load() == 0) return true;
   draining_.store(true);
   force_resend_.store(true);  // the run thread may resend at once
   const auto started = std::chrono::steady_clock::now();

@@ -54,7 +54,8 @@ class BasicBackfiller {
   /// Sends everything up to the last published sample and waits for the shore's receipt. Gives
   /// up after `quiet` if the shore has not been heard for `quiet` (a cut link, a shore gone: the
   /// log keeps the samples); while the shore is heard, or was heard within `quiet` (it may be
-  /// restarting), waits up to `patience`. True if the shore has it all.
+  /// restarting), waits up to `patience`. True if the shore has it all (at once when nothing
+  /// was published).
   bool drain(std::chrono::milliseconds quiet, std::chrono::milliseconds patience);
 
   [[nodiscard]] std::uint64_t acked() const { return acked_.load(); }

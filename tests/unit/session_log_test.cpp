@@ -1,5 +1,5 @@
 // The boat's session log across runs: which earlier runs still need delivering, and how far
-// each one goes on disk.
+// each one goes on disk; both record kinds (attitude, GNSS fixes); the backfill's stop.
 #include "session_log.hpp"
 
 #include <fcntl.h>
@@ -13,6 +13,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+
+#include "backfill.hpp"
 
 namespace telltale::boat {
 namespace {
@@ -127,7 +129,8 @@ TEST_F(SessionLogRuns, BufferedRecordsAreNotAFailure) {
 }
 
 TEST_F(SessionLogFaults, DiskFullSpellLosesNothingAndReportsIt) {
-  if (!mount_tmpfs("size=256k,mode=0755")) FAIL() << "needs root and mount namespaces (a fault test fails, never skips, without them)";
+  if (!mount_tmpfs("size=256k,mode=0755"))
+    FAIL() << "needs root and mount namespaces (a fault test fails, never skips, without them)";
   const auto ballast = dir_ / "ballast";
   {
     // Fill the filesystem, then give back a little over one page.
@@ -197,7 +200,8 @@ TEST_F(SessionLogRuns, ReaderResynchronisesAfterATornRecord) {
 // Given a log directory that exists but cannot be written (a read-only mount), the log refuses
 // to open: a boat must not say "ready" and then sail without a log.
 TEST_F(SessionLogFaults, ReadOnlyDirectoryIsRefused) {
-  if (!mount_tmpfs("size=64k", MS_RDONLY)) FAIL() << "needs root and mount namespaces (a fault test fails, never skips, without them)";
+  if (!mount_tmpfs("size=64k", MS_RDONLY))
+    FAIL() << "needs root and mount namespaces (a fault test fails, never skips, without them)";
   EXPECT_THROW(SessionLog({dir_, "ro", 0x1, 100000, 1ULL << 30}), std::runtime_error);
 }
 
@@ -328,6 +332,17 @@ TEST_F(SessionLogRuns, OneDiskBudgetOverBothKinds) {
   EXPECT_EQ(FixLogReader(dir_, "bd", 0x1).read(1, 50).size(), 0u);
   EXPECT_EQ(FixLogReader(dir_, "bd", 0x2).read(31, 35).size(), 5u);
   EXPECT_EQ(SessionLogReader(dir_, "bd", 0x2).read(31, 35).size(), 5u);
+}
+
+// Given a run that published no fix (no receiver, or no data from it), the stop's drain of the
+// fixes returns at once: the shore sends no fix receipt for a run it has no fix of, and waiting
+// for one held every such boat's stop for 3 s.
+TEST_F(SessionLogRuns, DrainWithNothingPublishedDoesNotWait) {
+  FixBackfiller backfiller({0x5, 50, 2500, std::chrono::milliseconds(5000)},
+                           FixLogReader(dir_, "nf", 0x5), [](const FixRecord&) { return true; });
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_TRUE(backfiller.drain(std::chrono::seconds(3), std::chrono::seconds(10)));
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::milliseconds(500));
 }
 
 // Given a fix log on a small real filesystem, when the disk fills for a while and is then given
