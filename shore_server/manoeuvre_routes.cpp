@@ -90,8 +90,8 @@ void register_manoeuvre_routes(httplib::Server& server, ShoreContext& ctx) {
     const auto rel = [base](std::uint64_t t) {
       return t >= base ? static_cast<double>(t - base) * 1e-9 : -static_cast<double>(base - t) * 1e-9;
     };
-    // `from` (a live session polled by the fleet view): only the manoeuvres from then, read
-    // from the data of the 45 s before it on, not the whole session.
+    // `from` (the fleet view filling in a live boat when it opens): only the manoeuvres from
+    // then, read from the data of the 45 s before it on, not the whole session.
     const std::string* from_param = param(req, "from");
     const std::uint64_t from_ns = from_param ? parse_range(from_param, nullptr).from_ns : 0;
     const std::uint64_t read_from = std::max(s->start_ns, from_ns > kLookbackNs ? from_ns - kLookbackNs : 0);
