@@ -110,7 +110,14 @@ void TelltaleAttitudeFilter::initialise(const ImuSample& s) {
   state_.start_pending = params_.start_fit_s > 0.0;
 }
 
-void TelltaleAttitudeFilter::begin_start_fit() {
+void TelltaleAttitudeFilter::start_wait(bool at_rest, bool gap, double dt) {
+  State& st = state_;
+  st.start_elapsed_s += dt;  // since the first sample, while waiting
+  if (at_rest || st.start_elapsed_s >= params_.start_fit_s) {
+    st.start_pending = false;
+    return;
+  }
+  if (gap || !(st.speed_m_s > params_.rest_max_speed_m_s)) return;
   // The GNSS speed says the sensor is under way: the start is a hull's in a seaway, and the
   // growing mean the filter began with is the wrong model there (its first values are single
   // samples, one wave's acceleration, and the drift between them was read as a bias of several
@@ -123,7 +130,6 @@ void TelltaleAttitudeFilter::begin_start_fit() {
   // start_fit_s of sea (two periods of the slowest wave) whenever the receiver's first fix
   // comes, and a fix a few seconds late (a receiver's cold start) would otherwise leave it one
   // wave's half swing. The cost is the start ending that much later, at most start_fit_s.
-  State& st = state_;
   const double a0 = params_.start_acc_sigma_m_s2 / params_.g_m_s2;
   const double var0 = params_.bias_sigma_init_rad_s * params_.bias_sigma_init_rad_s;
   st.start_pending = false;
@@ -381,14 +387,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // a phone or a bench has no GNSS, and never enters it. A rest ends the wait (it measures the
   // bias far better, and a platform at rest is in no seaway); a gap does not (the fit starts
   // from the estimate whenever it starts), but the fit never starts at one.
-  if (st.start_pending) {
-    st.start_elapsed_s += dt;
-    if (at_rest || st.start_elapsed_s >= p.start_fit_s) {
-      st.start_pending = false;
-    } else if (!gap && st.speed_m_s > p.rest_max_speed_m_s) {
-      begin_start_fit();
-    }
-  }
+  if (st.start_pending) start_wait(at_rest, gap, dt);
   // The fit runs until start_fit_s have passed since it began, or a rest or a gap comes first
   // (a rest measures the bias far better; over a gap the line breaks). Then the low-pass takes
   // over below, in its steady state at the start's vertical, with its bias covariance.
