@@ -106,6 +106,11 @@ void ManoeuvreTracker::on_attitude(const AttitudeSample& sample) {
     b.heel.pop_front();
 }
 
+std::size_t ManoeuvreTracker::held(const std::string& boat_id) const {
+  const auto it = boats_.find(boat_id);
+  return it == boats_.end() ? 0 : it->second.course.size() + it->second.heel.size();
+}
+
 void ManoeuvreTracker::forget(const std::string& boat_id) { boats_.erase(boat_id); }
 
 void ManoeuvreTracker::retain(const std::function<bool(const std::string&)>& known) {

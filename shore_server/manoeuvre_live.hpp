@@ -109,6 +109,8 @@ class ManoeuvreTracker {
   void release(const std::string& boat_id);
 
   [[nodiscard]] std::size_t boats() const { return boats_.size(); }
+  /// Samples (fixes and attitude) held for a boat: its window.
+  [[nodiscard]] std::size_t held(const std::string& boat_id) const;
   /// Detector runs so far (all boats).
   [[nodiscard]] std::uint64_t runs() const { return runs_; }
 

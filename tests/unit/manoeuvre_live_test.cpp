@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -191,6 +192,59 @@ TEST_P(ManoeuvreLiveRace, WithTheWindEstimatedReportsTheSameManoeuvresMostlyOfTh
 INSTANTIATE_TEST_SUITE_P(Seeds, ManoeuvreLiveRace,
                          ::testing::Values(Case{10, false}, Case{328, false}, Case{3, true},
                                            Case{7, true}));
+
+// Whatever a boat sends, the tracker neither throws nor grows: time going back a little (dropped)
+// or by more than the window (the boat starts over), NaN course and speed, the ends of the time
+// range, a boat publishing far faster than any does. Boats the fleet model forgot are forgotten.
+TEST(ManoeuvreLive, BadInputNeverThrowsAndEachBoatsWindowStaysBounded) {
+  std::vector<LiveManoeuvre> out;
+  ManoeuvreTracker tracker([&](const LiveManoeuvre& m) { out.push_back(m); });
+  const Race r = sail(10, 900, false);
+  FixSample f = r.fixes[0];
+  AttitudeSample a = r.attitude[0];
+  for (const std::uint64_t t : {std::uint64_t{0}, ~std::uint64_t{0}, kStartNs, kStartNs - 1,
+                                kStartNs + 1, std::uint64_t{1}, kStartNs}) {
+    f.t_utc_ns = a.t_utc_ns = t;
+    f.cog_deg = f.sog_m_s = std::numeric_limits<double>::quiet_NaN();
+    a.heel_deg = std::numeric_limits<double>::infinity();
+    EXPECT_NO_THROW(tracker.on_fix(f));
+    EXPECT_NO_THROW(tracker.on_attitude(a));
+  }
+  // A fast publisher: 1 kHz of both for 10 minutes keeps at most the caps.
+  f.boat_id = a.boat_id = "fast";
+  for (int k = 0; k < 600'000; ++k) {
+    f.t_utc_ns = a.t_utc_ns = kStartNs + static_cast<std::uint64_t>(k) * 1'000'000;
+    f.cog_deg = 90.0 + (k / 30'000 % 2) * 90.0;  // a turn every 30 s
+    f.sog_m_s = 3.0;
+    a.heel_deg = 10.0;
+    tracker.on_fix(f);
+    tracker.on_attitude(a);
+  }
+  const ManoeuvreTracker::Config caps;
+  EXPECT_LE(tracker.held("fast"), caps.max_fixes + caps.max_attitude);
+  // The race, with a stretch of it sent again late (dropped) and its clock set back an hour
+  // midway (started over): still its manoeuvres, nothing thrown.
+  std::size_t n = 0;
+  out.clear();
+  for (std::size_t i = 0; i < r.fixes.size(); ++i) {
+    FixSample g = r.fixes[i];
+    if (i >= 3000) g.t_utc_ns -= 3'600'000'000'000ULL;
+    tracker.on_fix(g);
+    if (i % 500 == 499) tracker.on_fix(r.fixes[i - 100]);
+    ++n;
+  }
+  EXPECT_EQ(n, r.fixes.size());
+  EXPECT_TRUE(std::any_of(out.begin(), out.end(), [](const LiveManoeuvre& m) {
+    return m.boat_id == "sim" && m.final;
+  }));
+  EXPECT_EQ(tracker.boats(), 2u);
+  EXPECT_LE(tracker.held("sim"), caps.max_fixes + caps.max_attitude);
+  tracker.retain([](const std::string& id) { return id == "sim"; });
+  EXPECT_EQ(tracker.boats(), 1u);
+  EXPECT_EQ(tracker.held("fast"), 0u);
+  tracker.forget("sim");
+  EXPECT_EQ(tracker.boats(), 0u);
+}
 
 }  // namespace
 }  // namespace telltale::shore
