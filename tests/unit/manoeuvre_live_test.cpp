@@ -10,8 +10,11 @@
 #include <cstdlib>
 #include <limits>
 #include <string>
+#include <thread>
 #include <vector>
 
+#include "live_hub.hpp"
+#include "manoeuvre_routes.hpp"
 #include "telltale/fusion/sim/course.hpp"
 
 namespace telltale::shore {
@@ -244,6 +247,57 @@ TEST(ManoeuvreLive, BadInputNeverThrowsAndEachBoatsWindowStaysBounded) {
   EXPECT_EQ(tracker.held("fast"), 0u);
   tracker.forget("sim");
   EXPECT_EQ(tracker.boats(), 0u);
+}
+
+// In the shore: fixes queued by another thread (as the DDS listener queues them), attitude from
+// the live worker, and each report on the live hub as an SSE event "manoeuvre": the REST row
+// with boat_id and final, found and then final, only for clients that may see the boat.
+TEST(ManoeuvreLive, TheShoreQueuesFixesAndPushesManoeuvreEventsOnTheHub) {
+  const Race r = sail(10, 120, false);
+  LiveHub hub(4, 256, std::chrono::milliseconds(1));
+  const auto coach = hub.connect();
+  const auto other_athlete = hub.connect("other");
+  FleetModel fleet(std::chrono::milliseconds(2000));
+  ManoeuvreLive live(hub, fleet, 60.0);
+  std::size_t f = 0;
+  for (const auto& a : r.attitude) {
+    (void)fleet.update(a, std::chrono::steady_clock::now(), a.t_utc_ns);
+    std::thread receiver([&] {
+      while (f < r.fixes.size() && r.fixes[f].t_utc_ns <= a.t_utc_ns) live.queue_fix(r.fixes[f++]);
+    });
+    receiver.join();
+    live.on_attitude(a);
+  }
+  std::string text;
+  bool closed = false;
+  for (std::string got; !(got = hub.wait(*coach, std::chrono::milliseconds(20), closed)).empty();)
+    text += got;
+  std::vector<nlohmann::json> events;
+  const std::string head = "event: manoeuvre\ndata: ";
+  for (std::size_t at = 0; (at = text.find(head, at)) != std::string::npos;) {
+    at += head.size();
+    events.push_back(nlohmann::json::parse(text.substr(at, text.find('\n', at) - at)));
+  }
+  ASSERT_EQ(events.size(), 2u) << text;
+  EXPECT_EQ(events[0]["final"], false);
+  EXPECT_EQ(events[1]["final"], true);
+  const ManoeuvreReport batch = analyse_manoeuvres(r.course, r.heel);
+  ASSERT_FALSE(batch.manoeuvres.empty());
+  const Manoeuvre& m = batch.manoeuvres[0];
+  for (const auto& e : events) {
+    EXPECT_EQ(e["boat_id"], "sim");
+    EXPECT_EQ(e["kind"], to_string(m.kind));
+  }
+  // The REST row's every field, as its writer makes it, plus boat_id and final.
+  nlohmann::json row = manoeuvre_object(m, ns_at(m.t0_s));
+  EXPECT_EQ(events[1]["t_utc"], row["t_utc"]);
+  EXPECT_NEAR(events[1]["distance_lost_m"].get<double>(), m.distance_lost_m, 0.05);
+  row["boat_id"] = "sim";
+  row["final"] = true;
+  for (const auto& [k, v] : row.items()) EXPECT_TRUE(events[1].contains(k)) << k;
+  EXPECT_EQ(events[1].size(), row.size());
+  EXPECT_TRUE(hub.wait(*other_athlete, std::chrono::milliseconds(5), closed).find("manoeuvre") ==
+              std::string::npos);
 }
 
 }  // namespace
