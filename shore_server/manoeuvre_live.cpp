@@ -145,9 +145,11 @@ void ManoeuvreTracker::run(const std::string& id, Boat& b) {
   const bool quiet = steady(course_buf_, kQuietS, kQuietDeg);
   for (const auto& m : rep.manoeuvres) {
     if (b.trimmed && m.t0_s < start + kLeadS) continue;
+    // The nearest report not yet taken by another manoeuvre of this run: tacks of a tacking
+    // duel, 10 s apart, stay apart.
     Seen* same = nullptr;
     for (auto& s : b.seen)
-      if (std::abs(s.t0_s - m.t0_s) < kSameManoeuvreS &&
+      if (s.run != runs_ && std::abs(s.t0_s - m.t0_s) < kSameManoeuvreS &&
           (!same || std::abs(s.t0_s - m.t0_s) < std::abs(same->t0_s - m.t0_s)))
         same = &s;
     // The windows end 25 s after t0, the course after the turn 15 s after its end: later than
@@ -157,11 +159,13 @@ void ManoeuvreTracker::run(const std::string& id, Boat& b) {
     const bool final = data_end >= windows_end && (quiet || data_end >= m.t0_s + kFinalByS);
     if (same && (same->final || !final)) {
       same->t0_s = m.t0_s;  // follows t0 as it settles, so the next run still matches it
+      same->run = runs_;
       continue;
     }
     if (!same) same = &b.seen.emplace_back();
     same->t0_s = m.t0_s;
     same->final = final;
+    same->run = runs_;
     sink_({id, m, at_ns(b.base_ns, m.t0_s), final});
     if (final) {
       b.history.push_back(m);

@@ -38,8 +38,9 @@
 ///
 /// Cost per sample O(1) amortised (a deque push and trim); the detector, O(window), runs per boat
 /// every 2 s of data: measured 62 us of CPU per boat and second of data, 6 % of one core for
-/// 1000 boats (bench/manoeuvre_live_bench.cpp). Memory per boat is bounded by the window and by a cap on samples (a boat
-/// publishing faster than 20 fixes / 50 attitude samples a second keeps less than 90 s).
+/// 1000 boats (bench/manoeuvre_live_bench.cpp). Memory per boat is bounded by the window and by
+/// a cap on samples (a boat publishing faster than 20 fixes / 50 attitude samples a second keeps
+/// less than 90 s).
 /// Single-threaded: every call from one thread (the shore's live worker).
 
 #include <atomic>
@@ -118,6 +119,7 @@ class ManoeuvreTracker {
   struct Seen {
     double t0_s = 0.0;
     bool final = false;
+    std::uint64_t run = 0;  ///< the run that last matched it: one manoeuvre per run
   };
   struct Boat {
     std::uint64_t base_ns = 0;  ///< the time base: the boat's first sample

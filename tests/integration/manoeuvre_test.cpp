@@ -130,7 +130,8 @@ TEST_F(ManoeuvreTest, TheStreamPushesTheTackFoundThenFinal) {
       [&] {
         const auto s = get_json("/api/v1/sessions?boat=tack2");
         if (!s.is_array() || s.empty()) return false;
-        rest = get_json("/api/v1/sessions/" + std::to_string(s[0]["id"].get<int>()) + "/manoeuvres");
+        rest = get_json("/api/v1/sessions/" + std::to_string(s[0]["id"].get<int>()) +
+                        "/manoeuvres");
         return rest.is_object() && !rest["manoeuvres"].empty();
       },
       10s))
