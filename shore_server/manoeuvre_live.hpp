@@ -144,6 +144,8 @@ class ManoeuvreTracker {
 
 /// The tracker in the shore: fed by the live worker, reporting to the dashboards as SSE events
 /// of type `manoeuvre` (the REST row of /sessions/{id}/manoeuvres plus `boat_id` and `final`).
+/// No session id: only the store's writer thread knows a boat's open session, and asking SQLite
+/// from the live worker is what this replaces; the card needs none.
 /// Fixes arrive on the DDS receive thread, which only queues them (queue_fix); the live worker
 /// takes them with the next attitude sample, so the detector never runs on the receive thread.
 class ManoeuvreLive {
