@@ -4,6 +4,7 @@
 #include <fastrtps/types/TypesBase.h>
 #include <fastrtps/utils/IPLocator.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <filesystem>
@@ -127,8 +128,17 @@ Participant::Participant(const DdsOptions& options, const std::string& name)
 Participant::~Participant() {
   if (!participant_) return;
   if (announcer_) announcer_->stop();
-  participant_->delete_contained_entities();
-  DomainParticipantFactory::get_instance()->delete_participant(participant_);
+  // Readers stop calling their listeners before they are deleted: samples keep arriving while the
+  // entities go, and a listener is often destroyed right after this participant.
+  std::vector<fdds::DataReader*> readers;
+  if (subscriber_->get_datareaders(readers) == ReturnCode_t::RETCODE_OK)
+    for (auto* r : readers) r->set_listener(nullptr);
+  // A participant Fast DDS refuses to delete keeps running (its readers, their listeners): say so
+  // rather than leave it silent. A destructor cannot throw.
+  if (participant_->delete_contained_entities() != ReturnCode_t::RETCODE_OK ||
+      DomainParticipantFactory::get_instance()->delete_participant(participant_) !=
+          ReturnCode_t::RETCODE_OK)
+    std::fprintf(stderr, "telltale dds: a DDS participant could not be deleted (left running)\n");
 }
 
 fdds::Topic* Participant::topic(const std::string& topic_name, fdds::TypeSupport type) {
