@@ -33,6 +33,10 @@ Target target_for(const std::string& scenario) {
   // 10 seeds at 25 Hz (before the start's Kalman filter and the course's bias update: 1.5 and
   // 6.6). The goal, 2 deg after 5 s and 1 after 15 s, is not met (attitude_regimes_test).
   if (scenario.starts_with("underway-")) return {0.6, 2.8};
+  // The race: the course's boat, its tacks and gybes flipping the heel some 28 deg in ~3 s,
+  // started under way, with the GNSS speed and course. 0.28 / 1.24 measured over 10 seeds at
+  // 25 Hz (0.29 / 1.26 at 100 Hz). A new scenario, not a filter change: held to what it does.
+  if (scenario == "race") return {0.4, 1.6};
   return {0.4, 1.0};  // pendulum (every amplitude, both mountings), turntable, desk
 }
 

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "telltale/fusion/attitude.hpp"
+#include "telltale/fusion/sim/race.hpp"
 #include "telltale/fusion/sim/scenario.hpp"
 
 namespace telltale::fusion::sim {
@@ -197,25 +198,57 @@ class DeskTrajectory final : public SmoothTrajectory {
 };
 
 // ---------------------------------------------------------------------------------------------
+/// The dinghy's sea, shared by the dinghy and the race: a chop of 2..3 s waves (0.3..0.5 Hz)
+/// that rolls the hull +-3 deg, pitches it +-5 deg and yaws it +-2 deg, heaves it (+-0.2 m),
+/// moves it to and fro along the wind (orbital surge) and sideways across it (sway); ~1.5 m/s^2
+/// of acceleration in all. Seeded streams 11..16.
+class Waves {
+ public:
+  Waves(std::uint64_t seed, double wind_dir_rad)
+      : roll_(seed, 11, 0.6 * kDeg, 1.2 * kDeg, 0.3, 0.5),
+        pitch_(seed, 12, 1.0 * kDeg, 2.0 * kDeg, 0.3, 0.5),
+        yaw_(seed, 13, 0.3 * kDeg, 0.8 * kDeg, 0.3, 0.5),
+        heave_(seed, 14, 0.04, 0.10, 0.3, 0.5),
+        orbit_(seed, 15, 0.03, 0.08, 0.3, 0.5),
+        sway_(seed, 16, 0.02, 0.05, 0.3, 0.5),
+        along_(std::cos(wind_dir_rad), std::sin(wind_dir_rad), 0.0),
+        across_(-along_.y(), along_.x(), 0.0) {}
+  /// The waves' heel, pitch and yaw at t, rad.
+  [[nodiscard]] double roll(double t) const { return roll_.value(t); }
+  [[nodiscard]] double pitch(double t) const { return pitch_.value(t); }
+  [[nodiscard]] double yaw(double t) const { return yaw_.value(t); }
+  /// Adds the waves' velocity (world frame: heave, surge along the wind, sway across it) to v:
+  /// the rate of e(t) times the waves' displacement, e rising from 0 to 1 at de (the dinghy
+  /// putting to sea; 1 and 0 once at sea).
+  void add_velocity(double t, double e, double de, Eigen::Vector3d& v) const {
+    v.z() += de * heave_.value(t) + e * heave_.rate(t);
+    v += (de * orbit_.value(t) + e * orbit_.rate(t)) * along_;
+    v += (de * sway_.value(t) + e * sway_.rate(t)) * across_;
+  }
+
+ private:
+  Sines roll_, pitch_, yaw_, heave_, orbit_, sway_;
+  Eigen::Vector3d along_, across_;
+};
+
+/// The instrument on the bow of both boats: 1.5 m ahead of the centre of gravity, 0.25 m above.
+Eigen::Vector3d bow_lever_arm() { return {1.5, 0.0, 0.25}; }
+
+// ---------------------------------------------------------------------------------------------
 class DinghyTrajectory final : public SmoothTrajectory {
  public:
   DinghyTrajectory(std::uint64_t seed, double rest_s)
       : seed_(seed),
         rest_(rest_s),
-        roll_waves_(seed, 11, 0.6 * kDeg, 1.2 * kDeg, 0.3, 0.5),
-        pitch_waves_(seed, 12, 1.0 * kDeg, 2.0 * kDeg, 0.3, 0.5),
-        yaw_waves_(seed, 13, 0.3 * kDeg, 0.8 * kDeg, 0.3, 0.5),
-        heave_(seed, 14, 0.04, 0.10, 0.3, 0.5),
-        orbit_(seed, 15, 0.03, 0.08, 0.3, 0.5),
-        sway_(seed, 16, 0.02, 0.05, 0.3, 0.5),
-        wind_dir_(2.0 * M_PI * hash_uniform(seed, 17, 0)) {}
+        wind_dir_(2.0 * M_PI * hash_uniform(seed, 17, 0)),
+        waves_(seed, wind_dir_) {}
 
   [[nodiscard]] Eigen::Quaterniond attitude(double t) const override {
     const double e = envelope(t);
     const double s = side(t);
-    const double heel = e * (s * (12.0 * kDeg + gust(t)) + roll_waves_.value(t));
-    const double pitch = 1.0 * kDeg + e * pitch_waves_.value(t);
-    const double yaw = wind_dir_ + s * 45.0 * kDeg + e * yaw_waves_.value(t);
+    const double heel = e * (s * (12.0 * kDeg + gust(t)) + waves_.roll(t));
+    const double pitch = 1.0 * kDeg + e * waves_.pitch(t);
+    const double yaw = wind_dir_ + s * 45.0 * kDeg + e * waves_.yaw(t);
     return attitude_from_euler(heel, pitch, yaw);
   }
   [[nodiscard]] Eigen::Vector3d velocity_world(double t) const override {
@@ -231,16 +264,10 @@ class DinghyTrajectory final : public SmoothTrajectory {
       speed -= 1.2 * std::exp(-d * d);
     }
     Eigen::Vector3d v(e * speed * std::cos(yaw), e * speed * std::sin(yaw), 0.0);
-    // Waves: heave, orbital surge along the wind, sway across it (world frame).
-    const Eigen::Vector3d along(std::cos(wind_dir_), std::sin(wind_dir_), 0.0);
-    const Eigen::Vector3d across(-along.y(), along.x(), 0.0);
-    v.z() += de * heave_.value(t) + e * heave_.rate(t);
-    v += (de * orbit_.value(t) + e * orbit_.rate(t)) * along;
-    v += (de * sway_.value(t) + e * sway_.rate(t)) * across;
+    waves_.add_velocity(t, e, de, v);
     return v;
   }
-  /// The instrument on the bow: 1.5 m ahead of the centre of gravity, 0.25 m above it.
-  [[nodiscard]] static Eigen::Vector3d lever_arm() { return {1.5, 0.0, 0.25}; }
+  [[nodiscard]] static Eigen::Vector3d lever_arm() { return bow_lever_arm(); }
 
  private:
   [[nodiscard]] double envelope(double t) const { return smooth_step(t, rest_ + 5.0, 2.0); }
@@ -273,8 +300,61 @@ class DinghyTrajectory final : public SmoothTrajectory {
   }
   std::uint64_t seed_;
   double rest_;
-  Sines roll_waves_, pitch_waves_, yaw_waves_, heave_, orbit_, sway_;
   double wind_dir_;
+  Waves waves_;
+};
+
+// ---------------------------------------------------------------------------------------------
+/// The race: the body sails the course of a RaceCourse (race.hpp) in the dinghy's waves, the
+/// instrument on its bow. Its truth is the course's boat, so what the IMU reads is what that
+/// boat's motion makes a sensor at the bow read (ImuScenario: the mean body rate from the
+/// attitude increments; specific_force_body: the specific force at the lever arm):
+///   gyro = the body rate of R = Rz(yaw) Ry(-pitch) Rx(heel): the heading's rate resolved in
+///     the heeled and pitched body (R_x(heel)^T R_y(-pitch)^T (0, 0, d yaw/dt): a turn while
+///     heeled shows on the y gyro too), plus the pitch rate about the pitched y axis and the heel
+///     rate about x (the flip through a tack is a ~14 deg/s roll), waves' roll, pitch and yaw
+///     included;
+///   accelerometer = R^T (a_cg + g up) + alpha x r + omega x (omega x r):
+///     gravity, the reason the tilt can be measured at all;
+///     a_cg = d/dt (speed (sin hdg, cos hdg)): its along-track part is the surge (the speed
+///     halving through a tack, the recovery, the gusts), its across-track part the centripetal
+///     speed x turn rate (0.9 m/s^2 in a 3 m/s tack: 5 deg of false heel to a filter that does not
+///     take it off with the GNSS speed), plus the waves' heave, surge and sway;
+///     alpha x r, omega x (omega x r): the bow, 1.5 m from the centre, swings round it in the
+///     turns and in the waves' pitch and roll.
+class RaceTrajectory final : public SmoothTrajectory {
+ public:
+  RaceTrajectory(std::shared_ptr<RaceCourse> course, std::uint64_t seed)
+      : course_(std::move(course)),
+        // The waves run with the mean wind (ENU angle of the direction it comes from).
+        waves_(seed, M_PI / 2.0 - course_->mean_wind_from_deg() * kDeg) {}
+  RigidMotion motion(double t) override {
+    // The spline needs two knots ahead of the latest query (finite differences reach a few ms
+    // past it): a second covers both.
+    course_->advance_to(t + 1.0);
+    return SmoothTrajectory::motion(t);
+  }
+  [[nodiscard]] Eigen::Quaterniond attitude(double t) const override {
+    const RaceCourse::Smooth b = course_->smooth_at(t);
+    // Heel: the course's (to leeward, flipping through each tack and gybe) plus the waves' roll.
+    // Pitch: the dinghy's 1 deg trim plus the waves'. Yaw (ENU, counter-clockwise from east):
+    // the course's heading (clockwise from north) plus the waves' yaw.
+    return attitude_from_euler(b.heel_rad + waves_.roll(t), 1.0 * kDeg + waves_.pitch(t),
+                               M_PI / 2.0 - b.heading_rad + waves_.yaw(t));
+  }
+  [[nodiscard]] Eigen::Vector3d velocity_world(double t) const override {
+    const RaceCourse::Smooth b = course_->smooth_at(t);
+    // The centre of gravity goes where the bow points (the course has no leeway) at the
+    // course's speed, plus the waves (at sea from the start: e = 1).
+    Eigen::Vector3d v(b.speed_m_s * std::sin(b.heading_rad), b.speed_m_s * std::cos(b.heading_rad),
+                      0.0);
+    waves_.add_velocity(t, 1.0, 0.0, v);
+    return v;
+  }
+
+ private:
+  std::shared_ptr<RaceCourse> course_;
+  Waves waves_;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -413,7 +493,7 @@ const std::vector<std::string>& scenario_names() {
     }
     n.insert(n.end(), {"turntable", "desk", "dinghy"});
     for (int r : {10, 30, 60, 90, 120}) n.push_back("yaw-" + std::to_string(r));
-    n.insert(n.end(), {"underway-5", "underway-15"});
+    n.insert(n.end(), {"underway-5", "underway-15", "race"});
     return n;
   }();
   return names;
@@ -421,6 +501,7 @@ const std::vector<std::string>& scenario_names() {
 
 double scenario_default_duration_s(std::string_view name) {
   if (name == "dinghy") return 300.0;
+  if (name == "race") return 600.0;
   if (name.starts_with("underway-")) return 60.0;
   return 65.0;
 }
@@ -483,7 +564,23 @@ std::unique_ptr<ImuScenario> make_scenario(std::string_view name, std::uint64_t 
                                               offset),
         DinghyTrajectory::lever_arm(), rate_hz, duration_s, warmup, seed, options, true);
   }
+  if (name == "race") {
+    return make_race_scenario(std::make_shared<RaceCourse>(seed), seed, rate_hz, duration_s,
+                              options);
+  }
   return nullptr;
+}
+
+std::unique_ptr<ImuScenario> make_race_scenario(std::shared_ptr<RaceCourse> course,
+                                                std::uint64_t seed, double rate_hz,
+                                                double duration_s, const ScenarioOptions& options) {
+  if (!(rate_hz > 0.0) || !course) return nullptr;
+  // Under way from the first sample (the node joins the race already sailing), scored like
+  // underway-15: from 15 s.
+  constexpr double kWarmup = 15.0;
+  return std::make_unique<ImuScenario>(std::make_unique<RaceTrajectory>(std::move(course), seed),
+                                       bow_lever_arm(), rate_hz, duration_s, kWarmup, seed, options,
+                                       true);
 }
 
 }  // namespace telltale::fusion::sim

@@ -1,7 +1,8 @@
 #pragma once
 /// \file
 /// Streaming IMU scenarios with ground truth (used by `fusion_cli simulate`, the tests, eval, and
-/// the boat node's `--source sim:SCENARIO`, which runs `dinghy` live and endlessly).
+/// the boat node's `--source sim:SCENARIO`; plain `--source sim` runs `race` live and endlessly,
+/// on the same course as its simulated receiver: race.hpp).
 ///
 ///   auto sc = sim::make_scenario("dinghy", seed, 25.0, 0.0);   // 0 = endless
 ///   ImuSample imu; sim::AttitudeTruth truth;
@@ -25,7 +26,12 @@
 ///     from the end of the rest.
 ///   underway-5, underway-15: the dinghy joined 100..120 s into its script (sailing in waves,
 ///     instrument on the bow, no rest before the first sample), 60 s; scored from 5 s or 15 s.
-/// The dinghy and underway scenarios also have a GNSS receiver (gnss_fix()): speed
+///   race: the boat of the windward-leeward race (course.hpp, the same seed) as a rigid body:
+///     heading, speed and heel (to leeward, flipping at each tack and gybe) are the course's,
+///     smoothed over ~0.14 s (race.hpp); the dinghy's waves and 1 deg trim, the instrument on its
+///     bow. Under way from the first sample (no rest); 600 s (a beat with its tacks, the
+///     windward mark, the run with its gybes); scored from 15 s.
+/// The dinghy, underway and race scenarios also have a GNSS receiver (gnss_fix()): speed
 /// and course over ground of the boat's centre at ScenarioOptions::gnss_rate_hz, with noise and
 /// latency.
 /// Sensor: ImuErrorModel with the L3G4200D/LSM303DLH defaults of imu_errors.hpp.
