@@ -56,4 +56,44 @@ TEST_F(StepsCli, TimeGoingBackwardsIsAnErrorNamingFileLineAndColumn) {
       << read("err.txt");
 }
 
+// Given a trial laid out as the IPOL healthy-gait folder (README: steps reported inside the
+// U-turn are left out; the annotated steps are those outside it): a lower-back sensor walking 12
+// steps at 2 steps/s, every heel strike annotated, two of them inside the U-turn. When
+// steps-eval scores it, then the README column compares the 10 steps found outside the U-turn
+// with the 10 annotated outside it (100 %), and the column against every annotated step says
+// 83 %. (The table once printed the latter as the README rule.)
+TEST_F(StepsCli, IpolReadmeRuleLeavesTheUTurnOutOfTheAnnotationsToo) {
+  namespace fs = std::filesystem;
+  fs::create_directories(path("data/ipol_gait"));
+  std::ofstream csv(path("data/ipol_gait/9-1_lb.imu.csv"));
+  csv << "t_s,ax_m_s2,ay_m_s2,az_m_s2,gx_rad_s,gy_rad_s,gz_rad_s\n";
+  // Walking from 2 s to 8 s: the trunk's vertical force -1.5 cos(2 pi 2 t) peaks once a step,
+  // at the loading after each heel strike: 2.25, 2.75, ..., 7.75 s.
+  for (int n = 0; n < 1000; ++n) {
+    const double t = n / 100.0;
+    const double walking = (t >= 2.0 && t < 8.0) ? 1.0 : 0.0;
+    const double az = 9.81 - walking * 1.5 * std::cos(2.0 * M_PI * 2.0 * (t - 2.0));
+    csv << t << ",0.1,0.2," << az << ",0,0,0\n";
+  }
+  csv.close();
+  std::string left, right;
+  for (int k = 0; k < 12; ++k) {
+    const int hs = 225 + 50 * k;  // sample index (100 Hz)
+    std::string& foot = k % 2 == 0 ? left : right;
+    foot += std::string(foot.empty() ? "" : ", ") + "[" + std::to_string(hs - 40) + ", " +
+            std::to_string(hs) + "]";
+  }
+  // U-turn 4.5-5.5 s: the heel strikes at 4.75 and 5.25 s are inside it.
+  write("data/ipol_gait/9-1.json",
+        "{\"TrialBoundaries\": [185, 775], \"UTurnBoundaries\": [450, 550], \"LeftFootEvents\": [" +
+            left + "], \"RightFootEvents\": [" + right + "]}");
+  ASSERT_EQ(run("steps-eval --tables ipol --data " + path("data")), 0) << read("err.txt");
+  const std::string out = read("out.txt");
+  const auto row = out.find("| 9-1_lb | 10 / 12 |");
+  ASSERT_NE(row, std::string::npos) << out;
+  const std::string line = out.substr(row, out.find('\n', row) - row);
+  // The last column is gait-phase, the lower back's default (fusion_cli steps --mount body).
+  EXPECT_NE(line.find("| 10 (100 / 83) |", line.size() - 20), std::string::npos) << line;
+}
+
 }  // namespace
