@@ -37,7 +37,7 @@ struct EvalOptions {
   int loops = 40;
   /// First loop seed: 2001 is the report set; the PDR was tuned on 100-139 (--first-seed 100).
   int first_seed = 2001;
-  bool detail = false;                     ///< IPOL: every file's misses and extras
+  bool detail = false;                       ///< IPOL: every file's misses and extras
   std::string detail_method = "gait-phase";  ///< ...of this detector
 };
 
