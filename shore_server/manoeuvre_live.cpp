@@ -22,15 +22,16 @@ constexpr double kLeadS = 30.0;
 // report (a boat whose IMU went quiet still gets its manoeuvres measured).
 constexpr double kHeelLagS = 5.0;
 
-// The boat sailed a steady course over the window's last `span_s` seconds: every COG within
-// `tolerance_deg` of their circular mean (true without a COG: a boat too slow for one turns no
-// manoeuvre).
-bool steady(const std::vector<fusion::CourseSample>& course, double span_s, double tolerance_deg) {
+// The boat sailed a steady course over [from_s, to_s]: every COG there within `tolerance_deg` of
+// their circular mean (true without a COG: a boat too slow for one turns no manoeuvre).
+bool steady(const std::vector<fusion::CourseSample>& course, double from_s, double to_s,
+            double tolerance_deg) {
   constexpr double kRad = std::numbers::pi / 180.0;
-  const double from = course.back().t_s - span_s;
-  auto first = course.end();
+  auto first = course.end(), last = course.end();
+  while (last != course.begin() && std::prev(last)->t_s > to_s) --last;
+  first = last;
   double sx = 0.0, sy = 0.0;
-  while (first != course.begin() && std::prev(first)->t_s >= from) {
+  while (first != course.begin() && std::prev(first)->t_s >= from_s) {
     --first;
     if (!std::isfinite(first->cog_deg)) continue;
     sx += std::cos(first->cog_deg * kRad);
@@ -38,7 +39,7 @@ bool steady(const std::vector<fusion::CourseSample>& course, double span_s, doub
   }
   if (sx == 0.0 && sy == 0.0) return true;
   const double mean = std::atan2(sy, sx) / kRad;
-  for (auto it = first; it != course.end(); ++it)
+  for (auto it = first; it != last; ++it)
     if (std::abs(std::remainder(it->cog_deg - mean, 360.0)) > tolerance_deg) return false;
   return true;
 }
@@ -142,7 +143,7 @@ void ManoeuvreTracker::run(const std::string& id, Boat& b) {
   // Heel complete up to a grid tick once a sample at or after it is in (the grid takes the latest
   // at or before each tick), so heel a tick behind the course holds nothing back.
   const double data_end = heel_end >= end - kHeelLagS ? std::min(end, heel_end + 0.1) : end;
-  const bool quiet = steady(course_buf_, kQuietS, kQuietDeg);
+  const bool quiet = steady(course_buf_, end - kQuietS, end, kQuietDeg);
   for (const auto& m : rep.manoeuvres) {
     if (b.trimmed && m.t0_s < start + kLeadS) continue;
     // The nearest report not yet taken by another manoeuvre of this run: tacks of a tacking
@@ -156,7 +157,15 @@ void ManoeuvreTracker::run(const std::string& id, Boat& b) {
     // that for a long turn (a 720's t0 is half its turning done, its end ~half its duration on).
     const double turn_half = std::isfinite(m.turn_duration_s) ? m.turn_duration_s / 1.6 : 0.0;
     const double windows_end = m.t0_s + std::max(config_.final_after_s, turn_half + 16.0);
-    const bool final = data_end >= windows_end && (quiet || data_end >= m.t0_s + kFinalByS);
+    // A turn begun later than 16 s after this one's end changes nothing of it: the detector
+    // measures its course after over the 15 s from its padded end (~0.9 s after the turn's) and
+    // joins turns less than 3 s apart only. Checked 3 s further, as the course needs ~1 s of a
+    // helm's turn to leave kQuietDeg and the detector's rate sees a turn 0.5 s early.
+    const double turn_end = m.t0_s + turn_half;
+    const bool settled = data_end >= turn_end + 19.0 &&
+                         steady(course_buf_, turn_end + 1.0, turn_end + 19.0, kQuietDeg);
+    const bool final = data_end >= windows_end &&
+                       (settled || quiet || data_end >= m.t0_s + kFinalByS);
     if (same && (same->final || !final)) {
       same->t0_s = m.t0_s;  // follows t0 as it settles, so the next run still matches it
       same->run = runs_;

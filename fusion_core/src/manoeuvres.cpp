@@ -167,42 +167,101 @@ Grid make_grid(std::span<const CourseSample> in, std::span<const HeelSample> hee
   return g;
 }
 
-/// A detected turn before classification.
+/// A turn before classification.
 struct Turn {
-  long peak = 0;            // tick of largest change
-  double delta = 0.0;       // the change there, deg
-  long ks = 0, ke = 0;      // continuous turn [ks, ke]
+  long peak = 0;            // tick of the largest course rate
+  long a = 0, b = 0;        // the ticks turning faster than 2 deg/s, first and last
+  long ks = 0, ke = 0;      // [a, b] padded by 0.5 s, from steady course to steady course
   double total = 0.0;       // unwrapped turning over it, deg (signed)
-  double before = 0.0, after = 0.0;  // mean unwrapped course 20-5 s before / 5-20 s after t0
+  double before = 0.0, after = 0.0;  // mean unwrapped course before / after the turn
+  double side_sog = kNaN, side_heel_abs = kNaN;  // how it sailed there (WindTurn)
   double t0_k = 0.0;        // fractional tick
   bool penalty = false;
 };
 
-/// The continuous turn through `peak`: course rate of one sign above 2 deg/s, dips < 1 s bridged.
-void extend_turn(const Grid& g, Turn& m) {
-  // Sign: the largest |rate| within 3 s of the peak.
-  double best = 0.0;
-  long at = m.peak;
-  for (long k = m.peak - 30; k <= m.peak + 30; ++k) {
-    if (k < 0 || k >= static_cast<long>(g.n)) continue;
-    const double r = g.rate(static_cast<std::size_t>(k));
-    if (std::isfinite(r) && std::abs(r) > std::abs(best)) best = r, at = k;
+/// The unwrapped course at k, or the nearest known one towards `toward` (a tick inside the
+/// turn): the ends of a turn padded into a gap still measure it.
+double course_near(const Grid& g, long k, long toward) {
+  const long step = toward >= k ? 1 : -1;
+  for (; k != toward + step; k += step) {
+    const double u = g.course[static_cast<std::size_t>(k)];
+    if (std::isfinite(u)) return u;
   }
-  const double s = best >= 0 ? 1.0 : -1.0;
-  const auto turning = [&](long k) {
-    if (k < 0 || k >= static_cast<long>(g.n)) return false;
-    const double r = g.rate(static_cast<std::size_t>(k));
-    return std::isfinite(r) && s * r > 2.0;
-  };
-  long a = at, b = at;
-  for (long gap = 0; a > 0 && gap <= 10; --a) gap = turning(a - 1) ? 0 : gap + 1;
-  for (long gap = 0; b + 1 < static_cast<long>(g.n) && gap <= 10; ++b) gap = turning(b + 1) ? 0 : gap + 1;
-  while (a < at && !turning(a)) ++a;
-  while (b > at && !turning(b)) --b;
-  m.ks = std::max(0L, a - 5);
-  m.ke = std::min(static_cast<long>(g.n) - 1, b + 5);
-  const double u0 = g.course[static_cast<std::size_t>(m.ks)], u1 = g.course[static_cast<std::size_t>(m.ke)];
-  m.total = std::isfinite(u0) && std::isfinite(u1) ? u1 - u0 : 0.0;
+  return kNaN;
+}
+
+/// Every continuous turn of the data: a run of ticks whose course rate (1 s central difference)
+/// has one sign and exceeds 2 deg/s, dips of 0.3 s bridged (a noisy fix), ended by turning the
+/// other way; longer pauses are judged by the caller (a wobbly tack, or a tack then a mark).
+/// 2 deg/s is ten times what following a wind shift takes (5 deg over a few minutes) and well
+/// under any helm's turn (a tack: 10-30 deg/s), so the runs are the helm's turns. The turn's
+/// ends are padded by 0.5 s, the central difference's half width, so its total is measured from
+/// steady course to steady course. Turns under `min_total_deg` (course corrections, COG noise in
+/// waves) are dropped: they neither make a manoeuvre nor split a neighbouring one.
+std::vector<Turn> continuous_turns(const Grid& g, double min_total_deg) {
+  std::vector<Turn> out;
+  const long n = static_cast<long>(g.n);
+  const auto rate = [&](long k) { return g.rate(static_cast<std::size_t>(k)); };
+  long k = 0;
+  while (k < n) {
+    const double r = rate(k);
+    if (!std::isfinite(r) || std::abs(r) <= 2.0) {
+      ++k;
+      continue;
+    }
+    const double s = r > 0 ? 1.0 : -1.0;
+    long b = k, peak = k;
+    for (long j = k + 1, gap = 0; j < n; ++j) {
+      const double rj = rate(j);
+      if (std::isfinite(rj) && s * rj > 2.0) {
+        b = j, gap = 0;
+        if (std::abs(rj) > std::abs(rate(peak))) peak = j;
+      } else if ((std::isfinite(rj) && -s * rj > 2.0) || ++gap > 3) {
+        break;
+      }
+    }
+    Turn t;
+    t.peak = peak;
+    t.a = k;
+    t.b = b;
+    t.ks = std::max(0L, k - 5);
+    t.ke = std::min(n - 1, b + 5);
+    const double u0 = course_near(g, t.ks, peak), u1 = course_near(g, t.ke, peak);
+    t.total = std::isfinite(u0) && std::isfinite(u1) ? u1 - u0 : 0.0;
+    if (std::abs(t.total) >= min_total_deg) out.push_back(t);
+    k = b + 1;
+  }
+  return out;
+}
+
+/// No neighbouring turn on that side (side_means).
+constexpr long kNoPrev = std::numeric_limits<long>::min() / 4;
+constexpr long kNoNext = std::numeric_limits<long>::max() / 4;
+
+/// The mean courses before and after turn m over up to `span` ticks each, cut where the
+/// neighbouring turns are turning (`prev_b`, `next_a`: their last and first turning ticks;
+/// kNoPrev / kNoNext without one; their padding may overlap m's when 1-2 s apart). Uncut, a side
+/// needs half its span of data: a turn the data ends 1 s after is not measured yet. Anchored on the
+/// unwrapped turn: `before` on the course where the turn starts, `after` on the same unwrapping
+/// as the turn measured through it (a 720 stays 720). false when a side has too little data.
+bool side_means(const Grid& g, Turn& m, long span, long prev_b, long next_a) {
+  // Each side from the padded end outwards; where a neighbour turns within the padding (turns
+  // 1-2 s apart), the unpadded gap between the two. Never into the turn itself nor past the
+  // data: a turn still going on where the data ends has no course after yet.
+  long from = std::max(m.ks - span, prev_b + 1), b0 = m.ks;
+  if (from >= b0 && prev_b != kNoPrev) from = prev_b + 1, b0 = m.a;
+  long a0 = m.ke + 1, to = std::min(m.ke + 1 + span, next_a);
+  if (to <= a0 && next_a != kNoNext) a0 = m.b + 1, to = next_a;
+  m.before = g.mean_unwrapped(from, b0);
+  m.after = g.mean_unwrapped(a0, to);
+  m.side_sog = 0.5 * (g.mean_sog(from, b0) + g.mean_sog(a0, to));
+  m.side_heel_abs = 0.5 * (std::abs(g.mean_heel(from, b0)) + std::abs(g.mean_heel(a0, to)));
+  if (!std::isfinite(m.before) || !std::isfinite(m.after)) return false;
+  const double u0 = course_near(g, m.ks, m.peak);
+  if (std::isfinite(u0)) m.before += 360.0 * std::round((u0 - m.before) / 360.0);
+  const double raw = m.after - m.before;
+  m.after = m.before + raw - 360.0 * std::round((raw - m.total) / 360.0);
+  return true;
 }
 
 /// Kind from the wind: where the unwrapped path from the course before crosses the wind.
@@ -224,16 +283,46 @@ ManoeuvreKind classify(double before_deg, double total_deg, double wind_from, bo
 }
 
 /// What the wind estimate needs of a measured turn: the unwrapped mean course before it, its
-/// signed turn (after - before), whether it is a penalty turn, and its bisector.
+/// signed turn (after - before), whether it is a penalty turn, its bisector, and how the boat
+/// sailed on the steady courses either side: mean SOG and mean |heel| (NaN when unknown).
 struct WindTurn {
   double before = 0.0, total = 0.0;
   bool penalty = false;
   double bisector = 0.0;
+  double sog = kNaN, heel_abs = kNaN;
 };
 
+/// Which end of the wind axis is upwind, as evidence for `wind`: > 0 when the turns it calls
+/// tacks sailed as a boat sails upwind, against the ones it calls gybes. The physics, strongest
+/// first:
+///  - heel: the apparent wind is the true wind plus the boat's own speed when beating and minus
+///    it when running, so every sailing boat heels more close-hauled than running (a dinghy:
+///    10-20 deg against 0-6, whichever side it runs on);
+///  - speed: close-hauled is a boat's slowest point of sail; every polar runs faster than it
+///    beats at the wind speeds a race sails in.
+/// 0 when it calls no turn a tack or none a gybe (nothing to compare).
+double upwind_evidence(const std::vector<WindTurn>& turns, double wind) {
+  double heel[2] = {0, 0}, sog[2] = {0, 0};
+  int nh[2] = {0, 0}, ns[2] = {0, 0};
+  for (const auto& m : turns) {
+    const auto k = classify(wrap360(m.before), m.total, wind, m.penalty);
+    if (k != ManoeuvreKind::kTack && k != ManoeuvreKind::kGybe) continue;
+    const int i = k == ManoeuvreKind::kTack ? 0 : 1;
+    if (std::isfinite(m.heel_abs)) heel[i] += m.heel_abs, ++nh[i];
+    if (std::isfinite(m.sog)) sog[i] += m.sog, ++ns[i];
+  }
+  if (nh[0] && nh[1]) {
+    const double d = heel[0] / nh[0] - heel[1] / nh[1];
+    if (std::abs(d) >= 1.0) return d;  // a degree of heel apart: the heel says it
+  }
+  if (ns[0] && ns[1]) return sog[1] / ns[1] - sog[0] / ns[0];
+  return 0.0;
+}
+
 /// The wind estimated from the turns (see the file comment): the axis from the doubled bisectors
-/// of the turns of 50-140 deg, its sign from the tacks turning more than the gybes, then twice
-/// the median of the tacks' bisectors and the gybes' inverted.
+/// of the turns of 50-140 deg, its upwind end from how the boat sailed (upwind_evidence; with
+/// tacks or gybes only, from tacks turning more than 72 deg), then twice the median of the
+/// tacks' bisectors and the gybes' inverted.
 std::optional<double> wind_from_turns(const std::vector<WindTurn>& turns) {
   std::vector<double> doubled;
   for (const auto& m : turns) {
@@ -243,8 +332,11 @@ std::optional<double> wind_from_turns(const std::vector<WindTurn>& turns) {
   if (doubled.empty()) return std::nullopt;
   std::optional<double> wind;
   const double axis = circular_median(doubled) / 2.0;
+  const double evidence = upwind_evidence(turns, axis);
+  if (evidence != 0.0) wind = evidence > 0 ? axis : wrap360(axis + 180.0);
   double best_score = -1e300;
   for (double cand : {axis, wrap360(axis + 180.0)}) {
+    if (evidence != 0.0) break;
     double score = 0.0;
     for (const auto& m : turns) {
       const auto k = classify(wrap360(m.before), m.total, cand, m.penalty);
@@ -291,75 +383,63 @@ ManoeuvreReport analyse_manoeuvres(std::span<const CourseSample> course,
   const long n = static_cast<long>(g.n);
   const long w = std::lround(o.window_s / kDt);
 
-  // 1. Candidates: runs of ticks where the 10 s means before and after differ enough.
-  std::vector<Turn> cands;
-  bool in_run = false;
-  Turn cur;
-  for (long k = w; k + w < n; ++k) {
-    const double b = g.mean_course(k - w, k), a = g.mean_course(k + 1, k + 1 + w);
-    const double sog = g.mean_sog(k - w, k);
-    const double d = std::isfinite(a) && std::isfinite(b) ? std::abs(diff180(a, b)) : 0.0;
-    const bool hit = d >= o.min_turn_deg && std::isfinite(sog) && sog >= o.min_sog_m_s;
-    if (hit) {
-      if (!in_run || d > cur.delta) cur.peak = k, cur.delta = d;
-      in_run = true;
-    } else if (in_run) {
-      cands.push_back(cur);
-      in_run = false;
-    }
-  }
-  if (in_run) cands.push_back(cur);
-
-  // 2. The continuous turn of each; merge those in one turn or within the debounce.
-  for (auto& c : cands) extend_turn(g, c);
-  const long debounce = std::lround(o.debounce_s / kDt);
-  std::vector<Turn> turns;
-  for (const auto& c : cands) {
-    if (!turns.empty()) {
-      Turn& p = turns.back();
-      const bool same_turn = c.peak <= p.ke && c.ks <= p.ke;
-      // Debounce: within 20 s is the same manoeuvre, unless the boat sailed a steady course
-      // (>= 1.5 s without turning) between the two turns: a layline tack then the mark.
-      const bool apart = c.ks - p.ke >= 15;
-      if (same_turn || (c.peak - p.peak < debounce && !apart)) {
-        const bool c_bigger = std::abs(c.total) > std::abs(p.total) ||
-                              (!same_turn && std::abs(c.total) == std::abs(p.total) && c.delta > p.delta);
-        if (same_turn) {
-          p.ks = std::min(p.ks, c.ks);
-          if (c.ke > p.ke) {
-            p.ke = c.ke;
-            const double u0 = g.course[static_cast<std::size_t>(p.ks)], u1 = g.course[static_cast<std::size_t>(p.ke)];
-            if (std::isfinite(u0) && std::isfinite(u1)) p.total = u1 - u0;
-          }
-          if (c.delta > p.delta) p.delta = c.delta;
-        } else if (c_bigger) {
-          p = c;
+  // 1. The helm's turns (continuous_turns). Two turns of one sign with under 3 s between their
+  // turning ticks (about 4 s of steady course: the rate's 1 s smear) are one manoeuvre (a tack with a pause in it),
+  // unless each is a manoeuvre on its own: a tack on the layline 2 s before the mark and the
+  // rounding are two, measured apart. Turns of opposite signs are never one.
+  const double split_deg = 0.5 * o.min_turn_deg;
+  const std::vector<Turn> segs = continuous_turns(g, 0.25 * o.min_turn_deg);
+  // A turn is a manoeuvre when the mean course over the `window_s` before it starts and after it
+  // ends (cut at the neighbouring turns) differs by >= min_turn_deg, at a mean SOG >= min_sog
+  // before it. This is the "10 s before and after t" with the turn itself taken out of
+  // the windows: a 60 deg gybe taking 3 s reads 60, not the 52-56 the windows about one tick see.
+  const auto is_manoeuvre = [&](Turn t, long prev_b, long next_a) {
+    if (!side_means(g, t, w, prev_b, next_a)) return false;
+    const double sog = g.mean_sog(std::max(t.ks - w, prev_b + 1), std::max(prev_b + 2, t.ks));
+    return std::abs(t.after - t.before) >= o.min_turn_deg && std::isfinite(sog) &&
+           sog >= o.min_sog_m_s;
+  };
+  std::vector<Turn> merged;
+  for (std::size_t i = 0; i < segs.size(); ++i) {
+    Turn c = segs[i];
+    if (!merged.empty()) {
+      Turn& p = merged.back();
+      const bool same_sign = (p.total > 0) == (c.total > 0);
+      if (same_sign && c.a - p.b < 30) {
+        const long pp = merged.size() > 1 ? merged[merged.size() - 2].b : kNoPrev;
+        const long nn = i + 1 < segs.size() ? segs[i + 1].a : kNoNext;
+        const bool apart = std::abs(p.total) >= split_deg && std::abs(c.total) >= split_deg &&
+                           is_manoeuvre(p, pp, c.a) && is_manoeuvre(c, p.b, nn);
+        if (!apart) {
+          const double rp = std::abs(g.rate(static_cast<std::size_t>(p.peak)));
+          if (std::abs(g.rate(static_cast<std::size_t>(c.peak))) > rp) p.peak = c.peak;
+          p.ke = c.ke;
+          p.b = c.b;
+          const double u0 = course_near(g, p.ks, p.peak), u1 = course_near(g, p.ke, p.peak);
+          p.total = std::isfinite(u0) && std::isfinite(u1) ? u1 - u0 : p.total + c.total;
+          continue;
         }
-        continue;
       }
     }
-    turns.push_back(c);
+    merged.push_back(c);
+  }
+  std::vector<Turn> turns;
+  for (std::size_t i = 0; i < merged.size(); ++i) {
+    const long pk = i > 0 ? merged[i - 1].b : kNoPrev;
+    const long nk = i + 1 < merged.size() ? merged[i + 1].a : kNoNext;
+    if (is_manoeuvre(merged[i], pk, nk)) turns.push_back(merged[i]);
   }
 
-  // 3. t0 and the means around it.
+  // 2. t0 and the means around it.
   std::vector<Turn> valid;
   for (std::size_t i = 0; i < turns.size(); ++i) {
     Turn& m = turns[i];
     m.penalty = std::abs(m.total) >= o.penalty_deg;
     // The steady courses either side: 15 s (the turn angle's 20-5 s about t0 when the turn
     // takes ~10 s), cut short by the neighbouring manoeuvres' turns.
-    const long span = 150;
-    const long from = i > 0 ? std::max(m.ks - span, turns[i - 1].ke + 1) : m.ks - span;
-    const long to = i + 1 < turns.size() ? std::min(m.ke + 1 + span, turns[i + 1].ks) : m.ke + 1 + span;
-    m.before = g.mean_unwrapped(from, m.ks);
-    m.after = g.mean_unwrapped(m.ke + 1, to);
-    if (!std::isfinite(m.before) || !std::isfinite(m.after)) continue;
-    // Re-anchor the means on the unwrapped turn (the means may sit 360 apart).
-    const double u0 = g.course[static_cast<std::size_t>(m.ks)];
-    if (std::isfinite(u0)) m.before += 360.0 * std::round((u0 - m.before) / 360.0);
-    // The after mean on the same unwrapping as the turn measured through it.
-    const double raw = m.after - m.before;
-    m.after = m.before + raw - 360.0 * std::round((raw - m.total) / 360.0);
+    const long prev_b = i > 0 ? turns[i - 1].b : kNoPrev;
+    const long next_a = i + 1 < turns.size() ? turns[i + 1].a : kNoNext;
+    if (!side_means(g, m, 150, prev_b, next_a)) continue;
     const double half = m.before + 0.5 * (m.after - m.before);
     const double s = m.after >= m.before ? 1.0 : -1.0;
     m.t0_k = static_cast<double>(m.peak);
@@ -374,19 +454,20 @@ ManoeuvreReport analyse_manoeuvres(std::span<const CourseSample> course,
     valid.push_back(m);
   }
 
-  // 4. The wind: given, or estimated from the turns.
+  // 3. The wind: given, or estimated from the turns.
   const auto bisector = [](const Turn& m) { return wrap360(0.5 * (m.before + m.after)); };
   std::optional<double> wind = o.wind_from_deg;
   if (wind) {
     rep.wind_given = true;
   } else {
     std::vector<WindTurn> wt;
-    for (const auto& m : valid) wt.push_back({m.before, m.after - m.before, m.penalty, bisector(m)});
+    for (const auto& m : valid)
+      wt.push_back({m.before, m.after - m.before, m.penalty, bisector(m), m.side_sog, m.side_heel_abs});
     wind = wind_from_turns(wt);
   }
   rep.wind_from_deg = wind;
 
-  // 5. Classify and measure.
+  // 4. Classify and measure.
   std::vector<double> running;
   for (const auto& m : valid) {
     Manoeuvre r;
@@ -517,7 +598,7 @@ std::optional<double> estimate_wind(std::span<const Manoeuvre> list) {
   std::vector<WindTurn> wt;
   for (const auto& m : list)
     wt.push_back({m.course_before_deg, m.turn_dir * m.turn_deg, m.kind == ManoeuvreKind::kPenalty,
-                  m.bisector_deg});
+                  m.bisector_deg, 0.5 * (m.entry_sog_m_s + m.exit_sog_m_s), std::abs(m.exit_heel_deg)});
   return wind_from_turns(wt);
 }
 

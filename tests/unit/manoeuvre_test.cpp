@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "telltale/fusion/sim/course.hpp"
@@ -61,6 +62,54 @@ TEST(Manoeuvre, ATackIsFoundMeasuredAndClassifiedWithAGivenWind) {
   EXPECT_NEAR(m.heel_peak_leeward_deg, 12.0, 1e-6);
   EXPECT_FALSE(m.unsteady_entry);
   EXPECT_TRUE(rep.wind_given);
+}
+
+// The issue's rule reads the 10 s either side of a tick; a turn of finite length sits inside those
+// windows, so a 64 deg gybe taking 3.2 s read about 56 deg there and was never a candidate.
+// Measured from before the turn starts to after it ends, it is 64.
+TEST(Manoeuvre, AGybeJustOverTheThresholdIsFoundAndMeasured) {
+  // Wind from 0: running at 148 deg to it on starboard... gybe through 180 to 212.
+  const Synth s = turn_at(148.0, 64.0, 60.0);
+  ManoeuvreOptions o;
+  o.wind_from_deg = 0.0;
+  const auto rep = analyse_manoeuvres(s.fixes, s.heel, o);
+  ASSERT_EQ(rep.manoeuvres.size(), 1u);
+  EXPECT_EQ(rep.manoeuvres[0].kind, ManoeuvreKind::kGybe);
+  EXPECT_NEAR(rep.manoeuvres[0].turn_deg, 64.0, 1.5);
+  EXPECT_NEAR(rep.manoeuvres[0].t0_s, 60.0 + 32.0 / 20.0, 0.3);
+}
+
+// A tack on the layline and, 2 s of steady course later, the bear-away round the windward mark:
+// two manoeuvres, the tack measured alone (84 deg, not the 190 of both turns together).
+TEST(Manoeuvre, ATackTwoSecondsBeforeTheMarkIsMeasuredApartFromTheRounding) {
+  Synth s;
+  const double tack_at = 60.0, tack_s = 84.0 / 20.0, mark_at = tack_at + tack_s + 2.0;
+  for (int k = 0; k <= 1200; ++k) {
+    const double t = k * 0.1;
+    const double c = 318.0 + 84.0 * std::clamp((t - tack_at) / tack_s, 0.0, 1.0) +
+                     106.0 * std::clamp((t - mark_at) / (106.0 / 20.0), 0.0, 1.0);
+    s.fixes.push_back({t, std::fmod(c + 720.0, 360.0), t < tack_at ? 3.0 : 2.5});
+  }
+  ManoeuvreOptions o;
+  o.wind_from_deg = 0.0;
+  const auto rep = analyse_manoeuvres(s.fixes, {}, o);
+  ASSERT_EQ(rep.manoeuvres.size(), 2u);
+  EXPECT_EQ(rep.manoeuvres[0].kind, ManoeuvreKind::kTack);
+  EXPECT_NEAR(rep.manoeuvres[0].turn_deg, 84.0, 2.0);
+  EXPECT_EQ(rep.manoeuvres[1].kind, ManoeuvreKind::kBearAway);
+  EXPECT_NEAR(rep.manoeuvres[1].turn_deg, 106.0, 2.0);
+  // With no steady course between them (0.3 s), the two are one turn of 190 deg.
+  Synth joined;
+  const double mark2 = tack_at + tack_s + 0.3;
+  for (int k = 0; k <= 1200; ++k) {
+    const double t = k * 0.1;
+    const double c = 318.0 + 84.0 * std::clamp((t - tack_at) / tack_s, 0.0, 1.0) +
+                     106.0 * std::clamp((t - mark2) / (106.0 / 20.0), 0.0, 1.0);
+    joined.fixes.push_back({t, std::fmod(c + 720.0, 360.0), 3.0});
+  }
+  const auto one = analyse_manoeuvres(joined.fixes, {}, o);
+  ASSERT_EQ(one.manoeuvres.size(), 1u);
+  EXPECT_NEAR(one.manoeuvres[0].turn_deg, 190.0, 2.0);
 }
 
 TEST(Manoeuvre, SameTurnIsAGybeBearAwayOrRoundUpDependingOnTheWind) {
@@ -196,7 +245,7 @@ TEST(CourseTruth, TheSimulatorLogsItsTacksGybesRoundingsAndDrills) {
     }
     if (m.kind == sim::TruthKind::kGybe) {
       ++gybes;
-      EXPECT_NEAR(std::abs(m.turn_deg), 60.0, 3.0);
+      EXPECT_NEAR(std::abs(m.turn_deg), 77.0, 15.0) << "runs at 135-148 deg: gybes of 64-90";
     }
     if (m.kind == sim::TruthKind::kPenalty) {
       ++penalty;
@@ -215,19 +264,22 @@ TEST(CourseTruth, TheSimulatorLogsItsTacksGybesRoundingsAndDrills) {
   EXPECT_EQ(up, 1);
 }
 
-// The issue's targets are printed by `fusion_cli manoeuvre-eval`; here, what it meets today
-// (detection threshold 60 deg misses the simulator's 60 deg gybes: see the report).
+// The targets of the issue, on the simulated races (`fusion_cli manoeuvre-eval`): ten seeds of
+// 40 min with their tacks, gybes, roundings, bear-aways and 720s, the wind estimated; with heel,
+// and from the course alone (a GNSS-only log: the wind's upwind end from speed).
 TEST(ManoeuvreEval, TenSeedsAgainstTheSimulatorTruth) {
-  const auto e = sim::evaluate_manoeuvres(1, 10, 40.0);
-  EXPECT_GE(e.tack.recall(), 0.98);
-  EXPECT_GE(e.tack.precision(), 0.98);
-  EXPECT_GE(e.gybe.precision(), 0.98);
-  EXPECT_LT(e.wind_err_max_deg, 5.0);
-  EXPECT_EQ(e.bear_away.recall(), 1.0);
-  EXPECT_EQ(e.round_up.recall(), 1.0);
-  ManoeuvreOptions o;
-  o.min_turn_deg = 45.0;
-  const auto low = sim::evaluate_manoeuvres(1, 10, 40.0, o);
-  EXPECT_GE(low.gybe.recall(), 0.95);
-  EXPECT_GE(low.gybe.precision(), 0.98);
+  for (bool with_heel : {true, false}) {
+    SCOPED_TRACE(with_heel ? "with heel" : "course only");
+    const auto e = sim::evaluate_manoeuvres(1, 10, 40.0, {}, 10.0, with_heel);
+    for (const auto* k : {&e.tack, &e.gybe}) {
+      EXPECT_GE(k->recall(), 0.98);
+      EXPECT_GE(k->precision(), 0.98);
+    }
+    EXPECT_EQ(e.bear_away.recall(), 1.0);
+    EXPECT_EQ(e.round_up.recall(), 1.0);
+    EXPECT_EQ(e.penalty.recall(), 1.0);
+    EXPECT_LT(e.turn_err_max_deg, 5.0);
+    EXPECT_LT(e.lost_err_max_m, 2.0);
+    EXPECT_LT(e.wind_err_max_deg, 5.0);
+  }
 }

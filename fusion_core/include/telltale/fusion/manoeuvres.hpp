@@ -6,13 +6,16 @@
 /// optionally attitude samples (heel, pitch). Everything is put on a 10 Hz grid (the latest
 /// sample at or before each tick, not older than 1 s; older: a gap).
 ///
-/// **Detection.** At every tick t: the circular-mean course over (t-10 s, t) against (t, t+10 s);
-/// a candidate where they differ by >= `min_turn_deg` (60) and the mean SOG before is >= 1 m/s.
-/// Each run of candidate ticks is refined to its tick of largest change; the continuous turn
-/// through it (turn rate of one sign above 2 deg/s, dips under 1 s bridged) is the manoeuvre's
-/// turn; candidates within the same turn, or within `debounce_s` (20 s) of a larger one without
-/// 1.5 s of steady course between their turns, are one manoeuvre (a tack on the layline 15 s before
-/// the mark is two manoeuvres; a wobbly tack is one).
+/// **Detection.** The helm's turns first: runs of ticks whose course rate (1 s central difference)
+/// has one sign and exceeds 2 deg/s (dips of 0.3 s bridged), padded by 0.5 s to steady course.
+/// A turn is a manoeuvre where the circular-mean course over the `window_s` (10 s) before it
+/// starts and after it ends differs by >= `min_turn_deg` (60), at a mean SOG >= 1 m/s before it:
+/// the rule "10 s before and after t" with the turn itself taken out of the windows, so a 64 deg
+/// gybe taking 3 s reads 64 (windows about one tick read it 8-10 deg short and missed it). Two
+/// turns of one sign with less than 3 s between their turning are one manoeuvre (a pause),
+/// unless each is a manoeuvre on its own, each window cut where the other turns: a tack on the
+/// layline 2 s before the mark and the rounding are two, each measured on its own. Turns of
+/// opposite signs are never one; turns under a quarter of `min_turn_deg` are course keeping.
 ///
 /// **Classification** against the true wind W: the course before (mean over the 10 s before the
 /// turn) turned through the unwrapped turn: crossing head-to-wind once is a tack, crossing
@@ -22,13 +25,16 @@
 ///
 /// **Wind without a sensor.** The bisector of a tack (the course halfway through the turn) is
 /// the wind direction; a gybe's, inverted. First the axis: the circular median of the doubled
-/// bisectors of the turns of 50-140 deg; its sign: tacks turn more than gybes (close-hauled
-/// +-40-45 deg, running +-150-165 deg), so the side where the turns called tacks exceed 72 deg
-/// and those called gybes fall below it wins. Then, with the manoeuvres classified, the wind is
-/// the circular median of the tacks' bisectors and the gybes' inverted (twice: classify again
-/// with it), reported with its uncertainty (1.25 x 1.4826 MAD / sqrt(n), the median's standard
-/// error) and as it stood after each tack or gybe (`wind_over_time`). A direction given by the
-/// caller overrides it.
+/// bisectors of the turns of 50-140 deg. Then which end is upwind, from how the boat sailed on the
+/// steady courses either side of the turns each end would call tacks and gybes: more heel (the
+/// apparent wind is the true wind plus the boat's speed close-hauled, minus it running), else
+/// less speed (close-hauled is every polar's slowest point of sail). Tack and gybe angles do not
+/// tell them apart (an asymmetric-spinnaker boat gybes through as much as it tacks); only when
+/// every turn is of one kind is the end taken where tacks turn more than 72 deg. Then, with the
+/// manoeuvres classified, the wind is the circular median of the tacks' bisectors and the gybes'
+/// inverted (twice: classify again with it), reported with its uncertainty (1.25 x 1.4826 MAD /
+/// sqrt(n), the median's standard error) and as it stood after each tack or gybe
+/// (`wind_over_time`). A direction given by the caller overrides it.
 ///
 /// **Metrics** (t0 = the course crosses the bisector of the mean courses 20-5 s before and 5-20 s
 /// after the turn; a penalty turn's t0 is half its turning done). All windows relative to t0:
@@ -86,7 +92,6 @@ struct ManoeuvreOptions {
   double min_turn_deg = 60.0;
   double window_s = 10.0;
   double min_sog_m_s = 1.0;
-  double debounce_s = 20.0;
   double penalty_deg = 300.0;
 };
 

@@ -4,8 +4,8 @@
 /// and the ground truth the manoeuvre detector is evaluated against. Pure (std only).
 ///
 /// The wind shifts (two slow oscillations, +-8 deg) and gusts; the boat beats at 42 deg to the
-/// true wind, tacking on the layline to the windward mark, and runs at 150 deg, gybing on the
-/// layline to the leeward mark; speed from a simple polar scaled by a per-boat factor, halved
+/// true wind, tacking on the layline to the windward mark, and runs at 135-148 deg (per boat), gybing on
+/// the layline to the leeward mark; speed from a simple polar scaled by a per-boat factor, halved
 /// through a tack or gybe and recovering over ~8 s. Every boat differs by its seed: start line
 /// position, speed factor, wind phase as it sees it, first tack.
 ///
@@ -45,6 +45,7 @@ struct CourseState {
   double wind_from_deg = 0.0;
   double wind_m_s = 0.0;
   double heel_deg = 0.0;     ///< + to starboard
+  double east_m = 0.0, north_m = 0.0;  ///< true position from the leeward mark (no receiver error)
   bool upwind = true;
 };
 
@@ -91,6 +92,7 @@ class CourseSim {
   double wind_from_deg_ = 0.0;
   double heel_deg_ = 0.0;
   bool upwind_ = true;
+  double downwind_twa_deg_ = 150.0;  ///< its running angle to the true wind, per boat
   double corridor_deg_ = 20.0;    ///< how far off the axis the mark may bear before a tack
   int side_ = 1;                  ///< +1 starboard tack (wind over the starboard side), -1 port
   double manoeuvre_s_ = 1e9;      ///< time since the last tack or gybe
