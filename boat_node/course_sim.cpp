@@ -6,7 +6,7 @@
 namespace telltale::boat {
 
 sensors::GnssReading CourseSim::at(double t_s, std::uint64_t utc_ns) {
-  const fusion::sim::CourseState s = sim_.at(t_s);
+  const fusion::sim::CourseState s = race_->fix_at(t_s);
   sensors::GnssReading r;
   r.lat_deg = s.lat_deg;
   r.lon_deg = s.lon_deg;

@@ -10,12 +10,17 @@
 namespace telltale::boat {
 namespace {
 
-/// A simulator scenario of fusion_core (default: a dinghy sailing upwind), endless.
+/// A simulator scenario of fusion_core (default: the race, on the course of the node's simulated
+/// receiver), endless.
 class SimImuSource : public ImuSource {
  public:
   SimImuSource(const std::string& scenario, std::uint64_t seed, double rate_hz)
       : name_(scenario), sim_(fusion::sim::make_scenario(scenario, seed, rate_hz, 0.0)) {
     if (!sim_) throw std::invalid_argument("unknown simulator scenario '" + scenario + "'");
+  }
+  SimImuSource(std::shared_ptr<fusion::sim::RaceCourse> race, std::uint64_t seed, double rate_hz)
+      : name_("race"), sim_(fusion::sim::make_race_scenario(std::move(race), seed, rate_hz, 0.0)) {
+    if (!sim_) throw std::invalid_argument("--imu-rate-hz must be positive");
   }
   std::optional<fusion::ImuSample> next() override {
     fusion::ImuSample s;
@@ -99,12 +104,18 @@ class WitMotionImuSource : public ImuSource {
 
 }  // namespace
 
+bool is_race_source(const std::string& spec) { return spec == "sim" || spec == "sim:race"; }
+
 std::unique_ptr<ImuSource> make_imu_source(const std::string& spec, std::uint64_t seed,
                                            double sim_rate_hz, const ReplayOptions& replay,
-                                           const std::function<bool()>& stop) {
+                                           const std::function<bool()>& stop,
+                                           std::shared_ptr<fusion::sim::RaceCourse> race) {
   if (spec.rfind("witmotion:", 0) == 0 && spec.size() > 10)
     return std::make_unique<WitMotionImuSource>(spec.substr(10), stop);
-  if (spec == "sim") return std::make_unique<SimImuSource>("dinghy", seed, sim_rate_hz);
+  if (is_race_source(spec)) {
+    if (!race) race = std::make_shared<fusion::sim::RaceCourse>(seed);
+    return std::make_unique<SimImuSource>(std::move(race), seed, sim_rate_hz);
+  }
   if (spec.rfind("sim:", 0) == 0)
     return std::make_unique<SimImuSource>(spec.substr(4), seed, sim_rate_hz);
   if (spec.rfind("replay:", 0) == 0 && spec.size() > 7)

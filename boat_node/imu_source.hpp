@@ -10,6 +10,7 @@
 #include <string>
 
 #include "telltale/fusion/imu_sample.hpp"
+#include "telltale/fusion/sim/race.hpp"
 
 namespace telltale::boat {
 
@@ -29,11 +30,17 @@ struct ReplayOptions {
   bool loop = false;  ///< start again at the end (time keeps increasing)
 };
 
-/// "sim" (the dinghy scenario), "sim:SCENARIO", "replay:FILE.csv" or "witmotion:DEVICE[@BAUD]". Throws std::invalid_argument for an
-/// unknown source, io::CsvError for an unreadable replay file, std::system_error for a device.
-/// `stop` ends a wait for a device.
+/// "sim" (the race scenario), "sim:SCENARIO", "replay:FILE.csv" or "witmotion:DEVICE[@BAUD]".
+/// Throws std::invalid_argument for an unknown source, io::CsvError for an unreadable replay
+/// file, std::system_error for a device. `stop` ends a wait for a device. `race`: the course the
+/// race scenario ("sim", "sim:race") sails, shared with the node's simulated receiver so both
+/// are one boat (CourseSim); null: a course of its own from `seed`.
 std::unique_ptr<ImuSource> make_imu_source(const std::string& spec, std::uint64_t seed,
                                            double sim_rate_hz, const ReplayOptions& replay,
-                                           const std::function<bool()>& stop);
+                                           const std::function<bool()>& stop,
+                                           std::shared_ptr<fusion::sim::RaceCourse> race = nullptr);
+
+/// True for the sources that run the race scenario ("sim", "sim:race").
+[[nodiscard]] bool is_race_source(const std::string& spec);
 
 }  // namespace telltale::boat

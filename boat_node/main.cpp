@@ -174,15 +174,24 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
     throw std::invalid_argument("--calibrate-s needs --mount-file to store the offsets");
 
   const std::uint64_t seed = o.seed ? o.seed : std::hash<std::string>{}(o.boat_id);
-  auto source = telltale::boat::make_imu_source(o.source, seed, o.imu_rate_hz, o.replay,
-                                                [&] { return shutdown.stop_requested(); });
+  // --source sim: the IMU's race scenario and the simulated receiver sail one course (one seed,
+  // one RaceCourse), so the attitude and the fixes are one boat's.
+  std::shared_ptr<telltale::fusion::sim::RaceCourse> race;
+  if (telltale::boat::is_race_source(o.source))
+    race = std::make_shared<telltale::fusion::sim::RaceCourse>(seed);
+  auto source = telltale::boat::make_imu_source(
+      o.source, seed, o.imu_rate_hz, o.replay, [&] { return shutdown.stop_requested(); }, race);
   // GNSS: an explicit --gnss receiver, else the simulated race course with --source sim.
   std::unique_ptr<telltale::boat::GnssInput> gnss;
   if (!o.gnss.empty()) gnss = std::make_unique<telltale::boat::GnssInput>(o.gnss);
   std::unique_ptr<telltale::boat::CourseSim> course;
   telltale::boat::GnssGate course_gate;
   if (!gnss && o.source.rfind("sim", 0) == 0)
-    course = std::make_unique<telltale::boat::CourseSim>(seed);
+    course = race ? std::make_unique<telltale::boat::CourseSim>(race)
+                  : std::make_unique<telltale::boat::CourseSim>(seed);
+  // Another scenario's IMU (sim:dinghy...) is not the course's boat: its fixes are published,
+  // never fed to the attitude filter.
+  const bool course_is_imu_boat = course && race;
   std::unique_ptr<telltale::boat::HeadingInput> heading;
   if (!o.headings.empty())
     heading = std::make_unique<telltale::boat::HeadingInput>(o.headings, o.variation_deg);
@@ -396,7 +405,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
     // GNSS: the receiver's fixes as they come, and their speed and course for the attitude
     // filter (it takes the boat's own acceleration in turns and speed changes off the specific
     // force), held on the sample clock from the sample they arrived with. The simulated course
-    // is not fed to the filter: it is another boat than the simulated IMU's dinghy.
+    // is fed the same way when the simulated IMU sails it (the race scenario).
     if (gnss) {
       gnss->take(fixes);
       for (const auto& f : fixes) {
@@ -405,17 +414,21 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
         ground_speed.on_fix(t, no_fix ? std::numeric_limits<double>::quiet_NaN() : f.sog_m_s,
                             f.cog_deg);
       }
-      filter.set_speed(ground_speed.speed_m_s(t), ground_speed.rate_m_s2(t),
-                       ground_speed.cog_rate_rad_s(t));
     }
-    filter.update(mounting.apply(*sample));
-
     // The simulated course at 10 Hz on the sample clock.
     if (!gnss && course && t + 1e-9 >= next_course_s) {
       next_course_s = t + 0.1;
       const unsigned long long t_ns = start_utc_ns + static_cast<unsigned long long>(t * 1e9);
-      if (auto f = course_gate.on_epoch(course->at(t, t_ns), t, t_ns)) publish_fix(*f, t_ns);
+      if (auto f = course_gate.on_epoch(course->at(t, t_ns), t, t_ns)) {
+        publish_fix(*f, t_ns);
+        if (course_is_imu_boat) ground_speed.on_fix(t, f->sog_m_s, f->cog_deg);
+      }
     }
+    if (gnss || course_is_imu_boat) {
+      filter.set_speed(ground_speed.speed_m_s(t), ground_speed.rate_m_s2(t),
+                       ground_speed.cog_rate_rad_s(t));
+    }
+    filter.update(mounting.apply(*sample));
 
     if (t + 1e-9 >= next_publish_s) {
       next_publish_s += publish_period_s;

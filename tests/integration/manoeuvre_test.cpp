@@ -1,6 +1,7 @@
 // Manoeuvres end to end: a simulated boat sails its race course (seed 10 tacks ~28 s
 // after the start) into a real shore; the session's /manoeuvres lists the tack, in JSON and CSV,
 // and the live stream pushes it, found and then final, measured as the REST endpoint measures it.
+// The boat's simulated IMU is the same boat (the race scenario): its heel flips at the tack.
 #include <string>
 #include <vector>
 
@@ -23,8 +24,9 @@ TEST_F(ManoeuvreTest, ASimBoatsSessionListsItsTack) {
         if (!s.is_array() || s.empty()) return false;
         got = get_json("/api/v1/sessions/" + std::to_string(s[0]["id"].get<int>()) +
                        "/manoeuvres?wind_from_deg=255");
+        // A tack whose 20 s after are in (its heel check is made then).
         for (const auto& m : got["manoeuvres"])
-          if (m["kind"] == "tack") return true;
+          if (m["kind"] == "tack" && !m["heel_flip_agrees"].is_null()) return true;
         return false;
       },
       80s))
@@ -38,6 +40,13 @@ TEST_F(ManoeuvreTest, ASimBoatsSessionListsItsTack) {
   EXPECT_EQ(got["wind"]["given"], true);
   EXPECT_EQ(got["summary"][0]["kind"], "tack");
   EXPECT_GE(got["summary"][0]["count"].get<int>(), 1);
+  // The sim boat's IMU sails the course its fixes come from (the race scenario): the published
+  // heel changes side through every tack listed.
+  for (const auto& t : got["manoeuvres"]) {
+    if (t["kind"] == "tack") {
+      EXPECT_EQ(t["heel_flip_agrees"], true) << t.dump();
+    }
+  }
 
   const auto sessions = get_json("/api/v1/sessions?boat=tack1");
   const std::string base = "/api/v1/sessions/" + std::to_string(sessions[0]["id"].get<int>());
