@@ -82,32 +82,29 @@ TEST(Manoeuvre, AGybeJustOverTheThresholdIsFoundAndMeasured) {
 // A tack on the layline and, 2 s of steady course later, the bear-away round the windward mark:
 // two manoeuvres, the tack measured alone (84 deg, not the 190 of both turns together).
 TEST(Manoeuvre, ATackTwoSecondsBeforeTheMarkIsMeasuredApartFromTheRounding) {
-  Synth s;
-  const double tack_at = 60.0, tack_s = 84.0 / 20.0, mark_at = tack_at + tack_s + 2.0;
-  for (int k = 0; k <= 1200; ++k) {
-    const double t = k * 0.1;
-    const double c = 318.0 + 84.0 * std::clamp((t - tack_at) / tack_s, 0.0, 1.0) +
-                     106.0 * std::clamp((t - mark_at) / (106.0 / 20.0), 0.0, 1.0);
-    s.fixes.push_back({t, std::fmod(c + 720.0, 360.0), t < tack_at ? 3.0 : 2.5});
-  }
+  // Close-hauled at 318 to wind from 0, tack (84 deg at 20 deg/s), `pause_s` of steady course,
+  // bear away round the mark (106 deg).
+  const auto tack_then_mark = [](double pause_s) {
+    std::vector<CourseSample> fixes;
+    const double tack_at = 60.0, tack_s = 84.0 / 20.0, mark_at = tack_at + tack_s + pause_s;
+    for (int k = 0; k <= 1200; ++k) {
+      const double t = k * 0.1;
+      const double c = 318.0 + 84.0 * std::clamp((t - tack_at) / tack_s, 0.0, 1.0) +
+                       106.0 * std::clamp((t - mark_at) / (106.0 / 20.0), 0.0, 1.0);
+      fixes.push_back({t, std::fmod(c + 720.0, 360.0), t < tack_at ? 3.0 : 2.5});
+    }
+    return fixes;
+  };
   ManoeuvreOptions o;
   o.wind_from_deg = 0.0;
-  const auto rep = analyse_manoeuvres(s.fixes, {}, o);
+  const auto rep = analyse_manoeuvres(tack_then_mark(2.0), {}, o);
   ASSERT_EQ(rep.manoeuvres.size(), 2u);
   EXPECT_EQ(rep.manoeuvres[0].kind, ManoeuvreKind::kTack);
   EXPECT_NEAR(rep.manoeuvres[0].turn_deg, 84.0, 2.0);
   EXPECT_EQ(rep.manoeuvres[1].kind, ManoeuvreKind::kBearAway);
   EXPECT_NEAR(rep.manoeuvres[1].turn_deg, 106.0, 2.0);
   // With no steady course between them (0.3 s), the two are one turn of 190 deg.
-  Synth joined;
-  const double mark2 = tack_at + tack_s + 0.3;
-  for (int k = 0; k <= 1200; ++k) {
-    const double t = k * 0.1;
-    const double c = 318.0 + 84.0 * std::clamp((t - tack_at) / tack_s, 0.0, 1.0) +
-                     106.0 * std::clamp((t - mark2) / (106.0 / 20.0), 0.0, 1.0);
-    joined.fixes.push_back({t, std::fmod(c + 720.0, 360.0), 3.0});
-  }
-  const auto one = analyse_manoeuvres(joined.fixes, {}, o);
+  const auto one = analyse_manoeuvres(tack_then_mark(0.3), {}, o);
   ASSERT_EQ(one.manoeuvres.size(), 1u);
   EXPECT_NEAR(one.manoeuvres[0].turn_deg, 190.0, 2.0);
 }

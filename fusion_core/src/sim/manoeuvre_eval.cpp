@@ -113,24 +113,20 @@ ManoeuvreEval evaluate_manoeuvres(std::uint64_t first_seed, int seeds, double mi
           const double e = std::abs(d.turn_deg - std::abs(t.turn_deg));
           turn_sum += e;
           ev.turn_err_max_deg = std::max(ev.turn_err_max_deg, e);
-          if (e > 5.0) {
+          // A matched tack or gybe measured off the truth: "seed S: tack at T s turn D, true D".
+          const auto off = [&](const char* what, double got, double truth_v) {
             char line[160];
-            std::snprintf(line, sizeof line, "seed %llu: %s at %.1f s turn %.1f, true %.1f",
-                          static_cast<unsigned long long>(seed), to_string(t.kind), t.t_s,
-                          d.turn_deg, t.turn_deg);
+            std::snprintf(line, sizeof line, "seed %llu: %s at %.1f s %s %.2f, true %.2f",
+                          static_cast<unsigned long long>(seed), to_string(t.kind), t.t_s, what,
+                          got, truth_v);
             ev.misses.emplace_back(line);
-          }
+          };
+          if (e > 5.0) off("turn", d.turn_deg, t.turn_deg);
           t0_sum += std::abs(d.t0_s - t.t_s);
           const double le = std::abs(d.distance_lost_m - true_lost(ti));
           lost_sum += le;
           ev.lost_err_max_m = std::max(ev.lost_err_max_m, le);
-          if (le > 2.0) {
-            char line[160];
-            std::snprintf(line, sizeof line, "seed %llu: %s at %.1f s lost %.2f m, true %.2f",
-                          static_cast<unsigned long long>(seed), to_string(t.kind), t.t_s,
-                          d.distance_lost_m, true_lost(ti));
-            ev.misses.emplace_back(line);
-          }
+          if (le > 2.0) off("lost (m)", d.distance_lost_m, true_lost(ti));
           ++turn_n;
         }
         break;
