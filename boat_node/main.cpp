@@ -24,6 +24,7 @@
 #include <string>
 
 #include "backfill.hpp"
+#include "boat_wire.hpp"
 #include "boat_dds.hpp"
 #include "console.hpp"
 #include "course_sim.hpp"
@@ -232,44 +233,24 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   };
   telltale::boat::BoatDds dds(o.dds, o.boat_id, callbacks);
 
-  // One message per thread: the sensor loop publishes `out`, the backfill thread its own copy.
-  const auto fill = [&](const telltale::boat::LogRecord& r, std::uint64_t run,
-                        telltale::msg::BoatAttitude& m) {
-    m.boat_id(o.boat_id);
-    m.boot_id(run);
-    m.seq(r.seq);
-    m.t_utc_ns(r.t_utc_ns);
-    m.heel_deg(r.heel_deg);
-    m.pitch_deg(r.pitch_deg);
-    m.heading_deg(r.heading_deg);
-    m.heel_rate_deg_s(r.heel_rate_deg_s);
-    m.pitch_rate_deg_s(r.pitch_rate_deg_s);
-    m.yaw_rate_deg_s(r.yaw_rate_deg_s);
-    m.accel_weight(r.accel_weight);
-    m.quality(r.quality);
-    m.leds().left_leds(r.leds[0]);
-    m.leds().right_leds(r.leds[1]);
-    m.leds().up_leds(r.leds[2]);
-    m.leds().down_leds(r.leds[3]);
-    m.leds().led_count(r.led_count);
-    m.leds().level(static_cast<telltale::msg::AlarmLevel>(r.level));
-  };
+  // One message per thread: the sensor loop publishes `out`, the backfill thread its own copy;
+  // each filled by the one wire module (boat_wire.hpp), live or from the log alike.
   telltale::msg::BoatAttitude out;
   backfiller = std::make_unique<telltale::boat::Backfiller>(
       telltale::boat::BackfillConfig{boot_id, static_cast<std::uint64_t>(2 * o.rate_hz), 2500,
                                      std::chrono::milliseconds(5000)},
       telltale::boat::SessionLogReader(o.log_dir, o.boat_id, boot_id),
-      [&fill, &dds, boot_id,
+      [&o, &dds, boot_id,
        backfill_msg = telltale::msg::BoatAttitude()](const telltale::boat::LogRecord& r) mutable {
-        fill(r, boot_id, backfill_msg);
+        telltale::boat::to_wire(r, o.boat_id, boot_id, backfill_msg);
         return dds.backfill(backfill_msg);
       });
   // Earlier runs the shore never had in full (stopped out of reach): delivered from the log too.
   earlier = std::make_unique<telltale::boat::EarlierRuns>(
       o.log_dir, o.boat_id, boot_id, std::chrono::hours(24 * o.deliver_earlier_days),
-      [&fill, &dds, msg = telltale::msg::BoatAttitude()](
+      [&o, &dds, msg = telltale::msg::BoatAttitude()](
           std::uint64_t run, const telltale::boat::LogRecord& r) mutable {
-        fill(r, run, msg);
+        telltale::boat::to_wire(r, o.boat_id, run, msg);
         return dds.backfill(msg);
       },
       [](const std::string& line) {
@@ -277,35 +258,20 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
         std::fflush(stdout);
       });
   // The fixes go the same way on their own topics, against their own receipts.
-  const auto fill_fix = [&](const telltale::boat::FixRecord& r, std::uint64_t run,
-                            telltale::msg::BoatFix& m) {
-    m.boat_id(o.boat_id);
-    m.boot_id(run);
-    m.seq(r.seq);
-    m.t_utc_ns(r.t_utc_ns);
-    m.gnss_utc_ns(r.gnss_utc_ns);
-    m.lat_deg(r.lat_deg);
-    m.lon_deg(r.lon_deg);
-    m.sog_m_s(r.sog_m_s);
-    m.cog_deg(r.cog_deg);
-    m.fix(static_cast<telltale::msg::FixKind>(r.fix));
-    m.satellites(r.satellites);
-    m.hdop(r.hdop);
-  };
   // Lag: 2 s at the fastest receiver (25 Hz); the live fix of the last seconds may be in flight.
   fix_backfiller = std::make_unique<telltale::boat::FixBackfiller>(
       telltale::boat::BackfillConfig{boot_id, 50, 2500, std::chrono::milliseconds(5000)},
       telltale::boat::FixLogReader(o.log_dir, o.boat_id, boot_id),
-      [&fill_fix, &dds, boot_id,
+      [&o, &dds, boot_id,
        msg = telltale::msg::BoatFix()](const telltale::boat::FixRecord& r) mutable {
-        fill_fix(r, boot_id, msg);
+        telltale::boat::to_wire(r, o.boat_id, boot_id, msg);
         return dds.backfill(msg);
       });
   earlier_fixes = std::make_unique<telltale::boat::FixEarlierRuns>(
       o.log_dir, o.boat_id, boot_id, std::chrono::hours(24 * o.deliver_earlier_days),
-      [&fill_fix, &dds, msg = telltale::msg::BoatFix()](
+      [&o, &dds, msg = telltale::msg::BoatFix()](
           std::uint64_t run, const telltale::boat::FixRecord& r) mutable {
-        fill_fix(r, run, msg);
+        telltale::boat::to_wire(r, o.boat_id, run, msg);
         return dds.backfill(msg);
       },
       [](const std::string& line) {
@@ -375,7 +341,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
     r.satellites = static_cast<std::uint8_t>(f.satellites);
     r.hdop = static_cast<float>(f.hdop);
     (void)fix_log.append(r);  // on failure held in memory, retried, reported in the status
-    fill_fix(r, boot_id, fix_msg);
+    telltale::boat::to_wire(r, o.boat_id, boot_id, fix_msg);
     if (!dds.publish(fix_msg)) ++write_failures;
     fix_backfiller->on_published(r.seq);
   };
@@ -474,7 +440,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       r.led_count = led_params.leds_per_bar;
       r.level = static_cast<std::uint8_t>(level);
       (void)log.append(r);  // on failure held in memory, retried, reported in the status
-      fill(r, boot_id, out);
+      telltale::boat::to_wire(r, o.boat_id, boot_id, out);
       if (!dds.publish(out)) ++write_failures;
       backfiller->on_published(r.seq);
       if (!silenced) hook.on_level(o.boat_id, level, heel, now);

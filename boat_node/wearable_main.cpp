@@ -7,6 +7,7 @@
 #include <limits>
 #include <regex>
 
+#include "boat_wire.hpp"
 #include "csv.hpp"
 #include "dds_cli.hpp"
 #include "dds_participant.hpp"
@@ -147,39 +148,6 @@ std::unique_ptr<WearableSource> make_source(const Options& o) {
                               "' (sim, sim:SCENARIO, replay:FILE.csv, witmotion:DEVICE[@BAUD])");
 }
 
-telltale::msg::Gait gait_of(const fusion::PdrOutput& p) {
-  if (p.cadence_spm <= 0.0) return telltale::msg::GAIT_STILL;
-  switch (p.gait) {
-    case 0:
-      return telltale::msg::GAIT_SLOW_WALK;
-    case 1:
-      return telltale::msg::GAIT_WALK;
-    case 2:
-      return telltale::msg::GAIT_FAST_WALK;
-    case 3:
-      return telltale::msg::GAIT_JOG;
-    case 4:
-      return telltale::msg::GAIT_RUN;
-    default:
-      return telltale::msg::GAIT_UNKNOWN;
-  }
-}
-
-telltale::msg::Pose pose_of(const fusion::PdrOutput& p, bool foot) {
-  if (foot) return telltale::msg::POSE_FOOT;
-  switch (p.pose) {
-    case fusion::PhonePose::kHandHeld:
-      return telltale::msg::POSE_HAND_HELD;
-    case fusion::PhonePose::kCall:
-      return telltale::msg::POSE_PHONE_CALL;
-    case fusion::PhonePose::kPocket:
-      return telltale::msg::POSE_POCKET;
-    case fusion::PhonePose::kArmSwing:
-      return telltale::msg::POSE_ARM_SWING;
-  }
-  return telltale::msg::POSE_UNKNOWN;
-}
-
 void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   static const std::regex kId("[A-Za-z0-9_-]{1,32}");
   if (!std::regex_match(o.athlete_id, kId))
@@ -225,7 +193,6 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
                         fdds::TypeSupport(new telltale::msg::NodeStatusPubSubType())),
       "status_writer");
   telltale::msg::WearableMotion m;
-  m.athlete_id(o.athlete_id);
   telltale::msg::NodeStatus status;
   status.node_id(o.athlete_id);
   status.kind(telltale::msg::NODE_KIND_WEARABLE);
@@ -271,16 +238,8 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
     const fusion::PdrOutput& p = handheld ? handheld_out : pdr->update(s->imu, s->mag_uT);
     if (t >= next_publish) {
       next_publish = t + 1.0 / o.rate_hz;
-      m.seq(++seq);
-      m.t_utc_ns(start_utc + static_cast<unsigned long long>(t * 1e9));
-      m.steps(static_cast<std::uint32_t>(p.steps));
-      m.cadence_spm(p.cadence_spm);
-      m.gait(gait_of(p));
-      m.pose(pose_of(p, foot));
-      m.x_m(p.x_m);
-      m.y_m(p.y_m);
-      m.heading_deg(p.heading_deg);
-      m.distance_m(p.distance_m);
+      telltale::boat::to_wire({++seq, start_utc + static_cast<unsigned long long>(t * 1e9), p, foot},
+                              o.athlete_id, m);
       motion_writer->write(&m);
     }
     if (Clock::now() >= next_status) {

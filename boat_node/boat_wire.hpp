@@ -1,0 +1,41 @@
+#pragma once
+/// \file
+/// The nodes' one wire module: every conversion from a boat's or a wearable's own record to the
+/// topic type of idl/telltale.idl it is published as. The shore's side of the same types is
+/// shore_server/wire.hpp; tests/unit/boat_wire_test.cpp holds each pair to a round trip across
+/// the two (the boat's to_wire, then the shore's from_wire, gives every field back).
+///
+/// Adding a member to a wire type (a new type on a new topic, idl/README.md) is one edit here on
+/// the nodes' side. Live samples, backfill and earlier runs are all filled by these functions:
+/// a record read back from the session log goes on the wire exactly as it went live.
+
+#include <cstdint>
+#include <string>
+
+#include "session_log.hpp"
+#include "telltale.h"
+#include "telltale/fusion/pdr.hpp"
+
+namespace telltale::boat {
+
+/// BoatAttitude (telltale_boat_attitude, telltale_boat_backfill) of run `run` (the boot id).
+/// leds.level carries the boat's own alarm colour (the shore ignores it: idl/README.md).
+void to_wire(const LogRecord& r, const std::string& boat_id, std::uint64_t run,
+             msg::BoatAttitude& m);
+
+/// BoatFix (telltale_boat_fix, telltale_boat_fix_backfill) of run `run`.
+void to_wire(const FixRecord& r, const std::string& boat_id, std::uint64_t run, msg::BoatFix& m);
+
+/// What a wearable publishes of its dead reckoning; `foot` for a foot-mounted IMU (pose FOOT).
+struct WearableRecord {
+  std::uint64_t seq = 0;
+  std::uint64_t t_utc_ns = 0;
+  fusion::PdrOutput pdr;
+  bool foot = false;
+};
+
+/// WearableMotion (telltale_wearable_motion): the gait from the cadence class (still at no
+/// cadence), the pose from the classifier (foot for a foot sensor).
+void to_wire(const WearableRecord& r, const std::string& athlete_id, msg::WearableMotion& m);
+
+}  // namespace telltale::boat
