@@ -190,6 +190,16 @@ double course_near(const Grid& g, long k, long toward) {
   return kNaN;
 }
 
+/// The turning done over [ks, ke]: the mean course over the 0.5 s after ke minus the 0.5 s
+/// before ks (single fixes there would carry their COG noise into it: 5 deg of noise would make
+/// every fourth 1 s wobble a 15 deg "turn"); the single fixes where the data has no 0.5 s.
+double turn_total(const Grid& g, const Turn& t) {
+  double u0 = g.mean_unwrapped(t.ks - 5, t.ks), u1 = g.mean_unwrapped(t.ke + 1, t.ke + 6);
+  if (!std::isfinite(u0)) u0 = course_near(g, t.ks, t.peak);
+  if (!std::isfinite(u1)) u1 = course_near(g, t.ke, t.peak);
+  return std::isfinite(u0) && std::isfinite(u1) ? u1 - u0 : 0.0;
+}
+
 /// Every continuous turn of the data: a run of ticks whose course rate (1 s central difference)
 /// has one sign and exceeds 2 deg/s, dips of 0.3 s bridged (a noisy fix), ended by turning the
 /// other way; longer pauses are judged by the caller (a wobbly tack, or a tack then a mark).
@@ -226,8 +236,7 @@ std::vector<Turn> continuous_turns(const Grid& g, double min_total_deg) {
     t.b = b;
     t.ks = std::max(0L, k - 5);
     t.ke = std::min(n - 1, b + 5);
-    const double u0 = course_near(g, t.ks, peak), u1 = course_near(g, t.ke, peak);
-    t.total = std::isfinite(u0) && std::isfinite(u1) ? u1 - u0 : 0.0;
+    t.total = turn_total(g, t);
     if (std::abs(t.total) >= min_total_deg) out.push_back(t);
     k = b + 1;
   }
@@ -399,6 +408,19 @@ ManoeuvreReport analyse_manoeuvres(std::span<const CourseSample> course,
     return std::abs(t.after - t.before) >= o.min_turn_deg && std::isfinite(sog) &&
            sog >= o.min_sog_m_s;
   };
+  // The neighbours that cut a turn's windows: turns of at least half the threshold. Smaller ones
+  // are course keeping, averaged into the course either side (a 15 deg wobble just before a tack
+  // would otherwise leave it no course before).
+  const auto last_cut = [&](const std::vector<Turn>& list, std::size_t from) {
+    for (std::size_t j = from + 1; j-- > 0;)
+      if (std::abs(list[j].total) >= split_deg) return list[j].b;
+    return kNoPrev;
+  };
+  const auto next_cut = [&](const std::vector<Turn>& list, std::size_t from) {
+    for (std::size_t j = from; j < list.size(); ++j)
+      if (std::abs(list[j].total) >= split_deg) return list[j].a;
+    return kNoNext;
+  };
   std::vector<Turn> merged;
   for (std::size_t i = 0; i < segs.size(); ++i) {
     Turn c = segs[i];
@@ -406,8 +428,8 @@ ManoeuvreReport analyse_manoeuvres(std::span<const CourseSample> course,
       Turn& p = merged.back();
       const bool same_sign = (p.total > 0) == (c.total > 0);
       if (same_sign && c.a - p.b < 30) {
-        const long pp = merged.size() > 1 ? merged[merged.size() - 2].b : kNoPrev;
-        const long nn = i + 1 < segs.size() ? segs[i + 1].a : kNoNext;
+        const long pp = merged.size() > 1 ? last_cut(merged, merged.size() - 2) : kNoPrev;
+        const long nn = next_cut(segs, i + 1);
         const bool apart = std::abs(p.total) >= split_deg && std::abs(c.total) >= split_deg &&
                            is_manoeuvre(p, pp, c.a) && is_manoeuvre(c, p.b, nn);
         if (!apart) {
@@ -415,8 +437,7 @@ ManoeuvreReport analyse_manoeuvres(std::span<const CourseSample> course,
           if (std::abs(g.rate(static_cast<std::size_t>(c.peak))) > rp) p.peak = c.peak;
           p.ke = c.ke;
           p.b = c.b;
-          const double u0 = course_near(g, p.ks, p.peak), u1 = course_near(g, p.ke, p.peak);
-          p.total = std::isfinite(u0) && std::isfinite(u1) ? u1 - u0 : p.total + c.total;
+          p.total = turn_total(g, p);
           continue;
         }
       }
@@ -425,8 +446,8 @@ ManoeuvreReport analyse_manoeuvres(std::span<const CourseSample> course,
   }
   std::vector<Turn> turns;
   for (std::size_t i = 0; i < merged.size(); ++i) {
-    const long pk = i > 0 ? merged[i - 1].b : kNoPrev;
-    const long nk = i + 1 < merged.size() ? merged[i + 1].a : kNoNext;
+    const long pk = i > 0 ? last_cut(merged, i - 1) : kNoPrev;
+    const long nk = next_cut(merged, i + 1);
     if (is_manoeuvre(merged[i], pk, nk)) turns.push_back(merged[i]);
   }
 

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 #include "telltale/fusion/sim/course.hpp"
 #include "telltale/fusion/sim/manoeuvre_eval.hpp"
@@ -107,6 +108,39 @@ TEST(Manoeuvre, ATackTwoSecondsBeforeTheMarkIsMeasuredApartFromTheRounding) {
   const auto one = analyse_manoeuvres(tack_then_mark(0.3), {}, o);
   ASSERT_EQ(one.manoeuvres.size(), 1u);
   EXPECT_NEAR(one.manoeuvres[0].turn_deg, 190.0, 2.0);
+}
+
+// A cheap receiver's COG at 10 Hz (5 deg of noise: a phone, or a boat at 1.5 m/s) and a helm
+// that checks the boat 15 deg the other way just before tacking: the wobble is course keeping,
+// neither a manoeuvre nor the end of the tack's course before it, and every tack is found and
+// measured. (Noise-made 1 s "turns" of 15 deg, measured fix to fix, used to take the course
+// before a tack away and lose one tack in ten.)
+TEST(Manoeuvre, TacksInNoisyCourseWithAWobbleBeforeThemAreFoundAndMeasured) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, 5.0);
+  std::vector<CourseSample> fixes;
+  const double first = 60.0, every = 40.0;
+  const int tacks = 8;
+  for (int k = 0; k <= static_cast<int>((first + every * tacks) * 10); ++k) {
+    const double t = k * 0.1;
+    double c = 318.0;
+    for (int i = 0; i < tacks; ++i) {
+      const double at = first + every * i, dir = i % 2 ? -1.0 : 1.0;
+      // The check: 15 deg off and back over the 1.5 s before the tack.
+      const double w = (t - (at - 2.0)) / 1.5;
+      if (w > 0.0 && w < 1.0) c -= dir * 15.0 * std::sin(M_PI * w);
+      c += dir * 84.0 * std::clamp((t - at) / 4.2, 0.0, 1.0);
+    }
+    fixes.push_back({t, std::fmod(c + noise(rng) + 720.0, 360.0), 3.0});
+  }
+  ManoeuvreOptions o;
+  o.wind_from_deg = 0.0;
+  const auto rep = analyse_manoeuvres(fixes, {}, o);
+  ASSERT_EQ(rep.manoeuvres.size(), static_cast<std::size_t>(tacks));
+  for (const Manoeuvre& m : rep.manoeuvres) {
+    EXPECT_EQ(m.kind, ManoeuvreKind::kTack) << "at " << m.t0_s;
+    EXPECT_NEAR(m.turn_deg, 84.0, 4.0) << "at " << m.t0_s;
+  }
 }
 
 TEST(Manoeuvre, SameTurnIsAGybeBearAwayOrRoundUpDependingOnTheWind) {
