@@ -1,5 +1,6 @@
 #include "telltale/fusion/steps.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 
@@ -406,7 +407,18 @@ bool GaitPhaseStepDetector::update_foot(const ImuSample& s, double dt, StepEvent
     swing_angle_rad_ = 0.0;
     swing_acc_m_s2_ = 0.0;
     landing_t_s_ = s.t_s;
+    swing_head_ = swing_size_ = 0;
+    swing_cov_.setZero();
   }
+  if (swing_size_ == kSwingCapacity) {  // the oldest samples go: the heel strike is at the end
+    swing_head_ = (swing_head_ + 1) % kSwingCapacity;
+    --swing_size_;
+  }
+  const std::size_t tail = (swing_head_ + swing_size_++) % kSwingCapacity;
+  swing_t_s_[tail] = s.t_s;
+  swing_gyro_rad_s_[tail] = s.gyro_body_rad_s;
+  swing_force_m_s2_[tail] = s.acc_body_m_s2.norm();
+  swing_cov_ += s.gyro_body_rad_s * s.gyro_body_rad_s.transpose();
   swing_angle_rad_ += w * dt;
   swing_peak_rad_s_ = std::max(swing_peak_rad_s_, w);
   if (w >= params_.landing_fraction * swing_peak_rad_s_) landing_t_s_ = s.t_s;
@@ -429,7 +441,11 @@ bool GaitPhaseStepDetector::update_foot(const ImuSample& s, double dt, StepEvent
   // One foot steps once per gait cycle: a second swing sooner than `interval_fraction` of the
   // recent cycle is the same step in two motions (heel-off then swing, or a landing that
   // settles); the cycle is forgotten after a pause, so a new walk at any pace starts afresh.
-  const double since = landing_t_s_ - last_step_t_s_;
+  // The spacing is between landings (a swing's rate may not reverse, its heel strike unknown).
+  const double hs = params_.report_heel_strike ? heel_strike_t_s() : -1.0;
+  const double trace = swing_cov_.trace();
+  if (trace > 0.0) axis_cov_ = params_.axis_keep * axis_cov_ + swing_cov_ / trace;
+  const double since = landing_t_s_ - last_landing_t_s_;
   if (since > params_.pause_s) cycle_s_ = 0.0;
   if (have_step_ &&
       since < std::max(params_.min_step_interval_s, params_.interval_fraction * cycle_s_)) {
@@ -438,7 +454,55 @@ bool GaitPhaseStepDetector::update_foot(const ImuSample& s, double dt, StepEvent
   }
   if (have_step_ && since <= params_.pause_s)
     cycle_s_ = cycle_s_ > 0.0 ? cycle_s_ + 0.3 * (since - cycle_s_) : since;
-  return emit(landing_t_s_, event);
+  last_landing_t_s_ = landing_t_s_;
+  return emit(hs >= 0.0 ? hs : landing_t_s_, event);
+}
+
+double GaitPhaseStepDetector::heel_strike_t_s() const {
+  // Toes down at push-off, toes up through the swing (the largest rotation of the cycle), toes
+  // down again as the heel is lowered: the swing's end is where the rate about the medio-lateral
+  // axis leaves the sign of the run that turned the foot through the largest angle. The heel
+  // then meets the ground: the impact is the largest |f| shortly after (the annotated heel
+  // strikes of the IPOL recordings are 0.02-0.08 s after the reversal).
+  if (swing_size_ < 3) return -1.0;
+  const double trace = swing_cov_.trace();
+  const Eigen::Matrix3d cov =
+      trace > 0.0 ? Eigen::Matrix3d(axis_cov_ + swing_cov_ / trace) : axis_cov_;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(cov);
+  const Eigen::Vector3d axis = eig.eigenvectors().col(2);  // the largest eigenvalue's
+  const auto at = [this](std::size_t i) { return (swing_head_ + i) % kSwingCapacity; };
+  double best = 0.0, area = 0.0;
+  std::size_t best_last = swing_size_;  // last sample of the largest run
+  int sign = 0;
+  for (std::size_t i = 0; i < swing_size_; ++i) {
+    const double p = swing_gyro_rad_s_[at(i)].dot(axis);
+    const int sg = p > 0.0 ? 1 : p < 0.0 ? -1 : sign;
+    if (sg != sign) {
+      if (std::abs(area) > best) {
+        best = std::abs(area);
+        best_last = i - 1;
+      }
+      sign = sg;
+      area = 0.0;
+    }
+    if (i > 0) area += p * (swing_t_s_[at(i)] - swing_t_s_[at(i - 1)]);
+  }
+  if (std::abs(area) > best || best_last + 1 >= swing_size_) return -1.0;  // never reversed
+  const std::size_t a = at(best_last), b = at(best_last + 1);
+  const double pa = swing_gyro_rad_s_[a].dot(axis), pb = swing_gyro_rad_s_[b].dot(axis);
+  const double f = pa != pb ? pa / (pa - pb) : 0.0;
+  const double t_rev = swing_t_s_[a] + f * (swing_t_s_[b] - swing_t_s_[a]);
+  double peak = -1.0, t_impact = t_rev;
+  for (std::size_t i = best_last + 1; i < swing_size_; ++i) {
+    const std::size_t k = at(i);
+    if (swing_t_s_[k] > t_rev + params_.impact_window_s) break;
+    if (swing_force_m_s2_[k] > peak) {
+      peak = swing_force_m_s2_[k];
+      t_impact = swing_t_s_[k];
+    }
+  }
+  return t_impact;
 }
 
 bool GaitPhaseStepDetector::update_body(const ImuSample& s, double dt, StepEvent& event) {

@@ -256,7 +256,13 @@ class PeakValleyStepDetector final : public StepDetector {
 /// through `min_swing_deg`, peaked at `min_peak_rad_s` and |f| left g by `min_acc_m_s2` -- small
 /// enough for the short first step from standing and the closing step, well above a weight shift
 /// while standing (< 0.3 rad/s, < 0.5 m/s^2 on the IPOL recordings). The event time is the
-/// landing: the last moment the rate was above half the swing's peak (heel strike to foot flat).
+/// heel strike: the swing turns the foot about its medio-lateral axis (toes up through the swing,
+/// the largest rotation of the cycle); at the end of the swing the rate about that axis reverses
+/// as the heel is lowered, and the heel meets the ground within a few hundredths of a second:
+/// the step is reported at the largest |f| (the impact) within `impact_window_s` after the
+/// reversal (the axis: the principal direction of the swings' rates, learnt over the steps).
+/// A swing whose rate never reverses is reported at its landing (the last moment the rate was
+/// above half the swing's peak, 0.1-0.2 s after the heel strike), which also sets the spacing.
 /// A foot cannot start a new step less than `min_step_interval_s` after its last one (the other
 /// foot swings in between: 2.5 cycles/s is beyond a sprint), nor sooner than
 /// `interval_fraction` of its recent cycle: that merges a landing that settles in two motions.
@@ -284,6 +290,9 @@ struct GaitPhaseStepParams {
   double min_peak_rad_s = 1.0;       ///< smallest peak smoothed |w| of a swing, rad/s
   double min_acc_m_s2 = 2.0;         ///< smallest ||f| - g| during a swing, m/s^2
   double landing_fraction = 0.5;     ///< landing = last time |w| was above this x peak
+  bool report_heel_strike = true;    ///< report the heel strike (false: the landing)
+  double impact_window_s = 0.05;     ///< the impact is sought this long after the reversal, s
+  double axis_keep = 0.9;            ///< memory of the medio-lateral axis, per step
   double min_step_interval_s = 0.4;  ///< same foot, between step events, s
   double interval_fraction = 0.6;    ///< ...and at least this x the recent gait cycle
   // Body.
@@ -298,8 +307,8 @@ class GaitPhaseStepDetector final : public StepDetector {
  public:
   using Params = GaitPhaseStepParams;
   explicit GaitPhaseStepDetector(Params params = {});
-  /// `event.t_s` is the time the step happened (foot: landing; body: the trunk's loading peak),
-  /// up to ~0.3 s before the sample that confirmed it.
+  /// `event.t_s` is the time the step happened (foot: heel strike; body: the trunk's loading
+  /// peak), up to ~0.4 s before the sample that confirmed it.
   bool update(const ImuSample& sample, StepEvent& event) override;
   void reset() override;
   [[nodiscard]] std::string_view name() const override { return "gait-phase"; }
@@ -309,6 +318,9 @@ class GaitPhaseStepDetector final : public StepDetector {
   bool update_foot(const ImuSample& s, double dt, StepEvent& event);
   bool update_body(const ImuSample& s, double dt, StepEvent& event);
   bool emit(double t_s, StepEvent& event);
+  /// Foot: the heel strike of the swing just ended, or -1 when the rate about the medio-lateral
+  /// axis never reversed.
+  [[nodiscard]] double heel_strike_t_s() const;
 
   Params params_;
   StepDiagnostics diag_;
@@ -324,6 +336,18 @@ class GaitPhaseStepDetector final : public StepDetector {
   double swing_angle_rad_ = 0.0;
   double swing_acc_m_s2_ = 0.0;
   double landing_t_s_ = 0.0;
+  double last_landing_t_s_ = -1e9;  ///< landing of the last step (the spacing rule's time)
+  /// The swing's samples (rate, |f|) in a ring: the heel strike is sought at its end.
+  static constexpr std::size_t kSwingCapacity = 512;  ///< 1.3 s at 400 Hz, 5 s at 100 Hz
+  std::array<double, kSwingCapacity> swing_t_s_{};
+  std::array<Eigen::Vector3d, kSwingCapacity> swing_gyro_rad_s_{};
+  std::array<double, kSwingCapacity> swing_force_m_s2_{};
+  std::size_t swing_head_ = 0;  ///< oldest sample of the ring
+  std::size_t swing_size_ = 0;
+  Eigen::Matrix3d swing_cov_ = Eigen::Matrix3d::Zero();  ///< sum of w w^T over the swing
+  /// The steps' swings, each of unit trace, forgotten by `axis_keep` a step: the foot's
+  /// medio-lateral axis in the sensor frame is its principal direction.
+  Eigen::Matrix3d axis_cov_ = Eigen::Matrix3d::Zero();
   double cycle_s_ = 0.0;  ///< recent interval between this foot's steps (0: none since a pause)
   // Body: gravity in the sensor frame and the oscillation's extremes.
   Eigen::Vector3d gravity_m_s2_ = Eigen::Vector3d::Zero();
