@@ -65,12 +65,14 @@ class LiveQueue {
     if (was_empty) cv_.notify_one();
   }
   /// Swaps out everything queued; false once closed. Takes at most every kCoalesce, so the
-  /// worker wakes for a batch of samples, not for each (the dashboards take 10 frames a second).
-  bool take(std::vector<std::pair<AttitudeSample, std::uint64_t>>& out) {
+  /// worker wakes for a batch of samples, not for each (the dashboards take 10 frames a second);
+  /// with nothing queued, returns an empty batch after `idle` (the worker's other inputs).
+  bool take(std::vector<std::pair<AttitudeSample, std::uint64_t>>& out,
+            std::chrono::milliseconds idle) {
     out.clear();
     std::unique_lock lock(mutex_);
     cv_.wait_until(lock, last_take_ + kCoalesce, [&] { return closed_; });
-    cv_.wait(lock, [&] { return closed_ || !queue_.empty(); });
+    cv_.wait_for(lock, idle, [&] { return closed_ || !queue_.empty(); });
     if (closed_) return false;
     out.swap(queue_);
     last_take_ = std::chrono::steady_clock::now();
@@ -173,7 +175,8 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
   JoinOnExit live_join{live_worker, [&] { live.close(); }};
   live_worker = std::thread([&] {
     std::vector<std::pair<AttitudeSample, std::uint64_t>> batch;
-    while (live.take(batch)) {
+    while (live.take(batch, ManoeuvreLive::kFixWakeup)) {
+      manoeuvres.take_fixes();
       for (const auto& [s, arrival_utc] : batch) {
         BoatView view = fleet.update(s, std::chrono::steady_clock::now(), arrival_utc);
         alarms.on_sample(s, view.status ? view.status->group : std::string());
@@ -297,51 +300,77 @@ int main(int argc, char** argv) {
   int domain = -1;
   CLI::App app{"Telltale shore server: fleet over DDS -> SQLite, REST API, live stream, dashboard"};
   app.set_config("--config", "", "read options from this file (INI/TOML: key = value)");
-  app.add_option("--domain", domain, "DDS domain id (default: $TELLTALE_DOMAIN, else 0)");
+  // --help: the dashboard's address, who may see what, the recording, the live fleet, the link.
+  const std::string http = "Dashboard and HTTP";
   app.add_option("--http-port", o.http.port, "HTTP port; 0 picks a free one and prints it")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->group(http);
   app.add_option("--bind", o.http.bind_address, "HTTP listen address (localhost by default)")
-      ->capture_default_str();
-  app.add_option("--db", o.store.path,
-                 "SQLite database file (created if missing); default: "
-                 "$XDG_DATA_HOME/telltale/telltale.db, else ~/.local/share/telltale/telltale.db");
-  app.add_option("--coach-token", o.coach_token,
-                 "coach token (default: $TELLTALE_COACH_TOKEN, else a generated one, printed)");
-  app.add_option("--analyst-token", o.analyst_tokens,
-                 "an analyst token (read and export); repeatable");
-  app.add_option("--athlete-token", o.athlete_tokens,
-                 "BOAT_ID:TOKEN, an athlete's token for their own boat; repeatable");
-  app.add_option("--session-gap-s", o.session_gap_s,
-                 "a boat silent this long starts a new session when it returns")
-      ->capture_default_str();
-  app.add_option("--retention-days", o.store.retention_days,
-                 "delete samples older than this (0: keep everything)")
-      ->capture_default_str();
-  app.add_option("--web-dir", o.http.web_dir, "dashboard files")->capture_default_str();
-  app.add_option("--max-streams", o.http.max_stream_clients, "live-stream clients at most")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->group(http);
+  app.add_option("--web-dir", o.http.web_dir, "dashboard files")->capture_default_str()->group(http);
   app.add_option_function<std::size_t>(
          "--max-import-mb", [&o](std::size_t mb) { o.http.max_import_bytes = mb << 20; },
          "largest log file POST /api/v1/imports takes, MB (default 256)")
-      ->check(CLI::Range(1, 65536));
+      ->check(CLI::Range(1, 65536))
+      ->group(http);
   app.add_option("--rest-threads", o.http.rest_threads, "HTTP workers besides the streams")
-      ->capture_default_str();
-  app.add_option("--stream-interval-ms", o.stream_interval_ms,
-                 "a live-stream client gets each boat's latest sample at most this often")
       ->capture_default_str()
-      ->check(CLI::Range(10, 5000));
-  app.add_option("--stale-ms", o.stale_ms, "a boat silent this long is stale")
-      ->capture_default_str();
-  app.add_option("--forget-after-s", o.forget_after_s,
-                 "a boat or athlete silent this long leaves the live fleet (its recording stays)")
-      ->capture_default_str()
-      ->check(CLI::Range(60, 30 * 86400));
+      ->group(http);
   app.add_option("--keep-alive-s", o.http.keep_alive_s,
                  "an idle HTTP keep-alive connection is closed after this (sooner under load)")
       ->capture_default_str()
-      ->check(CLI::Range(1, 300));
+      ->check(CLI::Range(1, 300))
+      ->group(http);
+
+  const char* security = telltale::dds::kSecurityCliGroup;  // with --security-dir
+  app.add_option("--coach-token", o.coach_token,
+                 "coach token (default: $TELLTALE_COACH_TOKEN, else a generated one, printed)")
+      ->group(security);
+  app.add_option("--analyst-token", o.analyst_tokens,
+                 "an analyst token (read and export); repeatable")
+      ->group(security);
+  app.add_option("--athlete-token", o.athlete_tokens,
+                 "BOAT_ID:TOKEN, an athlete's token for their own boat; repeatable")
+      ->group(security);
+
+  const std::string recording = "Recording";
+  app.add_option("--db", o.store.path,
+                 "SQLite database file (created if missing); default: "
+                 "$XDG_DATA_HOME/telltale/telltale.db, else ~/.local/share/telltale/telltale.db")
+      ->group(recording);
+  app.add_option("--session-gap-s", o.session_gap_s,
+                 "a boat silent this long starts a new session when it returns")
+      ->capture_default_str()
+      ->group(recording);
+  app.add_option("--retention-days", o.store.retention_days,
+                 "delete samples older than this (0: keep everything)")
+      ->capture_default_str()
+      ->group(recording);
   app.add_option("--commit-ms", o.commit_ms, "store commit interval (the durability window)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->group(recording);
+
+  const std::string live = "Live fleet";
+  app.add_option("--stale-ms", o.stale_ms, "a boat silent this long is stale")
+      ->capture_default_str()
+      ->group(live);
+  app.add_option("--forget-after-s", o.forget_after_s,
+                 "a boat or athlete silent this long leaves the live fleet (its recording stays)")
+      ->capture_default_str()
+      ->check(CLI::Range(60, 30 * 86400))
+      ->group(live);
+  app.add_option("--max-streams", o.http.max_stream_clients, "live-stream clients at most")
+      ->capture_default_str()
+      ->group(live);
+  app.add_option("--stream-interval-ms", o.stream_interval_ms,
+                 "a live-stream client gets each boat's latest sample at most this often")
+      ->capture_default_str()
+      ->check(CLI::Range(10, 5000))
+      ->group(live);
+
+  app.add_option("--domain", domain, "DDS domain id (default: $TELLTALE_DOMAIN, else 0)")
+      ->group(telltale::dds::kCliGroup);
   telltale::dds::add_dds_options(app, o.dds);
   o.http.web_dir = TELLTALE_DEFAULT_WEB_DIR;
   CLI11_PARSE(app, argc, argv);

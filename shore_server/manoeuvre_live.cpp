@@ -208,9 +208,10 @@ void ManoeuvreLive::queue_fix(const FixSample& fix) {
   has_fixes_.store(true, std::memory_order_release);
 }
 
-void ManoeuvreLive::on_attitude(const AttitudeSample& sample) {
-  // The flag spares the worker the lock for the 25 attitude samples a second that come with no
-  // fix in between.
+void ManoeuvreLive::on_attitude(const AttitudeSample& sample) { tracker_.on_attitude(sample); }
+
+void ManoeuvreLive::take_fixes() {
+  // The flag spares the worker the lock for the batches that come with no fix in them.
   if (has_fixes_.load(std::memory_order_acquire)) {
     {
       std::lock_guard lock(mutex_);
@@ -220,7 +221,6 @@ void ManoeuvreLive::on_attitude(const AttitudeSample& sample) {
     for (const auto& f : taken_) tracker_.on_fix(f);
     taken_.clear();
   }
-  tracker_.on_attitude(sample);
   const auto now = std::chrono::steady_clock::now();
   if (now >= next_retain_) {
     next_retain_ = now + std::chrono::minutes(1);

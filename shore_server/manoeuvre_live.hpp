@@ -147,17 +147,25 @@ class ManoeuvreTracker {
 /// No session id: only the store's writer thread knows a boat's open session, and asking SQLite
 /// from the live worker is what this replaces; the card needs none.
 /// Fixes arrive on the DDS receive thread, which only queues them (queue_fix); the live worker
-/// takes them with the next attitude sample, so the detector never runs on the receive thread.
+/// takes them once per batch of attitude samples and at least every kFixWakeup without one
+/// (take_fixes), so the detector never runs on the receive thread.
 class ManoeuvreLive {
  public:
+  /// How often the live worker takes fixes when no attitude sample wakes it: far inside the 2 s
+  /// of fixes between two runs of the detector.
+  static constexpr std::chrono::milliseconds kFixWakeup{200};
+
   ManoeuvreLive(LiveHub& hub, const FleetModel& fleet, double session_gap_s);
 
   /// Any thread (the DDS listener): queues the fix for the live worker. Bounded: 5 s of a
   /// 1000-boat fleet at 10 Hz; beyond that the oldest are dropped, as the live view skips ahead.
   void queue_fix(const FixSample& fix);
-  /// Live worker: the fixes queued so far, then this sample. Boats the fleet model has forgotten
-  /// are forgotten here too, and boats silent for longer than the window give back its memory
-  /// (checked every minute).
+  /// Live worker, once per batch of samples and at least every kFixWakeup without any: the fixes
+  /// queued so far go to the tracker (a boat whose IMU has gone quiet still has its manoeuvres
+  /// found). Boats the fleet model has forgotten are forgotten here too, and boats silent for
+  /// longer than the window give back its memory (checked every minute).
+  void take_fixes();
+  /// Live worker: an attitude sample (heel and pitch through the turns).
   void on_attitude(const AttitudeSample& sample);
 
  private:

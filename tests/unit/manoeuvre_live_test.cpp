@@ -340,6 +340,7 @@ TEST(ManoeuvreLive, TheShoreQueuesFixesAndPushesManoeuvreEventsOnTheHub) {
       while (f < r.fixes.size() && r.fixes[f].t_utc_ns <= a.t_utc_ns) live.queue_fix(r.fixes[f++]);
     });
     receiver.join();
+    live.take_fixes();
     live.on_attitude(a);
   }
   std::string text;
@@ -372,6 +373,30 @@ TEST(ManoeuvreLive, TheShoreQueuesFixesAndPushesManoeuvreEventsOnTheHub) {
   EXPECT_EQ(events[1].size(), row.size());
   EXPECT_TRUE(hub.wait(*other_athlete, std::chrono::milliseconds(5), closed).find("manoeuvre") ==
               std::string::npos);
+}
+
+// A boat whose IMU has gone quiet (or a node with GNSS alone) still has its manoeuvres found: the
+// live worker takes the fixes on its own, not only when an attitude sample comes (it used to, and
+// such a boat was never analysed).
+TEST(ManoeuvreLive, FixesAloneAreEnough) {
+  const Race r = sail(10, 120, false);
+  LiveHub hub(4, 256, std::chrono::milliseconds(1));
+  const auto coach = hub.connect();
+  FleetModel fleet(std::chrono::milliseconds(2000));
+  ManoeuvreLive live(hub, fleet, 60.0);
+  for (std::size_t i = 0; i < r.fixes.size(); ++i) {
+    live.queue_fix(r.fixes[i]);
+    if (i % 10 == 9) live.take_fixes();  // the worker's wake-ups, a batch each
+  }
+  live.take_fixes();
+  std::string text;
+  bool closed = false;
+  for (std::string got; !(got = hub.wait(*coach, std::chrono::milliseconds(20), closed)).empty();)
+    text += got;
+  std::size_t events = 0;
+  for (std::size_t at = 0; (at = text.find("event: manoeuvre\n", at)) != std::string::npos; ++at)
+    ++events;
+  EXPECT_EQ(events, 2u) << "found, then final: " << text;
 }
 
 }  // namespace
