@@ -9,6 +9,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "course_from_positions.hpp"
 #include "detect.hpp"
 #include "sqlite_stmt.hpp"
 
@@ -326,7 +327,10 @@ ImportRecord ImportStore::run(std::int64_t id, const ImportRequest& req,
         return;
       }
       StoreSink sink(db, id, r.boat_id, gap_ns, in, progress);
-      const ParseResult pr = parse_log(*format, in, req.options, sink);
+      // Positions without speed and course (a watch's GPX) get both from the positions.
+      CourseFromPositions derived(sink);
+      const ParseResult pr = parse_log(*format, in, req.options, derived);
+      if (pr.status != ParseStatus::kError) derived.finish();
       if (pr.status == ParseStatus::kError) throw ParseFailure(pr.message);
       if (pr.status == ParseStatus::kPartial) r.partial = pr.message;
       r.points = pr.points;
