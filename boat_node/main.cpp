@@ -575,59 +575,101 @@ int main(int argc, char** argv) {
       "Telltale boat node: IMU (+ heading sensors) -> fusion core -> DDS, with a session "
       "log and backfill"};
   app.set_config("--config", "", "read options from this file (INI/TOML: key = value)");
-  app.add_option("--domain", domain, "DDS domain id (default: $TELLTALE_DOMAIN, else 0)");
-  app.add_option("--boat-id", o.boat_id, "fleet-unique boat id, 1-32 of [A-Za-z0-9_-]")->required();
-  app.add_option("--group", o.group, "fleet group or class (alarm rules can target it)");
-  app.add_option("--source", o.source, "IMU: sim | replay:FILE.csv | witmotion:DEVICE[@BAUD]")
-      ->capture_default_str();
-  app.add_option("--heading", o.headings,
-                 "heading sensor, repeatable: nmea:DEVICE[@BAUD] | nmea:udp:[ADDR:]PORT");
-  app.add_option("--gnss", o.gnss,
-                 "GNSS receiver: gpsd[:HOST[:PORT]] | nmea:DEVICE[@BAUD] | nmea:udp:[ADDR:]PORT "
-                 "(default with --source sim: a simulated race course)");
-  app.add_option("--variation-deg", o.variation_deg,
-                 "magnetic variation (E positive) to use HDM/HDG sentences without one");
-  app.add_option("--rate-hz", o.rate_hz, "publish rate, Hz")->capture_default_str();
+  // --help groups the flags the way a technician fits a boat: who it is, its sensors, how the
+  // sensor sits in the hull, its log, its own alarms, then the link to the shore (DDS).
+  const std::string identity = "Identity";
+  app.add_option("--boat-id", o.boat_id, "fleet-unique boat id, 1-32 of [A-Za-z0-9_-]")
+      ->required()
+      ->group(identity);
+  app.add_option("--group", o.group, "fleet group or class (alarm rules can target it)")
+      ->group(identity);
+
+  const std::string sensors = "Sensors";
+  app.add_option("--source", o.source,
+                 "IMU: sim (the simulated race course's boat, also sim:race) | sim:SCENARIO "
+                 "(dinghy, desk, turntable...: the scenarios `fusion_cli simulate --help` lists) | "
+                 "replay:FILE.csv | witmotion:DEVICE[@BAUD]")
+      ->capture_default_str()
+      ->group(sensors);
   app.add_option("--imu-rate-hz", o.imu_rate_hz, "IMU rate of the sim source, Hz")
-      ->capture_default_str();
-  app.add_option("--seed", o.seed, "simulator seed (default: from the boat id)");
+      ->capture_default_str()
+      ->group(sensors);
+  app.add_option("--seed", o.seed, "simulator seed (default: from the boat id)")->group(sensors);
   app.add_option("--gyro-range-dps", o.gyro_range_dps,
                  "gyro full scale (saturation detection); a WitMotion module: 2000")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->group(sensors);
   app.add_option("--acc-range-g", o.acc_range_g,
                  "accelerometer full scale (saturation detection); a WitMotion module: 16")
-      ->capture_default_str();
-  app.add_flag("--replay-fast", o.replay.fast, "replay as fast as possible (default: real time)");
-  app.add_flag("--replay-loop", o.replay.loop, "replay the file again at its end");
-  app.add_option("--log-dir", o.log_dir, "session log directory")->capture_default_str();
+      ->capture_default_str()
+      ->group(sensors);
+  app.add_flag("--replay-fast", o.replay.fast, "replay as fast as possible (default: real time)")
+      ->group(sensors);
+  app.add_flag("--replay-loop", o.replay.loop, "replay the file again at its end")->group(sensors);
+
+  const std::string gnss_heading = "GNSS and heading";
+  app.add_option("--gnss", o.gnss,
+                 "GNSS receiver: gpsd[:HOST[:PORT]] | nmea:DEVICE[@BAUD] | nmea:udp:[ADDR:]PORT "
+                 "(default with a sim source: the simulated race course)")
+      ->group(gnss_heading);
+  app.add_option("--heading", o.headings,
+                 "heading sensor, repeatable: nmea:DEVICE[@BAUD] | nmea:udp:[ADDR:]PORT")
+      ->group(gnss_heading);
+  app.add_option("--variation-deg", o.variation_deg,
+                 "magnetic variation (E positive) to use HDM/HDG sentences without one")
+      ->group(gnss_heading);
+
+  const std::string mounting = "Mounting";
+  app.add_option("--axis-remap", o.axis_remap, "boat axes from sensor axes, e.g. x=-y,y=x,z=z")
+      ->capture_default_str()
+      ->group(mounting);
+  app.add_option("--mount-file", o.mount_file,
+                 "heel/pitch zero offsets (read, and written by --calibrate-s)")
+      ->group(mounting);
+  app.add_option("--calibrate-s", o.calibrate_s,
+                 "with the boat level at the dock: average this long and store the offsets")
+      ->group(mounting);
+
+  const std::string session_log = "Session log";
+  app.add_option("--log-dir", o.log_dir, "session log directory")
+      ->capture_default_str()
+      ->group(session_log);
+  app.add_option("--log-max-mb", o.log_max_mb, "session log disk budget; oldest files go first")
+      ->capture_default_str()
+      ->group(session_log);
   app.add_option("--deliver-earlier-days", o.deliver_earlier_days,
                  "runs of the last N days the shore never confirmed (stopped out of reach) are "
                  "delivered from the log at start; 0: none")
       ->check(CLI::Range(0, 365))
-      ->capture_default_str();
-  app.add_option("--log-max-mb", o.log_max_mb, "session log disk budget; oldest files go first")
-      ->capture_default_str();
-  app.add_option("--axis-remap", o.axis_remap, "boat axes from sensor axes, e.g. x=-y,y=x,z=z")
-      ->capture_default_str();
-  app.add_option("--mount-file", o.mount_file,
-                 "heel/pitch zero offsets (read, and written by "
-                 "--calibrate-s)");
-  app.add_option("--calibrate-s", o.calibrate_s,
-                 "with the boat level at the dock: average this long and store the offsets");
-  app.add_flag("--console", o.console, "show the LED panel on the console");
+      ->capture_default_str()
+      ->group(session_log);
+
+  const std::string alarms = "Alarms and LED panel";
+  app.add_flag("--console", o.console, "show the LED panel on the console")->group(alarms);
   app.add_option("--warn-command", o.warn_command,
-                 "command run when the alarm level rises (TELLTALE_LEVEL etc. in its environment)");
-  app.add_option("--led-step-deg", o.led_step_deg, "degrees per LED")->capture_default_str();
+                 "command run when the alarm level rises (TELLTALE_LEVEL etc. in its environment)")
+      ->group(alarms);
+  app.add_option("--led-step-deg", o.led_step_deg, "degrees per LED")
+      ->capture_default_str()
+      ->group(alarms);
   app.add_option("--leds-per-bar", o.leds_per_bar, "LEDs per bar")
       ->capture_default_str()
-      ->check(CLI::Range(1, 20));
+      ->check(CLI::Range(1, 20))
+      ->group(alarms);
   app.add_option("--default-max-heel-deg", o.default_max_heel_deg,
                  "local alarm when no shore has pushed rules: |heel| above this for 2 s")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->group(alarms);
+
+  app.add_option("--domain", domain, "DDS domain id (default: $TELLTALE_DOMAIN, else 0)")
+      ->group(telltale::dds::kCliGroup);
+  app.add_option("--rate-hz", o.rate_hz, "attitude samples published per second, Hz")
+      ->capture_default_str()
+      ->group(telltale::dds::kCliGroup);
+  telltale::dds::add_dds_options(app, o.dds);
   app.add_option("--fault-drop-link", o.fault_drop_link,
                  "testing: drop every packet this node sends from START_S for DURATION_S")
       ->group("Fault injection");
-  telltale::dds::add_dds_options(app, o.dds);
   CLI11_PARSE(app, argc, argv);
   if (domain >= 0) o.dds.domain = domain;
   try {

@@ -267,24 +267,39 @@ int main(int argc, char** argv) {
   int domain = -1;
   CLI::App app{"Telltale wearable node: phone/foot IMU -> steps and dead reckoning -> DDS"};
   app.set_config("--config", "", "read options from this file (INI/TOML: key = value)");
-  app.add_option("--domain", domain, "DDS domain id (default: $TELLTALE_DOMAIN, else 0)");
-  app.add_option("--athlete-id", o.athlete_id, "athlete id, 1-32 of [A-Za-z0-9_-]")->required();
+  // --help: who wears it, the sensor and how it is worn, the athlete's step, then the link.
+  app.add_option("--athlete-id", o.athlete_id, "athlete id, 1-32 of [A-Za-z0-9_-]")
+      ->required()
+      ->group("Identity");
+
+  const std::string sensor = "Sensor";
   app.add_option("--source", o.source,
                  "sim | sim:SCENARIO | replay:FILE.csv | witmotion:DEVICE[@BAUD]")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->group(sensor);
   app.add_option("--mount", o.mount,
                  "phone (held in front: HandheldPdr, as fusion_cli pdr --mount phone) | body "
                  "(carried in any of the seed-003 poses) | foot (toe-mounted module)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->group(sensor);
+  app.add_option("--seed", o.seed, "simulator seed")->capture_default_str()->group(sensor);
+  app.add_flag("--replay-fast", o.replay_fast, "replay as fast as possible")->group(sensor);
+
+  const std::string step = "Step length";
   app.add_option("--height-m", o.height_m, "athlete's height (step length model)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->group(step);
   app.add_option("--step-scale", o.step_scale,
                  "personal step-length factor: known length / distance measured by "
                  "`fusion_cli pdr` on a calibration walk")
-      ->capture_default_str();
-  app.add_option("--rate-hz", o.rate_hz, "publish rate")->capture_default_str();
-  app.add_option("--seed", o.seed, "simulator seed")->capture_default_str();
-  app.add_flag("--replay-fast", o.replay_fast, "replay as fast as possible");
+      ->capture_default_str()
+      ->group(step);
+
+  app.add_option("--domain", domain, "DDS domain id (default: $TELLTALE_DOMAIN, else 0)")
+      ->group(telltale::dds::kCliGroup);
+  app.add_option("--rate-hz", o.rate_hz, "publish rate")
+      ->capture_default_str()
+      ->group(telltale::dds::kCliGroup);
   telltale::dds::add_dds_options(app, o.dds);
   CLI11_PARSE(app, argc, argv);
   if (domain >= 0) o.dds.domain = domain;
