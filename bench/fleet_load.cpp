@@ -22,6 +22,7 @@
 #include <thread>
 #include <vector>
 
+#include "dds_cli.hpp"
 #include "dds_participant.hpp"
 #include "shutdown.hpp"
 #include "telltalePubSubTypes.h"
@@ -72,18 +73,28 @@ int main(int argc, char** argv) {
   double seconds = 300;
   int sse_clients = 1;
   CLI::App app{"Telltale fleet load generator"};
-  app.add_option("--domain", domain, "DDS domain")->required();
-  app.add_option("--shore-url", url, "shore base URL")->required();
-  app.add_option("--token", token, "coach token")->required();
-  app.add_option("--shore-pid", shore_pid, "shore process id (CPU and RSS)");
-  app.add_option("--boats", boats)->capture_default_str();
-  app.add_option("--rate-hz", rate_hz)->capture_default_str();
-  app.add_option("--fix-hz", fix_hz, "GNSS fixes per boat per second (a divisor of --rate-hz); 0: none")
-      ->capture_default_str();
-  app.add_option("--seconds", seconds)->capture_default_str();
+  const std::string shore = "Shore";
+  app.add_option("--shore-url", url, "shore base URL")->required()->group(shore);
+  app.add_option("--token", token, "coach token")->required()->group(shore);
+  app.add_option("--shore-pid", shore_pid, "shore process id (CPU and RSS)")->group(shore);
+
+  const std::string load = "Load";
+  app.add_option("--boats", boats, "simulated boats")->capture_default_str()->group(load);
+  app.add_option("--rate-hz", rate_hz, "attitude samples per boat per second")
+      ->capture_default_str()
+      ->group(load);
+  app.add_option("--fix-hz", fix_hz,
+                 "GNSS fixes per boat per second (a divisor of --rate-hz); 0: none")
+      ->capture_default_str()
+      ->group(load);
+  app.add_option("--seconds", seconds, "length of the run")->capture_default_str()->group(load);
   app.add_option("--sse-clients", sse_clients, "SSE clients held open (the first measures latency)")
-      ->capture_default_str();
-  app.add_option("--dds-profiles", dds.profiles_file);
+      ->capture_default_str()
+      ->group(load);
+
+  app.add_option("--domain", domain, "DDS domain")->required()->group(telltale::dds::kCliGroup);
+  app.add_option("--dds-profiles", dds.profiles_file, "Fast DDS profiles XML")
+      ->group(telltale::dds::kCliGroup);
   CLI11_PARSE(app, argc, argv);
   dds.domain = domain;
 

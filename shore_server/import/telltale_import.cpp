@@ -165,25 +165,43 @@ int main(int argc, char** argv) {
   app.add_option("paths", o.paths, "files, or folders whose files are all uploaded")
       ->required()
       ->check(CLI::ExistingPath);
-  app.add_option("--shore", o.shore, "the shore's URL")->capture_default_str();
-  app.add_option("--token", o.token, "coach or analyst token (default: $TELLTALE_TOKEN)");
-  app.add_option("--boat", o.boat,
-                 "the boat the files belong to (without it: the device's serial where a file "
-                 "names one, Velocitek VTK)");
-  app.add_option("--format", o.format, "force the format instead of reading it from the content")
-      ->check(CLI::IsMember({"vakaros_csv", "vkx", "vtk", "nmea", "gpx"}));
-  app.add_option("--tz", o.tz, "time zone of local times without an offset (Europe/Madrid, +01:00, UTC)");
-  app.add_option("--date", o.date, "UTC date (YYYY-MM-DD) of NMEA logs that state none");
-  app.add_option("--heel-offset", o.heel_offset, "degrees subtracted from every heel")
-      ->check(CLI::Range(-45.0, 45.0));
-  app.add_option("--pitch-offset", o.pitch_offset, "degrees subtracted from every pitch")
-      ->check(CLI::Range(-45.0, 45.0));
-  auto* decl = app.add_option("--declination", o.declination,
-                              "east positive, for magnetic headings when a file states none")
-                   ->check(CLI::Range(-90.0, 90.0));
+  // --help: where the files go, what they are, what to correct in them.
+  const std::string shore_heading = "Shore";
+  app.add_option("--shore", o.shore, "the shore's URL")
+      ->capture_default_str()
+      ->group(shore_heading);
+  app.add_option("--token", o.token, "coach or analyst token (default: $TELLTALE_TOKEN)")
+      ->group(shore_heading);
   app.add_option("--timeout-s", o.timeout_s, "give up waiting for one import after this long")
       ->check(CLI::Range(1, 86400))
-      ->capture_default_str();
+      ->capture_default_str()
+      ->group(shore_heading);
+
+  const std::string files_heading = "Files";
+  app.add_option("--boat", o.boat,
+                 "the boat the files belong to (without it: the device's serial where a file "
+                 "names one, Velocitek VTK)")
+      ->group(files_heading);
+  app.add_option("--format", o.format, "force the format instead of reading it from the content")
+      ->check(CLI::IsMember({"vakaros_csv", "vkx", "vtk", "nmea", "gpx"}))
+      ->group(files_heading);
+  app.add_option("--tz", o.tz,
+                 "time zone of local times without an offset (Europe/Madrid, +01:00, UTC)")
+      ->group(files_heading);
+  app.add_option("--date", o.date, "UTC date (YYYY-MM-DD) of NMEA logs that state none")
+      ->group(files_heading);
+
+  const std::string corrections_heading = "Corrections";
+  app.add_option("--heel-offset", o.heel_offset, "degrees subtracted from every heel")
+      ->check(CLI::Range(-45.0, 45.0))
+      ->group(corrections_heading);
+  app.add_option("--pitch-offset", o.pitch_offset, "degrees subtracted from every pitch")
+      ->check(CLI::Range(-45.0, 45.0))
+      ->group(corrections_heading);
+  auto* decl = app.add_option("--declination", o.declination,
+                              "east positive, for magnetic headings when a file states none")
+                   ->check(CLI::Range(-90.0, 90.0))
+                   ->group(corrections_heading);
   CLI11_PARSE(app, argc, argv);
   o.has_declination = decl->count() > 0;
   if (o.token.empty())
