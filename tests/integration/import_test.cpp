@@ -317,5 +317,118 @@ TEST_F(ImportTest, CommandLineUploaderImportsAFolder) {
   EXPECT_EQ(none.stop(SIGTERM), 2);
 }
 
+// Real watch tracks (tests/data/maxsail_valencia: a dinghy's two races, positions only at 1 Hz):
+// imported as the watch wrote them, the session gets speed and course from the positions and its
+// manoeuvres: every tack and gybe the track shows after the start (its course, read every 5 s:
+// steady courses on either side of a turn), at its time and through its angle, nothing else
+// called a tack or gybe after the start, and the wind within the estimate's reach of the 110 deg
+// the sailor noted for both races.
+struct SeenTurn {
+  const char* t_utc;  // the middle of the turn as the track shows it
+  const char* kind;
+  double turn_deg;  // between the steady courses either side
+};
+
+/// a - b in seconds, both "YYYY-MM-DDThh:mm:ss[.fff][Z]".
+double seconds_apart(const std::string& a, const std::string& b) {
+  const auto secs = [](const std::string& iso) {
+    std::tm tm{};
+    const char* rest = strptime(iso.c_str(), "%Y-%m-%dT%H:%M:%S", &tm);
+    double frac = 0.0;
+    if (rest && *rest == '.') frac = std::strtod(rest, nullptr);
+    return static_cast<double>(timegm(&tm)) + frac;
+  };
+  return secs(a) - secs(b);
+}
+
+/// The track as a watch's GPX 1.1 (positions and times only).
+std::string watch_gpx(const std::string& csv_path) {
+  std::ifstream in(csv_path);
+  std::string line, out =
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<gpx creator=\"Garmin Connect\" version=\"1.1\" "
+      "xmlns=\"http://www.topografix.com/GPX/1/1\">\n<trk><name>race</name><trkseg>\n";
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) {
+    const auto a = line.find(','), b = line.find(',', a + 1);
+    if (a == std::string::npos || b == std::string::npos) continue;
+    out += "<trkpt lat=\"" + line.substr(a + 1, b - a - 1) + "\" lon=\"" + line.substr(b + 1) +
+           "\"><time>" + line.substr(0, a) + "</time></trkpt>\n";
+  }
+  return out + "</trkseg></trk></gpx>\n";
+}
+
+TEST_F(ImportTest, RealWatchTracksGiveTheirTacksAndTheWind) {
+  struct Race {
+    const char* file;
+    const char* boat;
+    const char* start_utc;  // 5 minutes into the file (the sailor's note)
+    std::vector<SeenTurn> seen;
+  };
+  const Race races[] = {
+      {"ESP30782-P01.csv", "ESP30782-R1", "2025-06-21T11:23:29", {
+        {"2025-06-21T11:26:42", "tack", 88.0},
+        {"2025-06-21T11:30:32", "tack", 95.0},
+        {"2025-06-21T11:31:50", "gybe", 132.0},  // the windward mark: bear away and gybe
+        {"2025-06-21T11:37:10", "gybe", 85.0},   // the leeward mark, then up to close-hauled
+        {"2025-06-21T11:37:42", "tack", 82.0},
+        {"2025-06-21T11:38:35", "tack", 112.0},  // two tacks 15 s apart
+        {"2025-06-21T11:38:50", "tack", 112.0},
+        {"2025-06-21T11:40:34", "tack", 82.0},
+        {"2025-06-21T11:43:42", "tack", 80.0},
+        {"2025-06-21T11:51:00", "tack", 180.0}}},
+      {"ESP30782-P02.csv", "ESP30782-R2", "2025-06-21T12:06:29", {
+        {"2025-06-21T12:09:59", "tack", 92.0},
+        {"2025-06-21T12:10:16", "tack", 95.0},
+        {"2025-06-21T12:12:21", "tack", 86.0},
+        {"2025-06-21T12:21:30", "gybe", 140.0},  // the leeward mark: gybe and up in one turn
+        {"2025-06-21T12:22:04", "tack", 88.0},
+        {"2025-06-21T12:23:14", "tack", 80.0},
+        {"2025-06-21T12:26:32", "tack", 100.0},
+        {"2025-06-21T12:27:27", "tack", 82.0},
+        {"2025-06-21T12:28:19", "tack", 87.0},
+        {"2025-06-21T12:30:36", "gybe", 125.0},  // the windward mark: bear away and gybe
+        {"2025-06-21T12:39:11", "tack", 195.0}}},
+  };
+  for (const Race& race : races) {
+    SCOPED_TRACE(race.file);
+    const std::string gpx = watch_gpx(std::string(TELLTALE_TEST_DATA_DIR) + "/maxsail_valencia/" + race.file);
+    auto res = upload(std::string("boat=") + race.boat + "&name=" + race.file, gpx, kAnalyst);
+    ASSERT_TRUE(res);
+    ASSERT_EQ(res->status, 202) << res->body;
+    const auto done = finished(nlohmann::json::parse(res->body)["id"].get<std::int64_t>());
+    ASSERT_EQ(done["state"], "done") << done.dump();
+    EXPECT_EQ(done["format"], "gpx");
+    ASSERT_EQ(done["sessions"].size(), 1u) << done.dump();
+    const auto session = done["sessions"][0].get<std::int64_t>();
+    const auto got = get_json("/api/v1/sessions/" + std::to_string(session) + "/manoeuvres");
+    ASSERT_TRUE(got["manoeuvres"].is_array()) << got.dump();
+    ASSERT_TRUE(got["wind"]["from_deg"].is_number()) << got.dump();
+    const double wind = got["wind"]["from_deg"].get<double>();
+    EXPECT_LT(std::abs(std::remainder(wind - 110.0, 360.0)), 8.0) << "wind " << wind;
+    std::vector<bool> matched(got["manoeuvres"].size(), false);
+    for (const SeenTurn& s : race.seen) {
+      bool found = false;
+      for (std::size_t i = 0; i < got["manoeuvres"].size(); ++i) {
+        const auto& m = got["manoeuvres"][i];
+        const std::string t = m["t_utc"].get<std::string>();
+        if (matched[i] || m["kind"] != s.kind) continue;
+        if (std::abs(seconds_apart(t, s.t_utc)) > 6.0) continue;
+        matched[i] = found = true;
+        EXPECT_NEAR(m["turn_deg"].get<double>(), s.turn_deg, 12.0) << s.kind << " at " << s.t_utc;
+        EXPECT_TRUE(m["distance_lost_m"].is_number()) << s.kind << " at " << s.t_utc;
+        break;
+      }
+      EXPECT_TRUE(found) << "not found: " << s.kind << " at " << s.t_utc << "\n" << got.dump();
+    }
+    for (std::size_t i = 0; i < got["manoeuvres"].size(); ++i) {
+      const auto& m = got["manoeuvres"][i];
+      const bool after_start = seconds_apart(m["t_utc"].get<std::string>(), race.start_utc) > 0.0;
+      if (matched[i] || !after_start || (m["kind"] != "tack" && m["kind"] != "gybe")) continue;
+      ADD_FAILURE() << "not in the track: " << m.dump();
+    }
+  }
+}
+
+
 }  // namespace
 }  // namespace telltale::testing
