@@ -9,7 +9,6 @@
 namespace telltale::boat {
 namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kDegToRad = M_PI / 180.0;
 constexpr double kDay_ns = 86400e9;
 
 /// Days since 1970-01-01 of a civil date (proleptic Gregorian).
@@ -22,14 +21,6 @@ std::int64_t days_from_civil(int y, int m, int d) {
   return era * 146097 + doe - 719468;
 }
 }  // namespace
-
-double distance_m(double lat1_deg, double lon1_deg, double lat2_deg, double lon2_deg) {
-  const double p1 = lat1_deg * kDegToRad, p2 = lat2_deg * kDegToRad;
-  const double dp = p2 - p1, dl = (lon2_deg - lon1_deg) * kDegToRad;
-  const double a =
-      std::sin(dp / 2) * std::sin(dp / 2) + std::cos(p1) * std::cos(p2) * std::sin(dl / 2) * std::sin(dl / 2);
-  return 2.0 * 6371000.0 * std::asin(std::min(1.0, std::sqrt(a)));
-}
 
 std::uint64_t gnss_utc_ns(double time_of_day_s, int date_ddmmyy, std::uint64_t near_utc_ns) {
   if (!std::isfinite(time_of_day_s)) return 0;

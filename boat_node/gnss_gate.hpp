@@ -26,6 +26,7 @@
 #include <optional>
 
 #include "nmea_gnss.hpp"
+#include "telltale/fusion/geo.hpp"
 
 namespace telltale::boat {
 
@@ -81,10 +82,8 @@ class GnssGate {
   std::uint64_t last_gnss_utc_ns_ = 0;  ///< of the last accepted fix
 };
 
-/// Great-circle distance, metres (haversine on a 6371 km sphere: < 0.5 % error, plenty for a
-/// plausibility gate and a distance sailed).
-[[nodiscard]] double distance_m(double lat1_deg, double lon1_deg, double lat2_deg,
-                                double lon2_deg);
+/// Great-circle distance (fusion_core's geo.hpp, the one definition).
+using fusion::distance_m;
 
 /// UTC nanoseconds of a receiver's time of day; the date from RMC (ddmmyy) when given, else the
 /// day that puts it nearest `near_utc_ns`. 0 when time_of_day_s is NaN.

@@ -3,11 +3,12 @@
 
 #include <cmath>
 
+#include "telltale/fusion/geo.hpp"
+
 namespace telltale::shore::import {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
-constexpr double kEarthR = 6371008.8;  // mean radius, m
 
 bool has_position(const ImportPoint& p) {
   return std::isfinite(p.lat_deg) && std::isfinite(p.lon_deg);
@@ -32,11 +33,7 @@ void CourseFromPositions::emit(const ImportPoint* before, ImportPoint p, const I
       dt = (static_cast<double>(to->t_utc_ns) - static_cast<double>(from->t_utc_ns)) * 1e-9;
     }
     if (dt > 0.0 && dt <= kMaxSpanS) {
-      const double lat0 = 0.5 * (from->lat_deg + to->lat_deg) * kDeg;
-      const double north = (to->lat_deg - from->lat_deg) * kDeg * kEarthR;
-      double dlon = to->lon_deg - from->lon_deg;
-      dlon -= 360.0 * std::round(dlon / 360.0);  // across the antimeridian
-      const double east = dlon * kDeg * kEarthR * std::cos(lat0);
+      const auto [east, north] = fusion::offset_m(from->lat_deg, from->lon_deg, to->lat_deg, to->lon_deg);
       const double speed = std::hypot(east, north) / dt;
       if (!std::isfinite(p.sog_m_s)) p.sog_m_s = speed;
       if (!std::isfinite(p.cog_deg) && speed >= kMinCourseSpeed) {
