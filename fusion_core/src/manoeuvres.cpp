@@ -341,20 +341,17 @@ std::optional<double> wind_from_turns(const std::vector<WindTurn>& turns) {
   if (doubled.empty()) return std::nullopt;
   std::optional<double> wind;
   const double axis = circular_median(doubled) / 2.0;
-  const double evidence = upwind_evidence(turns, axis);
-  if (evidence != 0.0) wind = evidence > 0 ? axis : wrap360(axis + 180.0);
-  double best_score = -1e300;
-  for (double cand : {axis, wrap360(axis + 180.0)}) {
-    if (evidence != 0.0) break;
-    double score = 0.0;
+  double evidence = upwind_evidence(turns, axis);
+  if (evidence == 0.0) {
+    // Tacks only or gybes only: the end where the turns it calls tacks exceed 72 deg.
     for (const auto& m : turns) {
-      const auto k = classify(wrap360(m.before), m.total, cand, m.penalty);
+      const auto k = classify(wrap360(m.before), m.total, axis, m.penalty);
       const double t = std::abs(m.total);
-      if (k == ManoeuvreKind::kTack) score += t - 72.0;
-      if (k == ManoeuvreKind::kGybe) score -= t - 72.0;
+      if (k == ManoeuvreKind::kTack) evidence += t - 72.0;
+      if (k == ManoeuvreKind::kGybe) evidence -= t - 72.0;
     }
-    if (score > best_score) best_score = score, wind = cand;
   }
+  wind = evidence >= 0.0 ? axis : wrap360(axis + 180.0);
   // The median of the tacks' bisectors and the gybes' inverted, twice.
   for (int pass = 0; pass < 2; ++pass) {
     std::vector<double> b;
