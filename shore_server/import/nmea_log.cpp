@@ -252,9 +252,12 @@ ParseResult parse_nmea_log(std::istream& in, const ImportOptions& options, Impor
       std::array<std::string_view, 7> f;
       const std::size_t n = sensors::split_nmea_fields(frame.fields, f);
       double tod, d, m, y;
+      // A day, month or year outside an int (a garbled 1e300) is no date, and converting it
+      // would be undefined: whole numbers of a sane size only (the date check does the rest).
+      const auto whole = [](double v) { return std::abs(v) < 1e6 && v == std::floor(v); };
       if (n >= 4 && n <= f.size() && time_of_day(f[0], tod) &&
           sensors::parse_nmea_number(f[1], d) && sensors::parse_nmea_number(f[2], m) &&
-          sensors::parse_nmea_number(f[3], y)) {
+          sensors::parse_nmea_number(f[3], y) && whole(d) && whole(m) && whole(y)) {
         if (const auto days = days_from_civil(static_cast<int>(y), static_cast<int>(m),
                                               static_cast<int>(d))) {
           used = true;

@@ -81,6 +81,19 @@ TEST(ImportNmeaLog, NoDateIsAnError) {
   EXPECT_NE(r.message.find("no position with a date"), std::string::npos) << r.message;
 }
 
+// A garbled ZDA (a year of 1e300, a day of 1.5) gives no date and no undefined conversion (the
+// fuzz target found the year; UBSan flags the conversion in the sanitized run of this test).
+TEST(ImportNmeaLog, GarbledZdaDatesAreNoDates) {
+  Collect sink;
+  const std::string log = s("GPZDA,105640.00,1e300,02,2026,00,00") + "\n" +
+                          s("GPZDA,105640.00,08,02,1e300,00,00") + "\n" +
+                          s("GPZDA,105640.00,1.5,02,2026,00,00") + "\n" +
+                          s("GPGGA,105640.00,3930.0000,N,00230.0000,E,1,08,0.9,5.0,M,50.0,M,,") + "\n";
+  const auto r = run(Format::kNmea, log, sink);
+  EXPECT_EQ(r.status, ParseStatus::kError) << "still no date";
+  EXPECT_TRUE(sink.points.empty());
+}
+
 TEST(ImportNmeaLog, MidnightRollsTheDateOver) {
   const std::string log =
       s("GPRMC,235959.00,A,3930.0000,N,00230.0000,E,1.0,045.0,080226,,,A") + "\n" +
