@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <vector>
 
 #include "json_views.hpp"
@@ -29,6 +30,47 @@ std::string num(double v, int decimals = 3) {
 // With `from`: the data read from this long before it, so a manoeuvre at `from` has its
 // detection windows (10 s of course either side) and its metrics' (20 s before t0) complete.
 constexpr std::uint64_t kLookbackNs = 45'000'000'000ULL;
+
+/// A wind instrument's direction over a stretch: the circular mean of its readings moved by the
+/// median of their differences from it (a median, so a few readings from a boat head to wind or
+/// upside down do not pull it), the spread as the circular standard deviation sqrt(-2 ln R), and
+/// the median speed. Fewer than kMinWindReadings readings (a few seconds of an instrument) are no
+/// wind for the session.
+constexpr std::size_t kMinWindReadings = 10;
+struct InstrumentWind {
+  double from_deg = 0.0, spread_deg = 0.0, speed_m_s = std::nan("");
+  std::size_t n = 0;
+};
+std::optional<InstrumentWind> instrument_wind(const std::vector<WindSample>& rows) {
+  if (rows.size() < kMinWindReadings) return std::nullopt;
+  constexpr double kRad = 3.14159265358979323846 / 180.0;
+  double s = 0.0, c = 0.0;
+  std::vector<double> speeds;
+  for (const auto& w : rows) {
+    s += std::sin(w.from_deg * kRad);
+    c += std::cos(w.from_deg * kRad);
+    if (std::isfinite(w.speed_m_s)) speeds.push_back(w.speed_m_s);
+  }
+  const double n = static_cast<double>(rows.size());
+  const double r = std::hypot(s, c) / n;
+  if (r < 1e-6) return std::nullopt;  // readings all round the compass: no direction
+  const double mean = std::atan2(s, c) / kRad;
+  std::vector<double> off;
+  off.reserve(rows.size());
+  for (const auto& w : rows) off.push_back(std::remainder(w.from_deg - mean, 360.0));
+  std::nth_element(off.begin(), off.begin() + static_cast<std::ptrdiff_t>(off.size() / 2),
+                   off.end());
+  InstrumentWind out;
+  out.from_deg = std::fmod(mean + off[off.size() / 2] + 720.0, 360.0);
+  out.spread_deg = std::sqrt(-2.0 * std::log(std::min(1.0, r))) / kRad;
+  out.n = rows.size();
+  if (!speeds.empty()) {
+    std::nth_element(speeds.begin(),
+                     speeds.begin() + static_cast<std::ptrdiff_t>(speeds.size() / 2), speeds.end());
+    out.speed_m_s = speeds[speeds.size() / 2];
+  }
+  return out;
+}
 
 std::uint64_t to_ns(std::uint64_t base_ns, double t_s) {
   return base_ns + static_cast<std::uint64_t>(std::llround(std::max(0.0, t_s) * 1e9));
@@ -107,7 +149,23 @@ void register_manoeuvre_routes(httplib::Server& server, ShoreContext& ctx) {
       heel.push_back({rel(r.t_utc_ns), r.heel_deg, r.pitch_deg});
       return true;
     });
+    // The wind, in order of trust: the coach's (the query), the boat's wind instrument (stored
+    // by an import), else the estimate from the tacks. When the wind is given either way the
+    // estimate is still made, and reported beside it: how far the track's own estimate is off.
+    const char* wind_source = opt.wind_from_deg ? "coach" : "estimated";
+    std::optional<InstrumentWind> instrument;
+    if (!opt.wind_from_deg) {
+      instrument = instrument_wind(ctx.store.wind(s->boat_id, read_from, s->end_ns, 50000));
+      if (instrument) {
+        opt.wind_from_deg = instrument->from_deg;
+        wind_source = "instrument";
+      }
+    }
     fusion::ManoeuvreReport rep = fusion::analyse_manoeuvres(fixes, heel, opt);
+    std::optional<fusion::ManoeuvreReport> estimate;
+    if (rep.wind_given && !csv)
+      estimate = fusion::analyse_manoeuvres(fixes, heel, fusion::ManoeuvreOptions{});
+    const fusion::ManoeuvreReport& est = estimate ? *estimate : rep;
     if (from_param)
       std::erase_if(rep.manoeuvres, [&](const fusion::Manoeuvre& m) { return to_ns(base, m.t0_s) < from_ns; });
     if (csv) {
@@ -147,23 +205,39 @@ void register_manoeuvre_routes(httplib::Server& server, ShoreContext& ctx) {
                          {"best_distance_lost_m", finite_or_null(k.best_lost_m)},
                          {"worst_distance_lost_m", finite_or_null(k.worst_lost_m)}});
     json wind_t = json::array();
-    for (const auto& w : rep.wind_over_time)
+    for (const auto& w : est.wind_over_time)
       wind_t.push_back({{"t_utc", iso8601(to_ns(base, w.t_s))},
                         {"from_deg", w.from_deg},
                         {"uncertainty_deg", w.uncertainty_deg},
                         {"n", w.n}});
-    res.set_content(
-        to_json_text({{"session_id", s->id},
-                      {"boat_id", s->boat_id},
-                      {"from_utc", from_param ? json(iso8601(from_ns)) : json(nullptr)},
-                      {"data_to_utc", data_to ? json(iso8601(data_to)) : json(nullptr)},
-                      {"wind", {{"from_deg", rep.wind_from_deg ? json(*rep.wind_from_deg) : json(nullptr)},
-                                {"given", rep.wind_given},
-                                {"uncertainty_deg", rep.wind_from_deg ? json(rep.wind_uncertainty_deg) : json(nullptr)},
-                                {"over_time", std::move(wind_t)}}},
-                      {"manoeuvres", std::move(list)},
-                      {"summary", std::move(summary)}}),
-        "application/json");
+    json wind_json = {
+        {"from_deg", rep.wind_from_deg ? json(*rep.wind_from_deg) : json(nullptr)},
+        {"given", rep.wind_given},
+        {"source", rep.wind_from_deg ? json(wind_source) : json(nullptr)},
+        {"uncertainty_deg", rep.wind_from_deg ? json(rep.wind_uncertainty_deg) : json(nullptr)},
+        {"over_time", std::move(wind_t)},
+        {"instrument", nullptr},
+        {"estimated_from_deg", est.wind_from_deg ? json(*est.wind_from_deg) : json(nullptr)},
+        {"estimated_uncertainty_deg",
+         est.wind_from_deg ? json(est.wind_uncertainty_deg) : json(nullptr)},
+        {"estimate_error_deg", nullptr}};
+    if (instrument) {
+      wind_json["instrument"] = {{"from_deg", instrument->from_deg},
+                                 {"spread_deg", instrument->spread_deg},
+                                 {"speed_m_s", finite_or_null(instrument->speed_m_s)},
+                                 {"readings", instrument->n}};
+      if (est.wind_from_deg)
+        wind_json["estimate_error_deg"] =
+            std::remainder(*est.wind_from_deg - instrument->from_deg, 360.0);
+    }
+    res.set_content(to_json_text({{"session_id", s->id},
+                                  {"boat_id", s->boat_id},
+                                  {"from_utc", from_param ? json(iso8601(from_ns)) : json(nullptr)},
+                                  {"data_to_utc", data_to ? json(iso8601(data_to)) : json(nullptr)},
+                                  {"wind", wind_json},
+                                  {"manoeuvres", std::move(list)},
+                                  {"summary", std::move(summary)}}),
+                    "application/json");
   });
 }
 

@@ -1,8 +1,8 @@
 #pragma once
 /// \file
-/// One field table per stored record (the attitude sample, the GNSS fix): each field's column
-/// name, SQL type, uses and meaning, and where it sits in the shore's structs. Everything that
-/// lists the fields one by one is made from these tables: the CREATE TABLE, the migration that
+/// One field table per stored record (the attitude sample, the GNSS fix, the wind): each field's
+/// column name, SQL type, uses and meaning, and where it sits in the shore's structs. Everything
+/// that lists the fields one by one is made from these tables: the CREATE TABLE, the migration that
 /// adds a column missing from an older database, the INSERT, the row readers, the CSV header and
 /// rows of the exports, the JSON keys of the exported rows and of GET /boats. openapi.json is
 /// held to them by a test (tests/unit/sample_fields_test.cpp).
@@ -113,6 +113,18 @@ inline constexpr auto kFixFields = std::make_tuple(
                            TELLTALE_MEMBER(hdop)),
     field<kStored | kRead>("boot_id", "INTEGER NOT NULL", CsvFormat::kNumber,
                            "the boat node's run, as in the attitude", TELLTALE_MEMBER(boot_id)));
+
+/// The wind, table `wind`: WindSample (a wind instrument's readings, from imported logs).
+inline constexpr auto kWindFields = std::make_tuple(
+    field<kStored | kRead>("from_deg", "REAL NOT NULL", CsvFormat::kNumber,
+                           "true wind direction it blows from, 0..360 clockwise from true north",
+                           TELLTALE_MEMBER(from_deg)),
+    field<kStored | kRead>("speed_m_s", "REAL", CsvFormat::kNumber,
+                           "true wind speed; null when the instrument gave none",
+                           TELLTALE_MEMBER(speed_m_s)),
+    field<kStored | kRead>("source", "TEXT NOT NULL DEFAULT ''", CsvFormat::kNumber,
+                           "what it was made from: mwd, mwv_true, mwv_apparent, vkx_apparent",
+                           TELLTALE_MEMBER(source)));
 
 #undef TELLTALE_MEMBER
 

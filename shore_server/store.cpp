@@ -272,6 +272,7 @@ Store::Store(StoreConfig config) : config_(std::move(config)) {
     exec(db_, kSchema);
     exec(db_, create_table_sql("attitude", kAttitudeFields).c_str());
     exec(db_, create_table_sql("fixes", kFixFields).c_str());
+    exec(db_, create_table_sql("wind", kWindFields).c_str());
     exec(db_, kTierTable);
     exec(db_, tier_trigger().c_str());
     migrate(db_);
@@ -461,6 +462,38 @@ void Store::visit_fixes(const std::string& boat_id, std::uint64_t from_ns, std::
     if (rows.size() < page) return;
     after = rows.back().t_utc_ns;
   }
+}
+
+std::vector<WindSample> Store::wind(const std::string& boat_id, std::uint64_t from_ns,
+                                    std::uint64_t to_ns, std::size_t limit) {
+  std::vector<WindSample> all;
+  if (from_ns > to_ns || limit == 0) return all;
+  {
+    const ReadLease reader(*this);
+    static const std::string kSql = "SELECT " + select_columns(kWindFields) +
+                                    " FROM wind WHERE boat_id = ? AND t_utc_ns BETWEEN ? AND ? "
+                                    "ORDER BY t_utc_ns";
+    Stmt q(reader.db(), kSql.c_str());
+    q.bind(1, boat_id)
+        .bind_u(2, from_ns)
+        .bind_u(3, std::min<std::uint64_t>(to_ns, std::numeric_limits<std::int64_t>::max()));
+    while (q.step()) {
+      WindSample w;
+      w.boat_id = boat_id;
+      w.t_utc_ns = q.u64(0);
+      read_fields(q.get(), 1, kWindFields, w);
+      all.push_back(std::move(w));
+    }
+  }
+  if (all.size() <= limit) return all;
+  std::vector<WindSample> out;
+  out.reserve(limit);
+  const double step = static_cast<double>(all.size() - 1) /
+                      static_cast<double>(std::max<std::size_t>(limit - 1, 1));
+  for (std::size_t i = 0; i < limit; ++i)
+    out.push_back(all[std::min(
+        all.size() - 1, static_cast<std::size_t>(std::llround(step * static_cast<double>(i))))]);
+  return out;
 }
 
 std::vector<FixSample> Store::track(const std::string& boat_id, std::uint64_t from_ns,
@@ -989,7 +1022,13 @@ void Store::apply_retention() {
                    "DELETE FROM fixes WHERE boat_id = ?1 AND t_utc_ns BETWEEN ?2 AND ?3 "
                    "AND NOT EXISTS (SELECT 1 FROM sessions k WHERE k.boat_id = ?1 AND "
                    "k.start_ns <= fixes.t_utc_ns AND k.end_ns >= fixes.t_utc_ns)");
+    Stmt del_wind(db_,
+                  "DELETE FROM wind WHERE boat_id = ?1 AND t_utc_ns BETWEEN ?2 AND ?3 "
+                  "AND NOT EXISTS (SELECT 1 FROM sessions k WHERE k.boat_id = ?1 AND "
+                  "k.start_ns <= wind.t_utc_ns AND k.end_ns >= wind.t_utc_ns)");
     for (const auto& g : gone) {
+      del_wind.reset();
+      del_wind.bind(1, g.boat_id).bind_u(2, g.start_ns).bind_u(3, g.end_ns).step();
       del_session.reset();
       del_session.bind(1, g.id).step();
       del_samples.reset();

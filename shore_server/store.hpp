@@ -143,6 +143,10 @@ class Store {
   /// Calls `visit` for every fix with a position of the boat in [from_ns, to_ns], in time order.
   void visit_fixes(const std::string& boat_id, std::uint64_t from_ns, std::uint64_t to_ns,
                    const std::function<bool(const FixSample&)>& visit, std::size_t page = 2000);
+  /// The boat's wind instrument readings in [from_ns, to_ns], oldest first, at most `limit`
+  /// (evenly thinned beyond it, first and last kept). Written by imports (ImportStore).
+  [[nodiscard]] std::vector<WindSample> wind(const std::string& boat_id, std::uint64_t from_ns,
+                                             std::uint64_t to_ns, std::size_t limit);
   /// Distance sailed and speeds over [from_ns, to_ns].
   [[nodiscard]] FixStats fix_stats(const std::string& boat_id, std::uint64_t from_ns,
                                    std::uint64_t to_ns);

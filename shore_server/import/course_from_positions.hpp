@@ -24,6 +24,7 @@ class CourseFromPositions : public ImportSink {
   explicit CourseFromPositions(ImportSink& next) : next_(next) {}
   void point(const ImportPoint& p) override;
   void event(const ImportEvent& e) override { next_.event(e); }
+  void wind(const ImportWind& w) override { next_.wind(w); }
   void device(std::string_view d) override { next_.device(d); }
   /// The last point held back, with its velocity from the one before it.
   void finish();

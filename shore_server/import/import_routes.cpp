@@ -42,6 +42,7 @@ json import_json(const import::ImportRecord& r) {
             {"points", r.points},
             {"samples_added", r.samples_added},
             {"fixes_added", r.fixes_added},
+            {"wind_added", r.wind_added},
             {"events", r.events},
             {"skipped", r.skipped},
             {"start", r.start_ns ? json(iso8601(r.start_ns)) : json(nullptr)},

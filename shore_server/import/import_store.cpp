@@ -11,6 +11,7 @@
 
 #include "course_from_positions.hpp"
 #include "detect.hpp"
+#include "sample_fields.hpp"
 #include "sqlite_stmt.hpp"
 
 namespace telltale::shore::import {
@@ -29,6 +30,7 @@ CREATE TABLE IF NOT EXISTS imports (
   points INTEGER NOT NULL DEFAULT 0,
   samples_added INTEGER NOT NULL DEFAULT 0,
   fixes_added INTEGER NOT NULL DEFAULT 0,
+  wind_added INTEGER NOT NULL DEFAULT 0,
   events INTEGER NOT NULL DEFAULT 0,
   skipped INTEGER NOT NULL DEFAULT 0,
   start_ns INTEGER NOT NULL DEFAULT 0,
@@ -83,11 +85,13 @@ class StoreSink : public ImportSink {
              "INSERT OR IGNORE INTO fixes (boat_id, t_utc_ns, seq, gnss_utc_ns, lat_deg, lon_deg, "
              "sog_m_s, cog_deg, fix, satellites, hdop, boot_id) "
              "VALUES (?1, ?2, 0, ?2, ?3, ?4, ?5, ?6, '3d', 0, NULL, 0)"),
+        wind_(db, insert_sql("wind", kWindFields).c_str()),
         event_(db,
                "INSERT INTO import_events (import_id, boat_id, t_utc_ns, kind, detail) "
                "VALUES (?1, ?2, ?3, ?4, ?5)") {
     attitude_.bind(1, boat_);
     fix_.bind(1, boat_);
+    wind_.bind(1, boat_);
     event_.bind(1, import_id_).bind(2, boat_);
   }
 
@@ -104,6 +108,15 @@ class StoreSink : public ImportSink {
     }
     extend(p.t_utc_ns, added);
     if (++points_ % 4096 == 0 && progress_) progress_(static_cast<std::uint64_t>(in_.tellg()));
+  }
+  void wind(const ImportWind& w) override {
+    WindSample row;
+    row.from_deg = w.from_deg;
+    row.speed_m_s = w.speed_m_s;
+    row.source = w.source;
+    wind_.bind_u(2, w.t_utc_ns);
+    bind_fields(wind_.get(), 3, kWindFields, row);
+    wind_added += static_cast<std::uint64_t>(wind_.run());
   }
   void event(const ImportEvent& e) override {
     event_.bind_u(3, e.t_utc_ns).bind(4, e.kind).bind(5, e.detail);
@@ -169,7 +182,7 @@ class StoreSink : public ImportSink {
     return out;
   }
 
-  std::uint64_t samples_added = 0, fixes_added = 0;
+  std::uint64_t samples_added = 0, fixes_added = 0, wind_added = 0;
   std::uint64_t start_ns = 0, end_ns = 0;
   std::string device_name;
 
@@ -200,7 +213,7 @@ class StoreSink : public ImportSink {
   std::uint64_t gap_ns_;
   std::istream& in_;
   const std::function<void(std::uint64_t)>& progress_;
-  Stmt attitude_, fix_, event_;
+  Stmt attitude_, fix_, wind_, event_;
   std::uint64_t points_ = 0;
   std::vector<Span> spans_;
 };
@@ -234,7 +247,13 @@ std::string sha256_file(const std::string& path) {
 }
 
 ImportStore::ImportStore(Store& store) : store_(store) {
-  store_.write_transaction([](sqlite3* db) { exec(db, kSchema); });
+  store_.write_transaction([](sqlite3* db) {
+    exec(db, kSchema);
+    // A database from before imports stored wind: the count's column, added as kSchema has it.
+    Stmt has(db, "SELECT COUNT(*) FROM pragma_table_info('imports') WHERE name = 'wind_added'");
+    if (has.step() && has.i64(0) == 0)
+      exec(db, "ALTER TABLE imports ADD COLUMN wind_added INTEGER NOT NULL DEFAULT 0");
+  });
 }
 
 std::int64_t ImportStore::begin(const std::string& boat_id, const std::string& file_name,
@@ -262,12 +281,14 @@ void ImportStore::fail_unfinished() {
 void ImportStore::finish(const ImportRecord& r) {
   store_.write_transaction([&](sqlite3* db) {
     Stmt up(db,
-           "UPDATE imports SET format = ?2, device = ?3, sha256 = ?4, state = ?5, points = ?6, "
-           "samples_added = ?7, fixes_added = ?8, events = ?9, skipped = ?10, start_ns = ?11, "
-           "end_ns = ?12, error = ?13, partial = ?14, duplicate_of = ?15 WHERE id = ?1");
+            "UPDATE imports SET format = ?2, device = ?3, sha256 = ?4, state = ?5, points = ?6, "
+            "samples_added = ?7, fixes_added = ?8, events = ?9, skipped = ?10, start_ns = ?11, "
+            "end_ns = ?12, error = ?13, partial = ?14, duplicate_of = ?15, wind_added = ?16 "
+            "WHERE id = ?1");
     up.bind(1, r.id).bind(2, r.format).bind(3, r.device).bind(4, r.sha256).bind(5, r.state).bind_u(6, r.points);
     up.bind_u(7, r.samples_added).bind_u(8, r.fixes_added).bind_u(9, r.events).bind_u(10, r.skipped);
     up.bind_u(11, r.start_ns).bind_u(12, r.end_ns).bind(13, r.error).bind(14, r.partial).bind(15, r.duplicate_of);
+    up.bind_u(16, r.wind_added);
     up.run();
   });
 }
@@ -338,6 +359,7 @@ ImportRecord ImportStore::run(std::int64_t id, const ImportRequest& req,
       r.skipped = pr.skipped;
       r.samples_added = sink.samples_added;
       r.fixes_added = sink.fixes_added;
+      r.wind_added = sink.wind_added;
       r.start_ns = sink.start_ns;
       r.end_ns = sink.end_ns;
       r.device = sink.device_name;
@@ -363,10 +385,11 @@ ImportRecord ImportStore::run(std::int64_t id, const ImportRequest& req,
 std::optional<ImportRecord> ImportStore::get(std::int64_t id) {
   std::optional<ImportRecord> out;
   store_.read([&](sqlite3* db) {
-    Stmt q(db,
-          "SELECT boat_id, state, format, device, file_name, sha256, bytes, points, samples_added, "
-          "fixes_added, events, skipped, start_ns, end_ns, error, partial, duplicate_of "
-          "FROM imports WHERE id = ?1");
+    Stmt q(
+        db,
+        "SELECT boat_id, state, format, device, file_name, sha256, bytes, points, samples_added, "
+        "fixes_added, events, skipped, start_ns, end_ns, error, partial, duplicate_of, wind_added "
+        "FROM imports WHERE id = ?1");
     q.bind(1, id);
     if (!q.step()) return;
     ImportRecord r;
@@ -389,6 +412,7 @@ std::optional<ImportRecord> ImportStore::get(std::int64_t id) {
     r.error = q.text(14);
     r.partial = q.text(15);
     r.duplicate_of = q.i64(16);
+    r.wind_added = q.u64(17);
     Stmt s(db, "SELECT session_id FROM import_sessions WHERE import_id = ?1 ORDER BY session_id");
     s.bind(1, id);
     while (s.step()) r.sessions.push_back(s.i64(0));

@@ -52,6 +52,7 @@ struct ImportRecord {
   std::uint64_t points = 0;      ///< points the file held
   std::uint64_t samples_added = 0;  ///< attitude rows new to the store
   std::uint64_t fixes_added = 0;    ///< fix rows new to the store
+  std::uint64_t wind_added = 0;     ///< wind instrument rows new to the store
   std::uint64_t events = 0;
   std::uint64_t skipped = 0;
   std::vector<std::int64_t> sessions;

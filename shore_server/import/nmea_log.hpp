@@ -13,8 +13,12 @@
 /// - Speed and course: RMC, VTG. Heading: HDT, HDG (true when it states the variation), HDM
 ///   (magnetic: made true with ImportOptions::declination_deg, else left out).
 /// - Heel and pitch: XDR angle transducers named ROLL or HEEL (+ starboard down) and PTCH, PITCH
-///   or TRIM (+ bow up), any case. Each value is attached once, to the epoch it came in (or the next).
-/// - MWV/MWD wind is recognised and counted, not stored (the store has no wind column yet).
+///   or TRIM (+ bow up), any case. Each value is attached once, to the epoch it came in (or the
+///   next).
+/// - Wind: MWD (a true direction; a magnetic one with the declination), MWV T (the instrument's
+///   true angle off the bow, turned by the epoch's heading, else its COG) and MWV R (apparent,
+///   made true with the boat's velocity: record.hpp true_wind_from_apparent), one per epoch, the
+///   best kind in that order. MWV with status V, or MWD with a speed and no direction: skipped.
 /// - Lines that are not sentences, fail their checksum or do not parse are skipped and counted;
 ///   the file is an error only if no point at all came out of it.
 /// Streaming: one line in memory (longer than 1 KB: skipped).

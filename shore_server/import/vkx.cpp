@@ -65,6 +65,8 @@ ParseResult parse_vkx(std::istream& in, const ImportOptions& options, ImportSink
   std::array<unsigned char, 64> buf{};
   std::uint64_t offset = 0;
   bool seen_header = false;
+  ImportPoint last_pvo;  // the boat's velocity and heading for the apparent wind rows
+  std::uint64_t last_pvo_ns = 0;
   auto partial = [&](const std::string& why) {
     r.status = r.points > 0 ? ParseStatus::kPartial : ParseStatus::kError;
     r.message = why;
@@ -110,9 +112,22 @@ ParseResult parse_vkx(std::istream& in, const ImportOptions& options, ImportSink
         pt.heel_deg = e.heel_deg;
         pt.pitch_deg = e.pitch_deg;
         pt.heading_deg = e.heading_deg;
+        last_pvo = pt;
+        last_pvo_ns = pt.t_utc_ns;
         apply_offsets(options, pt);
         sink.point(pt);
         ++r.points;
+        break;
+      }
+      case 0x0A: {
+        // The Calypso sensor's apparent wind: made true with the boat's last position row (its
+        // heading, SOG and COG), when that row is at most a second older.
+        const std::uint64_t t = u64(p) * 1'000'000ULL;
+        if (t >= last_pvo_ns && t - last_pvo_ns <= 1'000'000'000ULL && last_pvo_ns != 0) {
+          const TrueWind w = true_wind_from_apparent(f32(p + 8), f32(p + 12), last_pvo.heading_deg,
+                                                     last_pvo.sog_m_s, last_pvo.cog_deg);
+          if (std::isfinite(w.from_deg)) sink.wind({t, w.from_deg, w.speed_m_s, "vkx_apparent"});
+        }
         break;
       }
       case 0x04: {

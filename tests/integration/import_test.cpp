@@ -429,6 +429,116 @@ TEST_F(ImportTest, RealWatchTracksGiveTheirTacksAndTheWind) {
   }
 }
 
+/// The first race's track as an NMEA log from a boat with a GPS and a masthead wind instrument:
+/// RMC (position, SOG and COG from the neighbouring positions, as a receiver gives them) and MWV R,
+/// the apparent wind such an instrument would read in a true wind from `wind_from(t_s)` at 6 m/s
+/// (the air over the ground minus the boat's own velocity, turned to the bow by the COG).
+std::string instrument_nmea(const std::string& csv_path, double (*wind_from)(double)) {
+  struct P {
+    std::string t;
+    double lat, lon;
+  };
+  std::vector<P> pts;
+  std::ifstream in(csv_path);
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    const auto a = line.find(','), b = line.find(',', a + 1);
+    if (a == std::string::npos || b == std::string::npos) continue;
+    pts.push_back({line.substr(0, a), std::stod(line.substr(a + 1, b - a - 1)),
+                   std::stod(line.substr(b + 1))});
+  }
+  const auto sentence = [](const std::string& body) {
+    unsigned sum = 0;
+    for (char c : body) sum ^= static_cast<unsigned char>(c);
+    char tail[8];
+    std::snprintf(tail, sizeof tail, "*%02X", sum);
+    return "$" + body + tail + "\r\n";
+  };
+  const auto dm = [](double deg, int deg_digits) {
+    const double a = std::abs(deg);
+    const int d = static_cast<int>(a);
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%0*d%09.6f", deg_digits, d, (a - d) * 60.0);
+    return std::string(buf);
+  };
+  constexpr double kRad = M_PI / 180.0, kM = 6371000.0 * M_PI / 180.0;
+  std::string out;
+  for (std::size_t i = 1; i + 1 < pts.size(); ++i) {
+    const P &p = pts[i], &a = pts[i - 1], &b = pts[i + 1];
+    const double dt = seconds_apart(b.t, a.t);
+    if (dt <= 0.0) continue;
+    const double vn = (b.lat - a.lat) * kM / dt,
+                 ve = (b.lon - a.lon) * kM * std::cos(p.lat * kRad) / dt;
+    const double sog = std::hypot(vn, ve),
+                 cog = std::fmod(std::atan2(ve, vn) / kRad + 360.0, 360.0);
+    // "2025-06-21T11:18:29Z" -> 111829.00 and 210625
+    const std::string hms = p.t.substr(11, 2) + p.t.substr(14, 2) + p.t.substr(17, 2) + ".00";
+    const std::string date = p.t.substr(8, 2) + p.t.substr(5, 2) + p.t.substr(2, 2);
+    char speed[64];
+    std::snprintf(speed, sizeof speed, "%.2f,%.1f", sog * 3600.0 / 1852.0, cog);
+    out += sentence("GPRMC," + hms + ",A," + dm(p.lat, 2) + (p.lat < 0 ? ",S," : ",N,") +
+                    dm(p.lon, 3) + (p.lon < 0 ? ",W," : ",E,") + speed + "," + date + ",,,A");
+    const double tw = wind_from(seconds_apart(p.t, pts.front().t)) * kRad;
+    const double rn = -6.0 * std::cos(tw) - vn, re = -6.0 * std::sin(tw) - ve;  // air past the boat
+    const double awa = std::fmod(std::atan2(-re, -rn) / kRad - cog + 720.0, 360.0);
+    char mwv[64];
+    std::snprintf(mwv, sizeof mwv, "WIMWV,%.1f,R,%.2f,M,A", awa, std::hypot(rn, re));
+    out += sentence(mwv);
+  }
+  return out;
+}
+
+// A boat with a wind instrument: its log's wind overrides the estimate from the tacks, and the
+// report says how far that estimate was off. The first race's real track, with the apparent wind
+// an instrument would read in a true wind from 110 deg (the sailor's note) swinging +-8 deg over
+// 5 minutes: the session's wind is the instrument's (within 1 deg of its mean, 110), the estimate
+// from the tacks is reported beside it (the figure of the GPX test above, within 8 deg), the
+// error is their difference, the manoeuvres are the same tacks and gybes, and a coach's wind
+// still overrides both.
+TEST_F(ImportTest, AWindInstrumentInTheLogOverridesTheEstimateAndMeasuresIt) {
+  const std::string csv =
+      std::string(TELLTALE_TEST_DATA_DIR) + "/maxsail_valencia/ESP30782-P01.csv";
+  const std::string log = instrument_nmea(
+      csv, [](double t_s) { return 110.0 + 8.0 * std::sin(2.0 * M_PI * t_s / 300.0); });
+  auto res = upload("boat=ESP30782-W&name=race1.nmea", log, kAnalyst);
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 202) << res->body;
+  const auto done = finished(nlohmann::json::parse(res->body)["id"].get<std::int64_t>());
+  ASSERT_EQ(done["state"], "done") << done.dump();
+  EXPECT_EQ(done["format"], "nmea");
+  ASSERT_EQ(done["sessions"].size(), 1u) << done.dump();
+  // Every epoch has its wind, made true again from the apparent (the boat's velocity taken out).
+  EXPECT_GT(done["wind_added"].get<int>(), 1900) << done.dump();
+  EXPECT_EQ(done["wind_added"], done["points"]) << done.dump();
+  const std::string base =
+      "/api/v1/sessions/" + std::to_string(done["sessions"][0].get<std::int64_t>());
+  const auto got = get_json(base + "/manoeuvres");
+  const auto& w = got["wind"];
+  ASSERT_EQ(w["source"], "instrument") << w.dump();
+  EXPECT_TRUE(w["given"].get<bool>());
+  EXPECT_NEAR(w["from_deg"].get<double>(), 110.0, 1.0) << w.dump();
+  EXPECT_NEAR(w["instrument"]["from_deg"].get<double>(), 110.0, 1.0) << w.dump();
+  EXPECT_NEAR(w["instrument"]["speed_m_s"].get<double>(), 6.0, 0.1) << w.dump();
+  EXPECT_GT(w["instrument"]["spread_deg"].get<double>(), 3.0) << w.dump();  // the swing is seen
+  EXPECT_LT(w["instrument"]["spread_deg"].get<double>(), 8.0) << w.dump();
+  ASSERT_TRUE(w["estimated_from_deg"].is_number()) << w.dump();
+  const double est = w["estimated_from_deg"].get<double>();
+  EXPECT_LT(std::abs(std::remainder(est - 110.0, 360.0)), 8.0) << w.dump();
+  EXPECT_NEAR(w["estimate_error_deg"].get<double>(),
+              std::remainder(est - w["instrument"]["from_deg"].get<double>(), 360.0), 1e-9);
+  int tacks = 0, gybes = 0;
+  for (const auto& m : got["manoeuvres"]) {
+    tacks += m["kind"] == "tack";
+    gybes += m["kind"] == "gybe";
+  }
+  EXPECT_GE(tacks, 7) << got.dump();  // the race's 7 after the start, and any before it
+  EXPECT_GE(gybes, 2) << got.dump();
+  const auto coach = get_json(base + "/manoeuvres?wind_from_deg=100");
+  EXPECT_EQ(coach["wind"]["source"], "coach") << coach["wind"].dump();
+  EXPECT_EQ(coach["wind"]["from_deg"].get<double>(), 100.0);
+  EXPECT_TRUE(coach["wind"]["instrument"].is_null()) << coach["wind"].dump();
+}
 
 }  // namespace
 }  // namespace telltale::testing

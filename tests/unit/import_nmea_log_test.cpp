@@ -131,6 +131,54 @@ TEST(ImportNmeaLog, RealSignalKSampleLog) {
   EXPECT_DOUBLE_EQ(sink.points[0].cog_deg, 225.18);
   EXPECT_TRUE(std::isnan(sink.points[0].heading_deg));  // the log's HDT and HDM are empty
   EXPECT_GT(r.skipped, 20u);  // VHW, VPW, VWT, DBT, XTE, GSV, ... are not ours
+
+  // Its wind: the instrument alternates MWV T (true angle off the bow) and MWV R (apparent);
+  // MWD has a speed and no direction. No heading: the COG turns the angle to the compass.
+  ASSERT_EQ(sink.winds.size(), 3u);  // the fourth epoch has no wind sentence
+  EXPECT_EQ(sink.winds[0].t_utc_ns, t0);
+  EXPECT_STREQ(sink.winds[0].source, "mwv_true");  // T outranks the R of the same epoch
+  EXPECT_NEAR(sink.winds[0].from_deg, std::fmod(313.0 + 225.18, 360.0), 1e-9);
+  EXPECT_NEAR(sink.winds[0].speed_m_s, 8.16 * 1852.0 / 3600.0, 1e-9);
+  // 09:56:01: apparent 336 deg off the bow at 12.82 kn, COG 226.95, SOG 5.80 kn.
+  const double kn = 1852.0 / 3600.0, rad = M_PI / 180.0;
+  const double a = (226.95 + 336.0) * rad, c = 226.95 * rad;
+  const double wn = -12.82 * kn * std::cos(a) + 5.80 * kn * std::cos(c);
+  const double we = -12.82 * kn * std::sin(a) + 5.80 * kn * std::sin(c);
+  EXPECT_STREQ(sink.winds[1].source, "mwv_apparent");
+  EXPECT_NEAR(sink.winds[1].from_deg,
+              std::atan2(-we, -wn) / rad + 360.0 * (std::atan2(-we, -wn) < 0), 1e-6);
+  EXPECT_NEAR(sink.winds[1].speed_m_s, std::hypot(wn, we), 1e-9);
+  // The same wind read both ways agrees to a few degrees (the instrument's own true wind is
+  // water-referenced and leeway is in both): 178.2 (T), 185.5 (R made true), 186.8 (T).
+  EXPECT_NEAR(std::remainder(sink.winds[1].from_deg - sink.winds[0].from_deg, 360.0), 0.0, 10.0);
+  EXPECT_NEAR(sink.winds[2].from_deg, std::fmod(318.0 + 228.83, 360.0), 1e-9);
+}
+
+TEST(ImportNmeaLog, WindDirectionsFromMwdAndInvalidReadingsSkipped) {
+  const std::string log =
+      s("GPRMC,105640.00,A,3930.0000,N,00230.0000,E,5.0,010.0,080226,,,A") + "\n" +
+      s("WIMWD,250.5,T,248.0,M,14.0,N,7.2,M") + "\n" + s("WIMWV,045,T,12.0,N,A") + "\n" +
+      s("GPRMC,105641.00,A,3930.0010,N,00230.0010,E,5.0,010.0,080226,,,A") + "\n" +
+      s("WIMWV,045,T,12.0,N,V") + "\n" +        // status V: not valid
+      s("WIMWD,,T,248.0,M,14.0,N,,M") + "\n" +  // magnetic only, and no declination given
+      s("GPRMC,105642.00,A,3930.0020,N,00230.0020,E,5.0,010.0,080226,,,A") + "\n" +
+      s("WIMWD,,T,248.0,M,14.0,N,,M") + "\n";
+  Collect sink;
+  const auto r = run(Format::kNmea, log, sink);
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.message;
+  ASSERT_EQ(sink.winds.size(), 1u);
+  EXPECT_STREQ(sink.winds[0].source, "mwd");  // MWD outranks the MWV of its epoch
+  EXPECT_DOUBLE_EQ(sink.winds[0].from_deg, 250.5);
+  EXPECT_DOUBLE_EQ(sink.winds[0].speed_m_s, 7.2);  // m/s preferred to knots
+  EXPECT_EQ(r.skipped, 3u);
+  // With the declination, the magnetic direction is made true (knots when no m/s).
+  ImportOptions o;
+  o.declination_deg = 2.5;
+  Collect with_decl;
+  ASSERT_EQ(run(Format::kNmea, log, with_decl, o).status, ParseStatus::kOk);
+  ASSERT_EQ(with_decl.winds.size(), 3u);
+  EXPECT_DOUBLE_EQ(with_decl.winds[2].from_deg, 250.5);
+  EXPECT_NEAR(with_decl.winds[2].speed_m_s, 14.0 * 1852.0 / 3600.0, 1e-9);
 }
 
 }  // namespace

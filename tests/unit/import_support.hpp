@@ -14,8 +14,10 @@ namespace telltale::shore::import::test {
 struct Collect : ImportSink {
   std::vector<ImportPoint> points;
   std::vector<ImportEvent> events;
+  std::vector<ImportWind> winds;
   std::string device_name;
   void point(const ImportPoint& p) override { points.push_back(p); }
+  void wind(const ImportWind& w) override { winds.push_back(w); }
   void event(const ImportEvent& e) override { events.push_back(e); }
   void device(std::string_view d) override { device_name = std::string(d); }
 };

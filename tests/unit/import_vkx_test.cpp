@@ -108,5 +108,32 @@ TEST(ImportVkx, TruncatedRowNamesItsOffset) {
   EXPECT_EQ(run(Format::kVkx, "not a vkx", none).status, ParseStatus::kError);
 }
 
+TEST(ImportVkx, ApparentWindRowsAreMadeTrueWithTheBoatsVelocity) {
+  // The boat heads and sails east (pvo: COG 90 deg, 3.5 m/s); a true wind of 5 m/s from the north
+  // reaches it as air moving past at (-5 north, -3.5 east): apparent from 325.0 deg on the
+  // compass, 235.0 deg off the bow, at hypot(5, 3.5).
+  const double awa = std::atan2(3.5, 5.0) * 180.0 / M_PI - 90.0 + 360.0;  // off the bow
+  const double aws = std::hypot(5.0, 3.5);
+  auto wind_row = [](std::uint64_t ms, double dir, double speed) {
+    std::string s;
+    put_u8(s, 0x0A);
+    put_u64(s, ms);
+    put_f32(s, static_cast<float>(dir));
+    put_f32(s, static_cast<float>(speed));
+    return s;
+  };
+  const std::string f = page_header() + wind_row(kMs0 - 100, awa, aws) + pvo(kMs0, 0.0, 0.0, 90.0) +
+                        wind_row(kMs0 + 200, awa, aws) + wind_row(kMs0 + 1500, awa, aws);
+  Collect sink;
+  const auto r = run(Format::kVkx, f, sink);
+  ASSERT_EQ(r.status, ParseStatus::kOk) << r.message;
+  // Before any position row and 1.5 s after the last one: no velocity to take out, no wind.
+  ASSERT_EQ(sink.winds.size(), 1u);
+  EXPECT_EQ(sink.winds[0].t_utc_ns, (kMs0 + 200) * 1000000ULL);
+  EXPECT_NEAR(std::remainder(sink.winds[0].from_deg - 0.0, 360.0), 0.0, 1e-3);
+  EXPECT_NEAR(sink.winds[0].speed_m_s, 5.0, 1e-4);
+  EXPECT_STREQ(sink.winds[0].source, "vkx_apparent");
+}
+
 }  // namespace
 }  // namespace telltale::shore::import
