@@ -57,6 +57,7 @@ struct StandBiasParams {
   /// (least squares over the stand's samples) is the bias about the stand's vertical; the other
   /// two components stay the gyro learner's. Never used while walking: the walker then moves
   /// through the field's disturbances, and a direction change of the field is not a turn.
+  /// Stands are combined by the inverse variance of their slopes (see StandBiasLearner::State).
   bool mag_yaw_bias = true;
   /// The magnetic yaw's noise goes as 1/|B horizontal|: below this (a field nearly along the
   /// vertical, or a dead sensor) a stand says nothing. Earth's horizontal field is 10-40 uT.
@@ -83,12 +84,14 @@ class StandBiasLearner {
     Eigen::Vector3d bias = Eigen::Vector3d::Zero();
     // Magnetic yaw: psi_g = integral of w . up (raw gyro), psi_m = the phone's yaw from the
     // field (unwrapped, counter-clockwise), d = psi_g - psi_m. Least-squares sums of d against t
-    // (t from the stand's start) over the window and over the stand; |B| sums for its rms.
+    // (t from the first sample) over the window and over the stand, d^2 for the residual about
+    // the fitted line (the slope's variance); |B| sums for its rms.
     struct YawSums {
-      double n = 0.0, t = 0.0, d = 0.0, tt = 0.0, td = 0.0, b = 0.0, bb = 0.0, bh = 0.0;
+      double n = 0.0, t = 0.0, d = 0.0, tt = 0.0, td = 0.0, dd = 0.0, b = 0.0, bb = 0.0,
+             bh = 0.0;
       Eigen::Vector3d up = Eigen::Vector3d::Zero();
       void add(const YawSums& o) {
-        n += o.n; t += o.t; d += o.d; tt += o.tt; td += o.td;
+        n += o.n; t += o.t; d += o.d; tt += o.tt; td += o.td; dd += o.dd;
         b += o.b; bb += o.bb; bh += o.bh; up += o.up;
       }
     };
@@ -98,9 +101,11 @@ class StandBiasLearner {
     YawSums win_yaw, stand_yaw;
     bool win_yaw_ok = true;    ///< every sample of the window had a usable field
     bool stand_yaw_ok = true;  ///< and every window of the stand
-    double mag_weight = 0.0;  ///< sum of T^2 of the stands with a magnetic slope
-    double mag_sum = 0.0;     ///< sum of T^2 * slope (rad/s about that stand's up)
-    Eigen::Vector3d mag_up = Eigen::Vector3d::Zero();  ///< sum of T^2 * the stand's mean up
+    /// The stands with a magnetic slope, each weighted by the inverse variance of its slope,
+    /// T^3 / (rms residual of d about its line)^2 (mag_slope_weight in the source).
+    double mag_weight = 0.0;  ///< sum of the weights
+    double mag_sum = 0.0;     ///< sum of weight * slope (rad/s about that stand's up)
+    Eigen::Vector3d mag_up = Eigen::Vector3d::Zero();  ///< sum of weight * the stand's mean up
     double vertical_bias = 0.0;  ///< the magnetic estimate about mag_up (valid if mag_weight > 0)
     bool quiet = false;  ///< the last full window was quiet
     bool have_bias = false;
