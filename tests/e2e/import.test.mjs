@@ -75,6 +75,58 @@ test('import view: dropped files upload with progress and open in review', async
   assert.deepEqual(browser.problems, []);
 });
 
+// An NMEA log of a boat beating with a wind instrument: RMC at 1 Hz, tacking through 90 deg every
+// 60 s on a wind from 200 deg, which its MWD states.
+function beatNmea(legs = 6, t0 = Date.UTC(2026, 10, 22, 12, 0, 0)) {
+  const sentence = (body) => {
+    let sum = 0;
+    for (const c of body) sum ^= c.charCodeAt(0);
+    return `$${body}*${sum.toString(16).toUpperCase().padStart(2, '0')}\r\n`;
+  };
+  const dm = (deg, digits) => {
+    const a = Math.abs(deg);
+    const d = Math.floor(a);
+    return `${String(d).padStart(digits, '0')}${((a - d) * 60).toFixed(5).padStart(8, '0')}`;
+  };
+  let lat = 39.45;
+  let lon = -0.3;
+  let out = '';
+  for (let i = 0; i < legs * 60; i++) {
+    const leg = Math.floor(i / 60);
+    const from = leg % 2 ? 245 : 155;
+    const to = leg % 2 ? 155 : 245;
+    const s = i % 60;
+    const cog = s >= 57 ? from + ((to - from) * (s - 56)) / 4 : from; // a 4 s tack
+    const d = new Date(t0 + i * 1000);
+    const hms = `${String(d.getUTCHours()).padStart(2, '0')}${String(d.getUTCMinutes()).padStart(2, '0')}${String(d.getUTCSeconds()).padStart(2, '0')}.00`;
+    out += sentence(`GPRMC,${hms},A,${dm(lat, 2)},N,${dm(lon, 3)},W,5.83,${cog.toFixed(1)},221126,,,A`);
+    out += sentence('WIMWD,200.0,T,,M,11.7,N,6.0,M');
+    lat += (3.0 * Math.cos((cog * Math.PI) / 180)) / 111320;
+    lon -= (3.0 * Math.sin((cog * Math.PI) / 180)) / (111320 * Math.cos((lat * Math.PI) / 180));
+  }
+  return out;
+}
+
+test('import view: a log with a wind instrument reviews with the instrument\'s wind', async () => {
+  await login(page, fleet, '#/import');
+  await page.waitForSelector('.drop-zone');
+  await page.fill('#import-boat', 'ILCA-6');
+  await drop([{ name: 'beat.nmea', text: beatNmea() }]);
+  const row = page.locator('.import-item', { has: page.locator('.import-name', { hasText: 'beat.nmea' }) });
+  await eventually(async () => (await row.getAttribute('data-state')) === 'done',
+    { timeoutMs: 15000, what: 'beat.nmea imported' });
+  const [session] = await fleet.json('/sessions?boat=ILCA-6');
+  const rest = await fleet.json(`/sessions/${session.id}/manoeuvres`);
+  assert.equal(rest.wind.source, 'instrument');
+  assert.equal(rest.wind.from_deg, 200);
+  assert.ok(rest.manoeuvres.filter((m) => m.kind === 'tack').length >= 4, JSON.stringify(rest.manoeuvres));
+  await login(page, fleet, `#/review?boat=ILCA-6&session=${session.id}`);
+  await page.waitForSelector('.manoeuvres[data-state="ready"]', { timeout: 10000 });
+  const hint = await page.textContent('.manoeuvres p.hint');
+  assert.match(hint, /Wind from 200° \(the boat's wind instrument, spread ±0°; the tacks say \d+° \([+−]\d+\.\d°\)\)/);
+  assert.deepEqual(browser.problems, []);
+});
+
 test('import view: the progress bar moves while a file uploads', async () => {
   await login(page, fleet, '#/import');
   await page.waitForSelector('.drop-zone');

@@ -168,8 +168,17 @@ function fillList(section, { detail, results, all, jump, overlay }) {
   }
   show.addEventListener('change', rows);
   const w = main.wind;
+  // Where the wind came from: the coach's (typed in), the boat's wind instrument (an imported
+  // log's), else the tacks; beside a given wind, what the tacks alone would have said.
+  const estimate = Number.isFinite(w?.estimated_from_deg) && w.given
+    ? `; the tacks say ${Math.round(w.estimated_from_deg)}°${Number.isFinite(w.estimate_error_deg) ? ` (${w.estimate_error_deg >= 0 ? '+' : '−'}${Math.abs(w.estimate_error_deg).toFixed(1)}°)` : ''}`
+    : '';
+  const source = w?.source === 'instrument'
+    ? ` (the boat's wind instrument, spread ±${Math.round(w.instrument?.spread_deg ?? 0)}°${estimate})`
+    : w?.source === 'coach' ? ` (given${estimate})`
+      : ` (estimated from the tacks, ±${Math.max(1, Math.round(w?.uncertainty_deg ?? 0))}°)`;
   const wind = Number.isFinite(w?.from_deg)
-    ? `Wind from ${Math.round(w.from_deg)}°${w.given ? '' : ` (estimated from the tacks, ±${Math.max(1, Math.round(w.uncertainty_deg ?? 0))}°)`}.`
+    ? `Wind from ${Math.round(w.from_deg)}°${source}.`
     : 'Wind not known (no tack to read it from): every turn that is not clearly a tack or gybe is listed by its course.';
   const counts = KIND_ORDER.map((k) => [k, main.manoeuvres.filter((m) => m.kind === k).length]).filter(([, c]) => c)
     .map(([k, c]) => `${c} × ${KIND_LABEL[k].toLowerCase()}`).join(' · ');
