@@ -154,11 +154,27 @@ void register_manoeuvre_routes(httplib::Server& server, ShoreContext& ctx) {
     // estimate is still made, and reported beside it: how far the track's own estimate is off.
     const char* wind_source = opt.wind_from_deg ? "coach" : "estimated";
     std::optional<InstrumentWind> instrument;
+    std::vector<WindSample> readings;
     if (!opt.wind_from_deg) {
-      instrument = instrument_wind(ctx.store.wind(s->boat_id, read_from, s->end_ns, 50000));
+      readings = ctx.store.wind(s->boat_id, read_from, s->end_ns, 50000);
+      instrument = instrument_wind(readings);
       if (instrument) {
         opt.wind_from_deg = instrument->from_deg;
         wind_source = "instrument";
+        // Each manoeuvre against the wind of its own time: the readings of the 2 minutes
+        // either side of its t0 (a shift is minutes long; a gust's swing averages out).
+        opt.wind_at = [&readings, &rel](double t_s) -> std::optional<double> {
+          constexpr double kHalfS = 120.0;
+          const auto lo = std::lower_bound(
+              readings.begin(), readings.end(), t_s - kHalfS,
+              [&](const WindSample& w, double t) { return rel(w.t_utc_ns) < t; });
+          const auto hi = std::upper_bound(
+              lo, readings.end(), t_s + kHalfS,
+              [&](double t, const WindSample& w) { return t < rel(w.t_utc_ns); });
+          const auto here = instrument_wind(std::vector<WindSample>(lo, hi));
+          if (!here) return std::nullopt;
+          return here->from_deg;
+        };
       }
     }
     fusion::ManoeuvreReport rep = fusion::analyse_manoeuvres(fixes, heel, opt);

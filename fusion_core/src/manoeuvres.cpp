@@ -490,7 +490,12 @@ ManoeuvreReport analyse_manoeuvres(std::span<const CourseSample> course,
   for (const auto& m : valid) {
     Manoeuvre r;
     const double total = m.after - m.before;
-    r.kind = wind ? classify(wrap360(m.before), total, *wind, m.penalty)
+    // The wind where this manoeuvre was: an instrument's reading of its time, else the session's.
+    std::optional<double> here = wind;
+    if (o.wind_at) {
+      if (const auto measured = o.wind_at(g.t_start + m.t0_k * kDt)) here = *measured;
+    }
+    r.kind = here ? classify(wrap360(m.before), total, *here, m.penalty)
                   : (m.penalty ? ManoeuvreKind::kPenalty : ManoeuvreKind::kOther);
     const long k0 = std::lround(m.t0_k);
     r.t0_s = g.t_start + m.t0_k * kDt;
@@ -538,9 +543,9 @@ ManoeuvreReport analyse_manoeuvres(std::span<const CourseSample> course,
     const auto [ee, en] = g.mean_vel(at(-20), at(-10));
     r.distance_lost_m = (ee * ue + en * un) * 30.0 - g.made_along(at(-10), at(20), ue, un);
     r.vmg_lost_m = kNaN;
-    if (wind) {
-      const bool up = std::abs(diff180(r.course_before_deg, *wind)) < 90.0;
-      const double wd = up ? *wind : wrap360(*wind + 180.0);
+    if (here) {
+      const bool up = std::abs(diff180(r.course_before_deg, *here)) < 90.0;
+      const double wd = up ? *here : wrap360(*here + 180.0);
       const double we = std::sin(wd * kDeg), wn = std::cos(wd * kDeg);
       r.vmg_lost_m = (ee * we + en * wn) * 30.0 - g.made_along(at(-10), at(20), we, wn);
     }

@@ -158,6 +158,34 @@ TEST(Manoeuvre, SameTurnIsAGybeBearAwayOrRoundUpDependingOnTheWind) {
   EXPECT_EQ(kind(130.0), ManoeuvreKind::kTack);
 }
 
+// A wind instrument's wind of the manoeuvre's own time overrides the session's: a turn of 100 ->
+// 160 deg in a wind from 130 (a tack), then back 160 -> 100 after the wind has gone round to 310
+// (the same crossing of 130 is then a gybe). One session wind calls both alike; the wind at each t0 tells
+// them apart, and a time the instrument does not know falls back to the session's wind.
+TEST(Manoeuvre, AnInstrumentsWindAtEachTimeClassifiesEachManoeuvreAgainstItsOwnWind) {
+  Synth s = turn_at(100.0, 60.0, 60.0);
+  const Synth second = turn_at(160.0, -60.0, 60.0);  // and back, from where the first ended
+  for (auto f : second.fixes) {
+    f.t_s += 120.1;
+    s.fixes.push_back(f);
+  }
+  ManoeuvreOptions o;
+  o.wind_from_deg = 130.0;
+  o.min_turn_deg = 45.0;
+  const auto one_wind = analyse_manoeuvres(s.fixes, {}, o);
+  ASSERT_EQ(one_wind.manoeuvres.size(), 2u);
+  EXPECT_EQ(one_wind.manoeuvres[1].kind, ManoeuvreKind::kTack);
+  o.wind_at = [](double t) -> std::optional<double> {
+    if (t < 100.0) return std::nullopt;  // not known: the session's 130
+    return 310.0;
+  };
+  const auto rep = analyse_manoeuvres(s.fixes, {}, o);
+  ASSERT_EQ(rep.manoeuvres.size(), 2u);
+  EXPECT_EQ(rep.manoeuvres[0].kind, ManoeuvreKind::kTack);
+  EXPECT_EQ(rep.manoeuvres[1].kind, ManoeuvreKind::kGybe);
+  EXPECT_EQ(*rep.wind_from_deg, 130.0);  // the session's wind as given
+}
+
 // A turn in the last seconds of the data: its after-windows lie past the end and must read as
 // empty (the AddressSanitizer build read past the prefix sums here).
 TEST(Manoeuvre, ATurnAtTheVeryEndOfTheDataIsHandledWithoutReadingPastIt) {

@@ -34,7 +34,8 @@
 /// manoeuvres classified, the wind is the circular median of the tacks' bisectors and the gybes'
 /// inverted (twice: classify again with it), reported with its uncertainty (1.25 x 1.4826 MAD /
 /// sqrt(n), the median's standard error) and as it stood after each tack or gybe
-/// (`wind_over_time`). A direction given by the caller overrides it.
+/// (`wind_over_time`). A direction given by the caller overrides it; a wind instrument's
+/// readings (`wind_at`) override it per manoeuvre, at its t0.
 ///
 /// **Metrics** (t0 = the course crosses the bisector of the mean courses 20-5 s before and 5-20 s
 /// after the turn; a penalty turn's t0 is half its turning done). All windows relative to t0:
@@ -63,6 +64,7 @@
 ///    20 % of its mean (-20, -10): the loss may come from before the turn (flagged, not clipped).
 /// A window without data gives NaN.
 
+#include <functional>
 #include <limits>
 #include <optional>
 #include <span>
@@ -89,6 +91,11 @@ const char* to_string(ManoeuvreKind k);
 
 struct ManoeuvreOptions {
   std::optional<double> wind_from_deg;  ///< a wind instrument or the coach: overrides the estimate
+  /// The wind at a time (s, the samples' time base), where a wind instrument measured it: each
+  /// manoeuvre is classified and its VMG loss measured against the wind of its t0 (a shift of 20
+  /// deg over a session moves a tack's VMG loss by a third of its distance); nullopt at a time
+  /// it does not know falls back to the session's wind.
+  std::function<std::optional<double>(double t_s)> wind_at;
   double min_turn_deg = 60.0;
   double window_s = 10.0;
   double min_sog_m_s = 1.0;
