@@ -8,6 +8,8 @@
 
 #include "nmea.hpp"
 #include "nmea_gnss.hpp"
+#include "nmea_wind.hpp"
+#include "telltale/fusion/wind.hpp"
 
 namespace telltale::shore::import {
 namespace {
@@ -83,16 +85,6 @@ bool split_line(std::string_view line, std::string_view& prefix, std::string_vie
   return true;
 }
 
-/// A wind sentence as read, made a true wind when its epoch closes (it may need the epoch's
-/// heading, course and speed, which can come after it). Better kinds replace worse ones within
-/// one epoch: a true direction (MWD) over a true angle off the bow (MWV T, which needs the
-/// heading) over an apparent one (MWV R, which needs the boat's velocity too).
-struct RawWind {
-  enum Kind : int { kNone = 0, kApparent = 1, kTrueAngle = 2, kTrueDirection = 3 } kind = kNone;
-  double angle_deg = kNaN;  ///< MWD: from, true; MWV: off the bow, clockwise
-  double speed_m_s = kNaN;
-};
-
 class Epochs {
  public:
   Epochs(const ImportOptions& options, ImportSink& sink, ParseResult& r)
@@ -118,8 +110,11 @@ class Epochs {
     if (std::isfinite(cog)) p_.cog_deg = cog;
   }
   void heading(double deg) { heading_ = deg; }
-  void wind(const RawWind& w) {
-    if (w.kind >= wind_.kind) wind_ = w;
+  /// A wind sentence's reading, made the true wind when its epoch closes (it may need the
+  /// epoch's heading, course and speed, which can come after it). The better kind replaces the
+  /// worse within one epoch (fusion::wind_rank).
+  void wind(const fusion::WindReading& w) {
+    if (!wind_ || fusion::wind_rank(w.ref) >= fusion::wind_rank(wind_->ref)) wind_ = w;
   }
   void heel(double deg) { heel_ = deg; }
   void pitch(double deg) { pitch_ = deg; }
@@ -159,36 +154,13 @@ class Epochs {
 
  private:
   void emit_wind() {
-    const RawWind w = wind_;
-    wind_ = RawWind{};
-    ImportWind out;
-    out.t_utc_ns = p_.t_utc_ns;
-    out.speed_m_s = w.speed_m_s;
-    switch (w.kind) {
-      case RawWind::kNone:
-        return;
-      case RawWind::kTrueDirection:
-        out.from_deg = wrap360(w.angle_deg);
-        out.source = "mwd";
-        break;
-      case RawWind::kTrueAngle: {
-        // The instrument's true wind angle is off the bow: the heading turns it to the compass.
-        // Without a heading the course stands in (leeway, a few degrees, reads as wind).
-        const double bow = std::isfinite(p_.heading_deg) ? p_.heading_deg : p_.cog_deg;
-        out.from_deg = wrap360(bow + w.angle_deg);
-        out.source = "mwv_true";
-        break;
-      }
-      case RawWind::kApparent: {
-        const TrueWind t = true_wind_from_apparent(w.angle_deg, w.speed_m_s, p_.heading_deg,
-                                                   p_.sog_m_s, p_.cog_deg);
-        out.from_deg = t.from_deg;
-        out.speed_m_s = t.speed_m_s;
-        out.source = "mwv_apparent";
-        break;
-      }
-    }
-    if (std::isfinite(out.from_deg)) sink_.wind(out);
+    if (!wind_) return;
+    const fusion::WindReading w = *wind_;
+    wind_.reset();
+    const fusion::TrueWind t =
+        fusion::true_wind(w, p_.heading_deg, p_.sog_m_s, p_.cog_deg, options_.declination_deg);
+    if (std::isfinite(t.from_deg))
+      sink_.wind({p_.t_utc_ns, t.from_deg, t.speed_m_s, fusion::nmea_wind_source(w.ref)});
   }
 
   /// A value is attached once, to the epoch it came in (or the next, when it came between two).
@@ -206,78 +178,8 @@ class Epochs {
   double tod_ = 0.0;
   ImportPoint p_;
   double heading_ = kNaN, heel_ = kNaN, pitch_ = kNaN;
-  RawWind wind_;
+  std::optional<fusion::WindReading> wind_;
 };
-
-/// A wind speed in m/s from a value and its NMEA unit letter (K km/h, M m/s, N knots, S statute
-/// miles per hour); NaN when either is missing or absurd (over 100 m/s).
-double wind_speed(std::string_view value, std::string_view unit) {
-  double v;
-  if (unit.size() != 1 || !sensors::parse_nmea_number(value, v) || v < 0.0) return kNaN;
-  switch (unit[0]) {
-    case 'K':
-      v /= 3.6;
-      break;
-    case 'M':
-      break;
-    case 'N':
-      v *= 1852.0 / 3600.0;
-      break;
-    case 'S':
-      v *= 0.44704;
-      break;
-    default:
-      return kNaN;
-  }
-  return v <= 100.0 ? v : kNaN;
-}
-
-/// An angle field in [0, 360]; nullopt otherwise.
-std::optional<double> wind_angle(std::string_view f) {
-  double v;
-  if (!sensors::parse_nmea_number(f, v) || v < 0.0 || v > 360.0) return std::nullopt;
-  return v;
-}
-
-/// MWV (angle, R|T, speed, unit, status) and MWD (true dir, T, magnetic dir, M, knots, N, m/s,
-/// M). False when the sentence carries no usable wind (empty fields, status V).
-bool wind_sentence(std::string_view type, std::string_view fields, const ImportOptions& options,
-                   Epochs& epochs) {
-  std::array<std::string_view, 12> f;
-  const std::size_t n = sensors::split_nmea_fields(fields, f);
-  if (n > f.size()) return false;
-  RawWind w;
-  if (type == "MWV") {
-    if (n < 5 || f[4] != "A") return false;
-    const auto a = wind_angle(f[0]);
-    if (!a) return false;
-    w.angle_deg = *a;
-    w.speed_m_s = wind_speed(f[2], f[3]);
-    if (f[1] == "T") {
-      w.kind = RawWind::kTrueAngle;
-    } else if (f[1] == "R" && std::isfinite(w.speed_m_s)) {
-      w.kind = RawWind::kApparent;  // the speed is needed to take the boat's motion out
-    } else {
-      return false;
-    }
-  } else {
-    if (n < 8) return false;
-    const auto t = wind_angle(f[0]);
-    const auto m = wind_angle(f[2]);
-    if (t && f[1] == "T") {
-      w.angle_deg = *t;
-    } else if (m && f[3] == "M" && std::isfinite(options.declination_deg)) {
-      w.angle_deg = *m + options.declination_deg;
-    } else {
-      return false;  // a speed alone gives no direction
-    }
-    w.kind = RawWind::kTrueDirection;
-    w.speed_m_s = wind_speed(f[6], f[7]);
-    if (!std::isfinite(w.speed_m_s)) w.speed_m_s = wind_speed(f[4], f[5]);
-  }
-  epochs.wind(w);
-  return true;
-}
 
 /// XDR: quadruples of type, value, unit, name.
 bool xdr(std::string_view fields, Epochs& epochs) {
@@ -397,7 +299,13 @@ ParseResult parse_nmea_log(std::istream& in, const ImportOptions& options, Impor
     } else if (type == "XDR") {
       used = xdr(frame.fields, epochs);
     } else if (type == "MWV" || type == "MWD") {
-      used = wind_sentence(type, frame.fields, options, epochs);
+      const auto w = sensors::parse_nmea_wind(sentence, o);
+      // A magnetic direction without the declination says nothing true: skipped, and it does
+      // not displace a usable reading of its epoch.
+      used = w.status == NmeaStatus::kOk &&
+             (w.reading.ref != fusion::WindRef::kMagneticDirection ||
+              std::isfinite(options.declination_deg));
+      if (used) epochs.wind(w.reading);
     }
     if (!used) ++r.skipped;
   };

@@ -17,8 +17,9 @@
 ///   next).
 /// - Wind: MWD (a true direction; a magnetic one with the declination), MWV T (the instrument's
 ///   true angle off the bow, turned by the epoch's heading, else its COG) and MWV R (apparent,
-///   made true with the boat's velocity: record.hpp true_wind_from_apparent), one per epoch, the
-///   best kind in that order. MWV with status V, or MWD with a speed and no direction: skipped.
+///   made true with the boat's velocity), read by the boat node's parser
+///   (boat_node/sensors/nmea_wind.hpp) and made true by telltale/fusion/wind.hpp; one per
+///   epoch, the best kind in that order. MWV with status V, or MWD with a speed and no direction: skipped.
 /// - Lines that are not sentences, fail their checksum or do not parse are skipped and counted;
 ///   the file is an error only if no point at all came out of it.
 /// Streaming: one line in memory (longer than 1 KB: skipped).

@@ -176,30 +176,6 @@ double wrap360(double deg) {
   return w >= 360.0 ? 0.0 : w;
 }
 
-TrueWind true_wind_from_apparent(double awa_deg, double aws_m_s, double heading_deg, double sog_m_s,
-                                 double cog_deg) {
-  constexpr double kStillM_s = 0.3;
-  if (!std::isfinite(awa_deg) || !std::isfinite(aws_m_s) || aws_m_s < 0.0 ||
-      !std::isfinite(sog_m_s))
-    return {};
-  const bool moving = sog_m_s >= kStillM_s;
-  if (moving && !std::isfinite(cog_deg)) return {};
-  const double bow = std::isfinite(heading_deg) ? heading_deg : cog_deg;
-  if (!std::isfinite(bow)) return {};
-  constexpr double kDegToRad = 1.0 / kRadToDeg;
-  const double a_from = (bow + awa_deg) * kDegToRad;
-  // Air velocity over the ground (north, east) = air past the boat + the boat over the ground.
-  double wn = -aws_m_s * std::cos(a_from), we = -aws_m_s * std::sin(a_from);
-  if (moving) {
-    wn += sog_m_s * std::cos(cog_deg * kDegToRad);
-    we += sog_m_s * std::sin(cog_deg * kDegToRad);
-  }
-  const double speed = std::hypot(wn, we);
-  // A wind too light to have a direction (the boat's own motion cancelled it): none.
-  if (speed < 0.05) return {kNaN, speed};
-  return {wrap360(std::atan2(-we, -wn) * kRadToDeg), speed};
-}
-
 Euler euler_from_ned_quaternion(double w, double x, double y, double z) {
   const double n = std::sqrt(w * w + x * x + y * y + z * z);
   if (!std::isfinite(n) || n < 1e-9) return {};

@@ -30,12 +30,10 @@ struct ImportPoint {
   double pitch_deg = kNaN;
 };
 
-/// The true wind at one instant, as a wind instrument gave it (after the conversion below): the
-/// direction it blows from, clockwise from true north in [0, 360), and its speed in m/s (NaN when
-/// the instrument gave none). `source` names what it came from: "mwd" (NMEA MWD, a true
-/// direction), "mwv_true" (NMEA MWV T: the instrument's true wind angle off the bow, turned by
-/// the boat's heading), "mwv_apparent" / "vkx_apparent" (the apparent wind made true here with
-/// the boat's own velocity).
+/// The true wind at one instant, as a wind instrument gave it, made true by
+/// telltale/fusion/wind.hpp: the direction it blows from, clockwise from true north in [0, 360),
+/// and its speed in m/s (NaN when the instrument gave none). `source` names what it came from:
+/// "mwd", "mwd_magnetic", "mwv_true", "mwv_apparent" (NMEA), "vkx_apparent".
 struct ImportWind {
   std::uint64_t t_utc_ns = 0;
   double from_deg = kNaN;
@@ -129,22 +127,6 @@ struct Euler {
   double heading_deg = kNaN;
 };
 [[nodiscard]] Euler euler_from_ned_quaternion(double w, double x, double y, double z);
-
-/// The true wind from an apparent one: `awa_deg` the angle off the bow it comes from (clockwise,
-/// 0..360), `aws_m_s` its speed, on a boat heading `heading_deg` and moving over the ground at
-/// `sog_m_s` towards `cog_deg`. The air moves past the boat at -AWS along (heading + AWA); add the
-/// boat's own velocity over the ground and what is left is how the air moves over the ground:
-/// the wind a sailor tacks in, the same frame as the course-over-ground bisectors the manoeuvre
-/// analysis estimates the wind from (a current makes this "ground wind" differ from the wind over
-/// the water by the current's velocity, which is also what GPS-only tools measure). No heading:
-/// the COG stands in (the few degrees of leeway read as wind direction). A boat below 0.3 m/s has
-/// no meaningful COG: its velocity is taken as zero. NaN fields when the inputs do not suffice.
-struct TrueWind {
-  double from_deg = kNaN;
-  double speed_m_s = kNaN;
-};
-[[nodiscard]] TrueWind true_wind_from_apparent(double awa_deg, double aws_m_s, double heading_deg,
-                                               double sog_m_s, double cog_deg);
 
 /// Wraps to [0, 360).
 [[nodiscard]] double wrap360(double deg);

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <cstring>
 
+#include "telltale/fusion/wind.hpp"
+
 namespace telltale::shore::import {
 namespace {
 
@@ -124,8 +126,9 @@ ParseResult parse_vkx(std::istream& in, const ImportOptions& options, ImportSink
         // heading, SOG and COG), when that row is at most a second older.
         const std::uint64_t t = u64(p) * 1'000'000ULL;
         if (t >= last_pvo_ns && t - last_pvo_ns <= 1'000'000'000ULL && last_pvo_ns != 0) {
-          const TrueWind w = true_wind_from_apparent(f32(p + 8), f32(p + 12), last_pvo.heading_deg,
-                                                     last_pvo.sog_m_s, last_pvo.cog_deg);
+          const fusion::TrueWind w = fusion::true_wind(
+              {fusion::WindRef::kApparent, f32(p + 8), f32(p + 12)}, last_pvo.heading_deg,
+              last_pvo.sog_m_s, last_pvo.cog_deg, kNaN);
           if (std::isfinite(w.from_deg)) sink.wind({t, w.from_deg, w.speed_m_s, "vkx_apparent"});
         }
         break;
