@@ -101,6 +101,10 @@ void BoatDds::join() {
       participant_->writer(participant_->topic(dds::kTopicBoatFixBackfill,
                                                fdds::TypeSupport(new msg::BoatFixPubSubType())),
                            "fix_backfill_writer");
+  // The wind shares the fix's QoS profile: keyed by boat, best effort, the latest per boat.
+  wind_writer_ = participant_->writer(
+      participant_->topic(dds::kTopicBoatWind, fdds::TypeSupport(new msg::BoatWindPubSubType())),
+      "fix_writer");
   status_writer_ =
       participant_->writer(participant_->topic(dds::kTopicNodeStatus,
                                                fdds::TypeSupport(new msg::NodeStatusPubSubType())),
@@ -125,13 +129,13 @@ void BoatDds::rejoin() {
   std::unique_lock lock(mutex_);
   participant_.reset();  // its readers go first: no callback runs during the swap
   attitude_writer_ = backfill_writer_ = status_writer_ = fix_writer_ = fix_backfill_writer_ =
-      nullptr;
+      wind_writer_ = nullptr;
   try {
     join();
   } catch (const dds::DdsError&) {
     participant_.reset();
     attitude_writer_ = backfill_writer_ = status_writer_ = fix_writer_ = fix_backfill_writer_ =
-        nullptr;
+        wind_writer_ = nullptr;
   }
 }
 
@@ -150,6 +154,10 @@ bool BoatDds::publish(msg::BoatFix& fix) {
 bool BoatDds::backfill(msg::BoatFix& fix) {
   std::shared_lock lock(mutex_);
   return fix_backfill_writer_ && fix_backfill_writer_->write(&fix);
+}
+bool BoatDds::publish(msg::BoatWind& wind) {
+  std::shared_lock lock(mutex_);
+  return wind_writer_ && wind_writer_->write(&wind);
 }
 bool BoatDds::publish(msg::NodeStatus& status) {
   std::shared_lock lock(mutex_);

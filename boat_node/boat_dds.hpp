@@ -44,6 +44,8 @@ class BoatDds {
   bool publish(msg::BoatFix& fix);
   /// A fix resent from the log ("telltale_boat_fix_backfill"); reliable, like backfill().
   bool backfill(msg::BoatFix& fix);
+  /// A wind instrument's reading (telltale_boat_wind, best effort like the fix).
+  bool publish(msg::BoatWind& wind);
   bool publish(msg::NodeStatus& status);
   [[nodiscard]] int domain() const { return domain_; }
 
@@ -69,6 +71,7 @@ class BoatDds {
   eprosima::fastdds::dds::DataWriter* status_writer_ = nullptr;
   eprosima::fastdds::dds::DataWriter* fix_writer_ = nullptr;
   eprosima::fastdds::dds::DataWriter* fix_backfill_writer_ = nullptr;
+  eprosima::fastdds::dds::DataWriter* wind_writer_ = nullptr;
 };
 
 }  // namespace telltale::boat

@@ -66,6 +66,16 @@ void to_wire(const FixRecord& r, const std::string& boat_id, std::uint64_t run, 
   m.hdop(r.hdop);
 }
 
+void to_wire(const WindRecord& r, const std::string& boat_id, std::uint64_t run, msg::BoatWind& m) {
+  m.boat_id(boat_id);
+  m.boot_id(run);
+  m.seq(r.seq);
+  m.t_utc_ns(r.t_utc_ns);
+  m.from_deg(r.from_deg);
+  m.speed_m_s(r.speed_m_s);
+  m.source(r.source);
+}
+
 void to_wire(const WearableRecord& r, const std::string& athlete_id, msg::WearableMotion& m) {
   m.athlete_id(athlete_id);
   m.seq(r.seq);

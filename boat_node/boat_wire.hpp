@@ -26,6 +26,18 @@ void to_wire(const LogRecord& r, const std::string& boat_id, std::uint64_t run,
 /// BoatFix (telltale_boat_fix, telltale_boat_fix_backfill) of run `run`.
 void to_wire(const FixRecord& r, const std::string& boat_id, std::uint64_t run, msg::BoatFix& m);
 
+/// A wind instrument's reading made the true wind on the boat (telltale/fusion/wind.hpp).
+struct WindRecord {
+  std::uint64_t seq = 0;
+  std::uint64_t t_utc_ns = 0;
+  double from_deg = 0.0;
+  double speed_m_s = 0.0;  ///< NaN when the instrument gave none
+  const char* source = "";
+};
+
+/// BoatWind (telltale_boat_wind) of run `run`.
+void to_wire(const WindRecord& r, const std::string& boat_id, std::uint64_t run, msg::BoatWind& m);
+
 /// What a wearable publishes of its dead reckoning; `foot` for a foot-mounted IMU (pose FOOT).
 struct WearableRecord {
   std::uint64_t seq = 0;

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "nmea_gnss.hpp"
+#include "nmea_wind.hpp"
 #include "shutdown.hpp"
 
 namespace telltale::boat {
@@ -111,6 +112,17 @@ void GnssInput::run_nmea() {
   sensors::GnssEpochAssembler epochs;
   const auto handler = [&](std::string_view line, sensors::NmeaClock::time_point t) {
     const auto r = sensors::parse_nmea_gnss(line, nmea_->options());
+    if (r.status == sensors::NmeaStatus::kUnsupported) {
+      // A wind instrument on the same NMEA line (a multiplexer's output): its readings, with the
+      // boat clock of their arrival, for the node to make true with its heading and velocity.
+      const auto w = sensors::parse_nmea_wind(line, nmea_->options());
+      if (w.status == sensors::NmeaStatus::kOk) {
+        std::lock_guard lock(mutex_);
+        if (wind_.size() >= kMaxQueued) wind_.pop_front();
+        wind_.push_back({utc_now_ns(), w.reading});
+      }
+      return w.status;
+    }
     if (r.status != sensors::NmeaStatus::kOk) return r.status;
     const double ts = std::chrono::duration<double>(t.time_since_epoch()).count();
     if (auto done = epochs.add(r.gnss, ts)) on_epoch(*done);
@@ -183,6 +195,13 @@ void GnssInput::take(std::vector<GnssFix>& out) {
   std::lock_guard lock(mutex_);
   out.assign(queue_.begin(), queue_.end());
   queue_.clear();
+}
+
+void GnssInput::take_wind(std::vector<TimedWind>& out) {
+  out.clear();
+  std::lock_guard lock(mutex_);
+  out.assign(wind_.begin(), wind_.end());
+  wind_.clear();
 }
 
 GnssInputStats GnssInput::stats() const {

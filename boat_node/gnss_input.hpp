@@ -1,7 +1,8 @@
 #pragma once
 /// \file
 /// One GNSS receiver on a thread of its own: gpsd through libgps, or NMEA 0183 straight from a
-/// serial port or a UDP port. Epochs go through the GnssGate; the node's loop takes the fixes.
+/// serial port or a UDP port. Epochs go through the GnssGate; the node's loop takes the fixes,
+/// and the wind instrument's MWV/MWD readings when the NMEA line carries them.
 /// Specs (binding, tools rely on them):
 ///   gpsd[:HOST[:PORT]]          gpsd, default localhost:2947; reconnects when gpsd restarts
 ///   nmea:DEVICE[@BAUD]          serial, 4800 baud by default
@@ -18,6 +19,7 @@
 
 #include "gnss_gate.hpp"
 #include "nmea.hpp"
+#include "telltale/fusion/wind.hpp"
 
 namespace telltale::boat {
 
@@ -28,6 +30,12 @@ struct GnssInputStats {
   std::uint64_t queue_overflows = 0;   ///< fixes dropped because the node did not take them
   double clock_offset_s = 0.0;         ///< boat clock - GNSS time, NaN before a time came
   bool connected = false;              ///< gpsd: connected now; NMEA: the device is open
+};
+
+/// A wind instrument's reading off the NMEA line, with the boat clock of its arrival.
+struct TimedWind {
+  std::uint64_t t_utc_ns = 0;
+  fusion::WindReading reading;
 };
 
 class GnssInput {
@@ -42,6 +50,8 @@ class GnssInput {
 
   /// Moves the fixes accepted since the last call into `out` (cleared first).
   void take(std::vector<GnssFix>& out);
+  /// Moves the wind readings (MWV/MWD on an NMEA source) since the last call into `out`.
+  void take_wind(std::vector<TimedWind>& out);
   [[nodiscard]] GnssInputStats stats() const;
   [[nodiscard]] const std::string& describe() const { return describe_; }
   /// The UDP port of an nmea:udp source (0 otherwise): for tests that pick port 0.
@@ -59,6 +69,7 @@ class GnssInput {
   mutable std::mutex mutex_;
   GnssGate gate_;
   std::deque<GnssFix> queue_;
+  std::deque<TimedWind> wind_;
   std::uint64_t overflows_ = 0;
   std::uint64_t reconnects_ = 0;
   bool connected_ = false;

@@ -346,6 +346,16 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
     fix_backfiller->on_published(r.seq);
   };
 
+  // A wind instrument on the GNSS's NMEA line: each reading made the true wind with the boat's
+  // latest heading (the heading source's, else the COG) and GNSS velocity, then published. Not
+  // logged for backfill: a lost reading is one of dozens a minute the wind is a mean over.
+  telltale::msg::BoatWind wind_msg;
+  std::uint64_t wind_seq = 0;
+  std::vector<telltale::boat::TimedWind> winds;
+  double last_heading_deg = std::numeric_limits<double>::quiet_NaN();
+  double last_sog_m_s = std::numeric_limits<double>::quiet_NaN();
+  double last_cog_deg = std::numeric_limits<double>::quiet_NaN();
+
   while (!shutdown.stop_requested()) {
     const auto sample = source->next();
     if (!sample) break;  // end of a replay
@@ -376,9 +386,23 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       gnss->take(fixes);
       for (const auto& f : fixes) {
         publish_fix(f, telltale::utc_now_ns());
+        last_sog_m_s = f.fix == telltale::sensors::GnssFixKind::kNone ? std::nan("") : f.sog_m_s;
+        last_cog_deg = f.cog_deg;
         const bool no_fix = f.fix == telltale::sensors::GnssFixKind::kNone;
         ground_speed.on_fix(t, no_fix ? std::numeric_limits<double>::quiet_NaN() : f.sog_m_s,
                             f.cog_deg);
+      }
+    }
+    if (gnss) {
+      gnss->take_wind(winds);
+      for (const auto& w : winds) {
+        const auto tw = telltale::fusion::true_wind(w.reading, last_heading_deg, last_sog_m_s,
+                                                    last_cog_deg, std::nan(""));
+        if (!std::isfinite(tw.from_deg)) continue;  // no heading nor course yet, or no direction
+        const telltale::boat::WindRecord rec{++wind_seq, w.t_utc_ns, tw.from_deg, tw.speed_m_s,
+                                             telltale::fusion::nmea_wind_source(w.reading.ref)};
+        telltale::boat::to_wire(rec, o.boat_id, boot_id, wind_msg);
+        if (!dds.publish(wind_msg)) ++write_failures;
       }
     }
     // The simulated course at 10 Hz on the sample clock.
@@ -424,6 +448,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       r.heel_deg = heel;
       r.pitch_deg = pitch;
       r.heading_deg = heading ? heading->tick(now) : std::numeric_limits<double>::quiet_NaN();
+      last_heading_deg = r.heading_deg;
       r.heel_rate_deg_s = fused.heel_rate_rad_s * kRadToDeg;
       r.pitch_rate_deg_s = fused.pitch_rate_rad_s * kRadToDeg;
       r.yaw_rate_deg_s = fused.yaw_rate_rad_s * kRadToDeg;

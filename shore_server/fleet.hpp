@@ -69,14 +69,16 @@ struct FixSample {
   std::uint64_t boot_id = 0;
 };
 
-/// The true wind at the boat, as a wind instrument gave it (imported logs; see
-/// import/record.hpp ImportWind for the sources and how each is made true).
+/// The true wind at the boat, as a wind instrument gave it (a live boat's BoatWind, an imported
+/// log's readings), made true by telltale/fusion/wind.hpp.
 struct WindSample {
   std::string boat_id;
   std::uint64_t t_utc_ns = 0;
   double from_deg = 0.0;   ///< direction it blows from, clockwise from true north
   double speed_m_s = 0.0;  ///< NaN when the instrument gave none
-  std::string source;      ///< "mwd", "mwv_true", "mwv_apparent", "vkx_apparent"
+  std::string source;      ///< "mwd", "mwd_magnetic", "mwv_true", "mwv_apparent", "vkx_apparent"
+  std::uint64_t seq = 0;   ///< a live boat's counter (not stored)
+  std::uint64_t boot_id = 0;  ///< a live boat's run (not stored)
 };
 
 /// A fix older than this is not shown as the boat's position (the receiver went quiet).

@@ -3,6 +3,7 @@
 #include <fastcdr/Cdr.h>
 #include <fastcdr/FastBuffer.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -14,8 +15,8 @@ namespace {
 
 constexpr std::array<const char*, kRejectKinds> kRejectNames = {"none",  "id",   "time",
                                                                 "value", "text", "reader_full"};
-constexpr std::array<const char*, kTopics> kTopicNames = {"attitude", "backfill", "status",
-                                                          "wearable", "fix",      "fix_backfill"};
+constexpr std::array<const char*, kTopics> kTopicNames = {
+    "attitude", "backfill", "status", "wearable", "fix", "fix_backfill", "wind"};
 
 bool finite_in(double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; }
 /// NaN ("no value") or within [lo, hi].
@@ -146,6 +147,18 @@ Reject check(const FixSample& s, std::uint64_t shore_now_ns) {
   return Reject::kNone;
 }
 
+Reject check(const WindSample& s, std::uint64_t shore_now_ns) {
+  if (!contract_id(s.boat_id)) return Reject::kId;
+  if (!contract_time(s.t_utc_ns, shore_now_ns)) return Reject::kTime;
+  // 100 m/s: beyond any wind a boat sails in, as for SOG.
+  if (!finite_in(s.from_deg, 0.0, 360.0) || !nan_or_in(s.speed_m_s, 0.0, 100.0))
+    return Reject::kValue;
+  static constexpr std::array<std::string_view, 4> kSources = {"mwd", "mwd_magnetic", "mwv_true",
+                                                               "mwv_apparent"};
+  if (std::find(kSources.begin(), kSources.end(), s.source) == kSources.end()) return Reject::kText;
+  return Reject::kNone;
+}
+
 Reject check(const std::string& node_id, const NodeStatusInfo& s, std::uint64_t t_utc_ns,
              std::uint64_t shore_now_ns) {
   if (!contract_id(node_id)) return Reject::kId;
@@ -242,6 +255,14 @@ Reject Ingest::fix(const msg::BoatFix& m, bool backfill) {
   return r;
 }
 
+Reject Ingest::wind(const msg::BoatWind& m) {
+  const WindSample w = from_wire(m);
+  const Reject r = check(w, now());
+  counters_.count(Topic::kWind, r);
+  if (r == Reject::kNone && sinks_.on_wind) sinks_.on_wind(w);
+  return r;
+}
+
 namespace {
 /// The generated deserialize, then the key's raw length checked against what Fast DDS kept: a
 /// key it cut to its bound (or that holds a NUL) is emptied, which the door refuses as an id.
@@ -282,6 +303,12 @@ bool StrictBoatFixType::deserialize(eprosima::fastrtps::rtps::SerializedPayload_
                                     void* data) {
   return strict_deserialize<msg::BoatFixPubSubType, msg::BoatFix>(
       *this, payload, data, [](msg::BoatFix & m) -> auto& { return m.boat_id(); });
+}
+
+bool StrictBoatWindType::deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload,
+                                     void* data) {
+  return strict_deserialize<msg::BoatWindPubSubType, msg::BoatWind>(
+      *this, payload, data, [](msg::BoatWind & m) -> auto& { return m.boat_id(); });
 }
 
 }  // namespace telltale::shore

@@ -45,8 +45,16 @@ inline constexpr std::size_t kRejectKinds = 6;
 [[nodiscard]] const char* reject_name(Reject r);
 
 /// The topics the shore reads.
-enum class Topic : std::uint8_t { kAttitude, kBackfill, kStatus, kWearable, kFix, kFixBackfill };
-inline constexpr std::size_t kTopics = 6;
+enum class Topic : std::uint8_t {
+  kAttitude,
+  kBackfill,
+  kStatus,
+  kWearable,
+  kFix,
+  kFixBackfill,
+  kWind
+};
+inline constexpr std::size_t kTopics = 7;
 [[nodiscard]] const char* topic_name(Topic t);
 
 /// Valid UTF-8 (shortest forms, no surrogates, at most U+10FFFF).
@@ -63,6 +71,8 @@ inline constexpr std::size_t kTopics = 6;
 /// A fix: position in range (or all of lat/lon/sog/cog NaN with fix "none"), SOG in [0, 100]
 /// m/s or NaN, COG in [0, 360] or NaN, HDOP >= 0 or NaN, a known fix kind.
 [[nodiscard]] Reject check(const FixSample& s, std::uint64_t shore_now_ns);
+/// A wind reading: direction finite in [0, 360], speed in [0, 100] m/s or NaN, a known source.
+[[nodiscard]] Reject check(const WindSample& s, std::uint64_t shore_now_ns);
 [[nodiscard]] Reject check(const std::string& node_id, const NodeStatusInfo& s,
                            std::uint64_t t_utc_ns, std::uint64_t shore_now_ns);
 
@@ -94,6 +104,7 @@ struct IngestSinks {
   std::function<void(const FixSample&)> on_fix;
   /// Fixes a boat resends from its session log: the same checks, another sink.
   std::function<void(const FixSample&)> on_fix_backfill;
+  std::function<void(const WindSample&)> on_wind;
 };
 
 class Ingest {
@@ -106,6 +117,7 @@ class Ingest {
   Reject status(const msg::NodeStatus& m);
   Reject wearable(const msg::WearableMotion& m);
   Reject fix(const msg::BoatFix& m, bool backfill = false);
+  Reject wind(const msg::BoatWind& m);
 
   [[nodiscard]] const IngestCounters& counters() const { return counters_; }
   [[nodiscard]] IngestCounters& counters() { return counters_; }
@@ -133,6 +145,10 @@ class StrictWearableMotionType : public msg::WearableMotionPubSubType {
   bool deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload, void* data) override;
 };
 class StrictBoatFixType : public msg::BoatFixPubSubType {
+ public:
+  bool deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload, void* data) override;
+};
+class StrictBoatWindType : public msg::BoatWindPubSubType {
  public:
   bool deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload, void* data) override;
 };

@@ -206,6 +206,11 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
     // Queued for the manoeuvres, which the live worker finds, never this receive thread.
     if (fleet.update_fix(f, std::chrono::steady_clock::now())) manoeuvres.queue_fix(f);
   };
+  // A live boat's wind instrument: recorded, and the boat's manoeuvres classified against it.
+  callbacks.on_wind = [&](const WindSample& w) {
+    store.enqueue(w);
+    manoeuvres.queue_wind(w);
+  };
   // Fixes resent from a boat's log: the recording only, as backfilled attitude.
   callbacks.on_fix_backfill = [&](const FixSample& f) { store.enqueue(f); };
   callbacks.on_status = [&](const std::string& id, const NodeStatusInfo& st) {

@@ -10,6 +10,7 @@
 #include "json_views.hpp"
 #include "live_hub.hpp"
 #include "manoeuvre_routes.hpp"
+#include "telltale/fusion/wind.hpp"
 
 namespace telltale::shore {
 
@@ -107,6 +108,16 @@ void ManoeuvreTracker::on_attitude(const AttitudeSample& sample) {
     b.heel.pop_front();
 }
 
+void ManoeuvreTracker::on_wind(const WindSample& wind) {
+  Boat& b = boat(wind.boat_id, wind.t_utc_ns);
+  const double t = seconds_between(b.base_ns, wind.t_utc_ns);
+  if (!b.instrument.empty() && t < b.instrument.back().first) b.instrument.clear();  // clock back
+  b.instrument.emplace_back(t, wind.from_deg);
+  while (b.instrument.size() > kMaxInstrumentReadings ||
+         b.instrument.front().first < t - kInstrumentWindS)
+    b.instrument.pop_front();
+}
+
 std::size_t ManoeuvreTracker::held(const std::string& boat_id) const {
   const auto it = boats_.find(boat_id);
   return it == boats_.end() ? 0 : it->second.course.size() + it->second.heel.size();
@@ -124,6 +135,7 @@ void ManoeuvreTracker::release(const std::string& boat_id) {
   Boat& b = it->second;
   std::deque<fusion::CourseSample>().swap(b.course);
   std::deque<fusion::HeelSample>().swap(b.heel);
+  std::deque<std::pair<double, double>>().swap(b.instrument);
   b.trimmed = false;  // what comes next starts afresh, as a session does
 }
 
@@ -136,7 +148,15 @@ void ManoeuvreTracker::run(const std::string& id, Boat& b) {
   for (const auto& h : b.heel)
     if (h.t_s >= start - 1.0) heel_buf_.push_back(h);
   fusion::ManoeuvreOptions options;
+  // The wind: the coach's, else the boat's instrument over its last 2 minutes (when it is still
+  // reading: none older than the window's end by 2 minutes), else the estimate from its tacks.
   options.wind_from_deg = config_.wind_from_deg ? config_.wind_from_deg : b.wind_from_deg;
+  if (!config_.wind_from_deg && !b.instrument.empty() &&
+      b.instrument.back().first >= end - kInstrumentWindS) {
+    instrument_buf_.clear();
+    for (const auto& [t, d] : b.instrument) instrument_buf_.push_back(d);
+    if (const auto m = fusion::wind_mean(instrument_buf_)) options.wind_from_deg = m->from_deg;
+  }
   const fusion::ManoeuvreReport rep = fusion::analyse_manoeuvres(course_buf_, heel_buf_, options);
   ++runs_;
   const double heel_end = heel_buf_.empty() ? end : heel_buf_.back().t_s;
@@ -210,14 +230,26 @@ void ManoeuvreLive::queue_fix(const FixSample& fix) {
 
 void ManoeuvreLive::on_attitude(const AttitudeSample& sample) { tracker_.on_attitude(sample); }
 
+void ManoeuvreLive::queue_wind(const WindSample& wind) {
+  std::lock_guard lock(mutex_);
+  if (wind_inbox_.size() >= 50000)
+    wind_inbox_.erase(wind_inbox_.begin(), wind_inbox_.begin() + 10000);
+  wind_inbox_.push_back(wind);
+  has_fixes_.store(true, std::memory_order_release);
+}
+
 void ManoeuvreLive::take_fixes() {
   // The flag spares the worker the lock for the batches that come with no fix in them.
   if (has_fixes_.load(std::memory_order_acquire)) {
     {
       std::lock_guard lock(mutex_);
       taken_.swap(inbox_);
+      wind_taken_.swap(wind_inbox_);
       has_fixes_.store(false, std::memory_order_relaxed);
     }
+    // The wind first: a fix may run the detector, which reads the boat's instrument wind.
+    for (const auto& w : wind_taken_) tracker_.on_wind(w);
+    wind_taken_.clear();
     for (const auto& f : taken_) tracker_.on_fix(f);
     taken_.clear();
   }

@@ -80,6 +80,10 @@ inline constexpr double kQuietDeg = 15.0;
 inline constexpr double kFinalByS = 55.0;
 /// Final manoeuvres a boat's wind estimate is made from (~3 h of racing).
 inline constexpr std::size_t kMaxHistory = 200;
+/// A live wind instrument's readings the boat's wind is the mean of (the review's: 2 minutes
+/// either side of t0; live, the last 2 minutes), and how many are kept (10 Hz).
+inline constexpr double kInstrumentWindS = 120.0;
+inline constexpr std::size_t kMaxInstrumentReadings = 1200;
 
 class ManoeuvreTracker {
  public:
@@ -101,6 +105,9 @@ class ManoeuvreTracker {
   void on_fix(const FixSample& fix);
   /// A boat's attitude (heel, pitch).
   void on_attitude(const AttitudeSample& sample);
+  /// A boat's wind instrument reading: with kMinWindReadings of the last kInstrumentWindS, the
+  /// boat's manoeuvres are classified against it (the coach's wind still comes first).
+  void on_wind(const WindSample& wind);
   /// Drops a boat's window and what was reported of it.
   void forget(const std::string& boat_id);
   /// Forgets every boat for which `known` is false.
@@ -130,6 +137,7 @@ class ManoeuvreTracker {
     std::vector<Seen> seen;  ///< reported manoeuvres still in the window
     std::deque<fusion::Manoeuvre> history;  ///< final ones of the session, for the wind
     std::optional<double> wind_from_deg;    ///< estimated from `history`
+    std::deque<std::pair<double, double>> instrument;  ///< (t_s, from_deg), the last minutes
   };
   Boat& boat(const std::string& id, std::uint64_t t_ns);
   void run(const std::string& id, Boat& b);
@@ -139,6 +147,7 @@ class ManoeuvreTracker {
   std::unordered_map<std::string, Boat> boats_;
   std::vector<fusion::CourseSample> course_buf_;  ///< the window made contiguous, reused
   std::vector<fusion::HeelSample> heel_buf_;
+  std::vector<double> instrument_buf_;
   std::uint64_t runs_ = 0;
 };
 
@@ -167,6 +176,8 @@ class ManoeuvreLive {
   void take_fixes();
   /// Live worker: an attitude sample (heel and pitch through the turns).
   void on_attitude(const AttitudeSample& sample);
+  /// Any thread (the DDS listener): queues a wind instrument reading, taken with the fixes.
+  void queue_wind(const WindSample& wind);
 
  private:
   const FleetModel& fleet_;
@@ -175,6 +186,7 @@ class ManoeuvreLive {
   std::vector<FixSample> inbox_;
   std::atomic<bool> has_fixes_{false};
   std::vector<FixSample> taken_;
+  std::vector<WindSample> wind_inbox_, wind_taken_;
   std::chrono::steady_clock::time_point next_retain_{};
 };
 

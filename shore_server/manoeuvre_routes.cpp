@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "json_views.hpp"
@@ -13,6 +14,7 @@
 #include "route_helpers.hpp"
 #include "store.hpp"
 #include "telltale/fusion/manoeuvres.hpp"
+#include "telltale/fusion/wind.hpp"
 
 namespace telltale::shore {
 
@@ -31,43 +33,26 @@ std::string num(double v, int decimals = 3) {
 // detection windows (10 s of course either side) and its metrics' (20 s before t0) complete.
 constexpr std::uint64_t kLookbackNs = 45'000'000'000ULL;
 
-/// A wind instrument's direction over a stretch: the circular mean of its readings moved by the
-/// median of their differences from it (a median, so a few readings from a boat head to wind or
-/// upside down do not pull it), the spread as the circular standard deviation sqrt(-2 ln R), and
-/// the median speed. Fewer than kMinWindReadings readings (a few seconds of an instrument) are no
-/// wind for the session.
-constexpr std::size_t kMinWindReadings = 10;
+/// The boat's wind instrument over a stretch (telltale/fusion/wind.hpp wind_mean), with the
+/// median speed and the number of readings.
 struct InstrumentWind {
   double from_deg = 0.0, spread_deg = 0.0, speed_m_s = std::nan("");
   std::size_t n = 0;
 };
-std::optional<InstrumentWind> instrument_wind(const std::vector<WindSample>& rows) {
-  if (rows.size() < kMinWindReadings) return std::nullopt;
-  constexpr double kRad = 3.14159265358979323846 / 180.0;
-  double s = 0.0, c = 0.0;
-  std::vector<double> speeds;
+std::optional<InstrumentWind> instrument_wind(std::span<const WindSample> rows) {
+  std::vector<double> dirs, speeds;
+  dirs.reserve(rows.size());
   for (const auto& w : rows) {
-    s += std::sin(w.from_deg * kRad);
-    c += std::cos(w.from_deg * kRad);
+    dirs.push_back(w.from_deg);
     if (std::isfinite(w.speed_m_s)) speeds.push_back(w.speed_m_s);
   }
-  const double n = static_cast<double>(rows.size());
-  const double r = std::hypot(s, c) / n;
-  if (r < 1e-6) return std::nullopt;  // readings all round the compass: no direction
-  const double mean = std::atan2(s, c) / kRad;
-  std::vector<double> off;
-  off.reserve(rows.size());
-  for (const auto& w : rows) off.push_back(std::remainder(w.from_deg - mean, 360.0));
-  std::nth_element(off.begin(), off.begin() + static_cast<std::ptrdiff_t>(off.size() / 2),
-                   off.end());
-  InstrumentWind out;
-  out.from_deg = std::fmod(mean + off[off.size() / 2] + 720.0, 360.0);
-  out.spread_deg = std::sqrt(-2.0 * std::log(std::min(1.0, r))) / kRad;
-  out.n = rows.size();
+  const auto mean = fusion::wind_mean(dirs);
+  if (!mean) return std::nullopt;
+  InstrumentWind out{mean->from_deg, mean->spread_deg, std::nan(""), rows.size()};
   if (!speeds.empty()) {
-    std::nth_element(speeds.begin(),
-                     speeds.begin() + static_cast<std::ptrdiff_t>(speeds.size() / 2), speeds.end());
-    out.speed_m_s = speeds[speeds.size() / 2];
+    const auto mid = speeds.begin() + static_cast<std::ptrdiff_t>(speeds.size() / 2);
+    std::nth_element(speeds.begin(), mid, speeds.end());
+    out.speed_m_s = *mid;
   }
   return out;
 }
@@ -171,7 +156,7 @@ void register_manoeuvre_routes(httplib::Server& server, ShoreContext& ctx) {
           const auto hi = std::upper_bound(
               lo, readings.end(), t_s + kHalfS,
               [&](double t, const WindSample& w) { return t < rel(w.t_utc_ns); });
-          const auto here = instrument_wind(std::vector<WindSample>(lo, hi));
+          const auto here = instrument_wind(std::span<const WindSample>(lo, hi));
           if (!here) return std::nullopt;
           return here->from_deg;
         };

@@ -57,6 +57,10 @@ class ShoreDds::Listener : public fdds::DataReaderListener {
           reader, backfill ? Topic::kFixBackfill : Topic::kFix,
           [](const auto& m) { return m.boat_id().to_string(); },
           [&](const auto& m) { (void)ingest_.fix(m, backfill); });
+    } else if (topic == dds::kTopicBoatWind) {
+      take<msg::BoatWind>(
+          reader, Topic::kWind, [](const auto& m) { return m.boat_id().to_string(); },
+          [&](const auto& m) { (void)ingest_.wind(m); });
     } else if (topic == dds::kTopicNodeStatus) {
       take<msg::NodeStatus>(
           reader, Topic::kStatus, [](const auto& m) { return m.node_id().to_string(); },
@@ -107,7 +111,8 @@ class ShoreDds::Listener : public fdds::DataReaderListener {
   /// DDS topic names in the order of ingest.hpp's Topic.
   static constexpr std::array<const char*, kTopics> kReaderTopics = {
       dds::kTopicBoatAttitude,   dds::kTopicBoatBackfill, dds::kTopicNodeStatus,
-      dds::kTopicWearableMotion, dds::kTopicBoatFix,      dds::kTopicBoatFixBackfill};
+      dds::kTopicWearableMotion, dds::kTopicBoatFix,      dds::kTopicBoatFixBackfill,
+      dds::kTopicBoatWind};
 
  private:
   using ReturnCode_t = eprosima::fastrtps::types::ReturnCode_t;
@@ -124,9 +129,10 @@ class ShoreDds::Listener : public fdds::DataReaderListener {
 
 ShoreDds::ShoreDds(const dds::DdsOptions& options, FleetCallbacks callbacks)
     : callbacks_(std::move(callbacks)),
-      ingest_(std::make_unique<Ingest>(
-          IngestSinks{callbacks_.on_attitude, callbacks_.on_backfill, callbacks_.on_status,
-                      callbacks_.on_wearable, callbacks_.on_fix, callbacks_.on_fix_backfill})) {
+      ingest_(std::make_unique<Ingest>(IngestSinks{callbacks_.on_attitude, callbacks_.on_backfill,
+                                                   callbacks_.on_status, callbacks_.on_wearable,
+                                                   callbacks_.on_fix, callbacks_.on_fix_backfill,
+                                                   callbacks_.on_wind})) {
   dds::DdsOptions opts = options;
   if (!opts.security_dir.empty()) {
     writer_check_ = std::make_unique<WriterCheck>(opts.security_dir);
@@ -148,6 +154,8 @@ ShoreDds::ShoreDds(const dds::DdsOptions& options, FleetCallbacks callbacks)
   add_reader(Topic::kFix, new StrictBoatFixType(), "fix_reader");
   add_reader(Topic::kFixBackfill, new StrictBoatFixType(), "fix_backfill_reader");
   add_reader(Topic::kStatus, new StrictNodeStatusType(), "status_reader");
+  // The wind shares the fix's profile (keyed by boat, best effort).
+  add_reader(Topic::kWind, new StrictBoatWindType(), "fix_reader");
   rule_writer_ = participant_->writer(
       participant_->topic(dds::kTopicAlarmRules, fdds::TypeSupport(new msg::AlarmRulePubSubType())),
       "alarm_writer");

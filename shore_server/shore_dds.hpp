@@ -35,6 +35,8 @@ struct FleetCallbacks {
   std::function<void(const FixSample&)> on_fix;
   /// Fixes a boat resends from its session log (reliable fix backfill topic).
   std::function<void(const FixSample&)> on_fix_backfill;
+  /// A live boat's wind instrument readings.
+  std::function<void(const WindSample&)> on_wind;
 };
 
 /// Receipt instances the shore's ack writer keeps registered at most (its profile allows 4096;

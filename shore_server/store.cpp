@@ -392,6 +392,37 @@ bool Store::commit_wearable(const std::vector<WearableSample>& batch) {
   }
 }
 
+void Store::enqueue(const WindSample& wind) {
+  std::lock_guard lock(mutex_);
+  if (wind_queue_.size() >= config_.max_backlog) {
+    ++dropped_wind_;
+    return;
+  }
+  wind_queue_.push_back(wind);
+}
+
+bool Store::commit_wind(const std::vector<WindSample>& batch) {
+  std::lock_guard db_lock(db_mutex_);
+  try {
+    exec(db_, "BEGIN");
+    Stmt ins(db_, insert_sql("wind", kWindFields).c_str());
+    for (const auto& w : batch) {
+      ins.reset();
+      ins.bind(1, w.boat_id);
+      ins.bind_u(2, w.t_utc_ns);
+      bind_fields(ins.get(), 3, kWindFields, w);
+      ins.step();
+    }
+    exec(db_, "COMMIT");
+    return true;
+  } catch (const StoreError& e) {
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    std::lock_guard lock(mutex_);
+    last_error_ = std::string("wind: ") + e.what();
+    return false;
+  }
+}
+
 void Store::enqueue(const FixSample& fix) {
   std::lock_guard lock(mutex_);
   if (fix_queue_.size() >= config_.max_backlog) {
@@ -594,6 +625,7 @@ void Store::writer_loop() {
   std::vector<AttitudeSample> batch;
   std::vector<WearableSample> wearable;
   std::vector<FixSample> fixes;
+  std::vector<WindSample> wind;
   for (;;) {
     bool stop = false;
     {
@@ -606,11 +638,12 @@ void Store::writer_loop() {
       batch.swap(queue_);
       wearable.swap(wearable_queue_);
       fixes.swap(fix_queue_);
+      wind.swap(wind_queue_);
     }
     // Every kind is kept and retried when its write fails (a full disk): wearables and fixes
     // have no backfill, so a batch dropped here would be lost for good.
     bool failed = false;
-    const bool work = !wearable.empty() || !fixes.empty() || !batch.empty();
+    const bool work = !wearable.empty() || !fixes.empty() || !batch.empty() || !wind.empty();
     // Attitude first: its commit is what the boats' receipts and the crash window are about.
     if (!batch.empty()) {
       const std::size_t n = batch.size();
@@ -637,6 +670,11 @@ void Store::writer_loop() {
       }
     }
     fixes.clear();
+    if (!wind.empty() && !commit_wind(wind)) {
+      failed = true;
+      requeue(wind, wind_queue_, dropped_wind_);
+    }
+    wind.clear();
     if (work) {
       std::lock_guard lock(mutex_);
       if (!failed) {

@@ -133,6 +133,9 @@ class Store {
                                                            std::uint64_t to_ns, std::size_t limit);
   /// Queues one GNSS fix (committed with the next batch).
   void enqueue(const FixSample& fix);
+  /// Queues one wind instrument reading (committed with the next batch, kept and retried when
+  /// the write fails, as fixes are).
+  void enqueue(const WindSample& wind);
   /// The boat's fixes with a position in [from_ns, to_ns], oldest first. More than `max_points`
   /// are thinned evenly in time to max_points (first and last kept).
   [[nodiscard]] std::vector<FixSample> track(const std::string& boat_id, std::uint64_t from_ns,
@@ -234,6 +237,7 @@ class Store {
   /// Each false when the write failed (the caller requeues the batch).
   bool commit_wearable(const std::vector<WearableSample>& batch);
   bool commit_fixes(const std::vector<FixSample>& batch);
+  bool commit_wind(const std::vector<WindSample>& batch);
   /// A failed batch back at the head of its queue, the queue bounded by max_backlog (the oldest
   /// beyond it dropped and counted in `dropped`).
   template <class T>
@@ -304,6 +308,8 @@ class Store {
   std::vector<AttitudeSample> queue_;
   std::vector<WearableSample> wearable_queue_;
   std::vector<FixSample> fix_queue_;
+  std::vector<WindSample> wind_queue_;
+  std::uint64_t dropped_wind_ = 0;
   std::uint64_t fixes_enqueued_ = 0;
   std::uint64_t fixes_processed_ = 0;
   std::uint64_t fixes_committed_ = 0;

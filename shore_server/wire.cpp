@@ -84,6 +84,18 @@ msg::BoatFix to_wire(const FixSample& f) {
   return m;
 }
 
+WindSample from_wire(const msg::BoatWind& m) {
+  WindSample w;
+  w.boat_id = m.boat_id().to_string();
+  w.t_utc_ns = m.t_utc_ns();
+  w.from_deg = m.from_deg();
+  w.speed_m_s = m.speed_m_s();
+  w.source = m.source().to_string();
+  w.seq = m.seq();
+  w.boot_id = m.boot_id();
+  return w;
+}
+
 WearableSample from_wire(const msg::WearableMotion& m) {
   WearableSample w;
   w.athlete_id = m.athlete_id().to_string();

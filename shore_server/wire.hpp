@@ -108,6 +108,10 @@ template <class Wire, class Shore, std::size_t N>
 [[nodiscard]] FixSample from_wire(const msg::BoatFix& m);
 [[nodiscard]] msg::BoatFix to_wire(const FixSample& f);
 
+/// BoatWind (a live boat's wind instrument). seq and boot_id are read, not stored: a reading
+/// is kept by its boat and time, like an imported one.
+[[nodiscard]] WindSample from_wire(const msg::BoatWind& m);
+
 /// WearableMotion. A gait or pose off the enum reads as "unknown".
 [[nodiscard]] WearableSample from_wire(const msg::WearableMotion& m);
 [[nodiscard]] msg::WearableMotion to_wire(const WearableSample& w);

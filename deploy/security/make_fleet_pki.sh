@@ -197,12 +197,12 @@ XML
   echo "made $dir ($cn)"
 }
 
-boat_pub="telltale_boat_attitude telltale_boat_backfill telltale_boat_fix telltale_boat_fix_backfill telltale_node_status"
+boat_pub="telltale_boat_attitude telltale_boat_backfill telltale_boat_fix telltale_boat_fix_backfill telltale_boat_wind telltale_node_status"
 boat_sub="telltale_shore_ack telltale_shore_fix_ack telltale_alarm_rules telltale_alarm_events"
 wear_pub="telltale_wearable_motion telltale_node_status"
 wear_sub="telltale_shore_ack telltale_alarm_rules telltale_alarm_events"
 shore_pub="telltale_shore_ack telltale_shore_fix_ack telltale_alarm_rules telltale_alarm_events"
-shore_sub="telltale_boat_attitude telltale_boat_backfill telltale_boat_fix telltale_boat_fix_backfill telltale_node_status telltale_wearable_motion"
+shore_sub="telltale_boat_attitude telltale_boat_backfill telltale_boat_fix telltale_boat_fix_backfill telltale_boat_wind telltale_node_status telltale_wearable_motion"
 
 make_node shore telltale-shore tt-shore 'tt-*' "$shore_pub" "$shore_sub"
 for b in "${boats[@]}"; do

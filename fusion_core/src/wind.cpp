@@ -1,5 +1,8 @@
 #include "telltale/fusion/wind.hpp"
 
+#include <algorithm>
+#include <vector>
+
 namespace telltale::fusion {
 namespace {
 
@@ -53,6 +56,24 @@ TrueWind true_wind(const WindReading& r, double heading_deg, double sog_m_s, dou
   const double ground = std::hypot(wn, we);
   if (ground < 0.05) return {kNaN, ground};  // the boat's own motion cancelled it: no direction
   return {wrap360(std::atan2(-we, -wn) / kDegToRad), ground};
+}
+
+std::optional<WindMean> wind_mean(std::span<const double> from_deg) {
+  if (from_deg.size() < kMinWindReadings) return std::nullopt;
+  double s = 0.0, c = 0.0;
+  for (const double d : from_deg) {
+    s += std::sin(d * kDegToRad);
+    c += std::cos(d * kDegToRad);
+  }
+  const double r = std::hypot(s, c) / static_cast<double>(from_deg.size());
+  if (r < 1e-6) return std::nullopt;
+  const double mean = std::atan2(s, c) / kDegToRad;
+  std::vector<double> off;
+  off.reserve(from_deg.size());
+  for (const double d : from_deg) off.push_back(std::remainder(d - mean, 360.0));
+  const auto mid = off.begin() + static_cast<std::ptrdiff_t>(off.size() / 2);
+  std::nth_element(off.begin(), mid, off.end());
+  return WindMean{wrap360(mean + *mid), std::sqrt(-2.0 * std::log(std::min(1.0, r))) / kDegToRad};
 }
 
 }  // namespace telltale::fusion

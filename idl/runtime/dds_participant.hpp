@@ -37,6 +37,7 @@ inline constexpr const char* kTopicShoreAck = "telltale_shore_ack";
 inline constexpr const char* kTopicBoatFix = "telltale_boat_fix";
 inline constexpr const char* kTopicBoatFixBackfill = "telltale_boat_fix_backfill";
 inline constexpr const char* kTopicShoreFixAck = "telltale_shore_fix_ack";
+inline constexpr const char* kTopicBoatWind = "telltale_boat_wind";
 
 /// Setup failure (profile file, participant, topic, entity): main() prints it and exits non-zero.
 class DdsError : public std::runtime_error {

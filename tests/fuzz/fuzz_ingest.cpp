@@ -61,6 +61,10 @@ Ingest& ingest() {
                              [](const FixSample& f) {
                                FUZZ_CHECK(check(f, kNow) == Reject::kNone);
                                store().enqueue(f);
+                             },
+                             [](const WindSample& w) {
+                               FUZZ_CHECK(check(w, kNow) == Reject::kNone);
+                               store().enqueue(w);
                              }},
                  [] { return kNow; });
   return *i;
@@ -91,13 +95,13 @@ eprosima::fastrtps::rtps::SerializedPayload_t payload(std::string_view bytes) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   telltale::fuzz::Input in(data, size);
   const std::uint8_t pick = in.byte();
-  const int topic = pick % 5;
+  const int topic = pick % 6;
   const bool as_cdr = (pick & 4) != 0;
   Ingest& door = ingest();
   const auto before = door.counters().rejected_total();
   std::uint64_t accepted_before = 0;
   for (auto t : {Topic::kAttitude, Topic::kBackfill, Topic::kStatus, Topic::kWearable, Topic::kFix,
-                 Topic::kFixBackfill})
+                 Topic::kFixBackfill, Topic::kWind})
     accepted_before += door.counters().accepted(t);
 
   bool handed = true;
@@ -151,6 +155,20 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       m.hdop(static_cast<float>(in.raw_double()));
     }
     if (handed) (void)door.fix(m, (pick & 8) != 0);  // live or resent from the boat's log
+  } else if (topic == 5) {
+    telltale::msg::BoatWind m;
+    if (as_cdr) {
+      auto p = payload(in.rest());
+      StrictBoatWindType type;
+      handed = type.deserialize(&p, &m);
+    } else {
+      m.boat_id(text(in));
+      m.t_utc_ns(time_near(in));
+      m.from_deg(in.raw_double());
+      m.speed_m_s(in.raw_double());
+      m.source(text(in).substr(0, 16));
+    }
+    if (handed) (void)door.wind(m);
   } else {
     telltale::msg::WearableMotion m;
     if (as_cdr) {
@@ -169,7 +187,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   std::uint64_t accepted_after = 0;
   for (auto t : {Topic::kAttitude, Topic::kBackfill, Topic::kStatus, Topic::kWearable, Topic::kFix,
-                 Topic::kFixBackfill})
+                 Topic::kFixBackfill, Topic::kWind})
     accepted_after += door.counters().accepted(t);
   // Each sample handed to the door is counted exactly once, accepted or refused.
   if (handed)

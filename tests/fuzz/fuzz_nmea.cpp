@@ -17,6 +17,7 @@
 #include "gnss_gate.hpp"
 #include "nmea.hpp"
 #include "nmea_gnss.hpp"
+#include "nmea_wind.hpp"
 
 namespace {
 
@@ -118,6 +119,22 @@ void gnss_pipeline(const std::vector<std::string>& lines, const NmeaParseOptions
   if (auto done = epochs.flush_if_quiet(t + 1.0)) gate_check(*done);
 }
 
+/// A wind sentence: a reading in range, and the true wind made of it finite or NaN, never out of
+/// range, on any boat velocity.
+void wind_check(std::string_view line, const NmeaParseOptions& options, std::uint8_t seed) {
+  const auto w = telltale::sensors::parse_nmea_wind(line, options);
+  if (w.status != NmeaStatus::kOk) return;
+  FUZZ_CHECK(w.reading.angle_deg >= 0.0 && w.reading.angle_deg <= 360.0);
+  FUZZ_CHECK(std::isnan(w.reading.speed_m_s) ||
+             (w.reading.speed_m_s >= 0.0 && w.reading.speed_m_s <= 100.0));
+  const double sog = (seed & 1) ? std::nan("") : seed * 0.1,
+               cog = (seed & 2) ? std::nan("") : seed * 1.7;
+  const auto t = telltale::fusion::true_wind(w.reading, (seed & 4) ? std::nan("") : seed * 1.3, sog,
+                                             cog, (seed & 8) ? std::nan("") : 2.5);
+  FUZZ_CHECK(std::isnan(t.from_deg) || (t.from_deg >= 0.0 && t.from_deg < 360.0));
+  FUZZ_CHECK(std::isnan(t.speed_m_s) || t.speed_m_s >= 0.0);
+}
+
 struct Assembled {
   std::vector<std::string> lines;
   NmeaLineAssembler::Stats stats;
@@ -163,6 +180,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     FUZZ_CHECK(l.find_first_of("\r\n") == std::string::npos);
     FUZZ_CHECK(l.find('$', 1) == std::string::npos);
     parse_and_check(l, options);
+    wind_check(l, options, seed);
   }
   gnss_pipeline(whole.lines, options);
   return 0;

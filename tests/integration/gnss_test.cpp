@@ -1,16 +1,13 @@
 // GNSS end to end: NMEA 0183 on a pseudo-terminal and on loopback UDP, and a real gpsd fed by a
 // pseudo-terminal, bring a boat's position to GET /api/v1/boats; malformed sentences and jumps
 // are counted on the boat and never shown; a session's GPX is read back by gpsbabel.
-#include "shore_fixture.hpp"
-
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <pty.h>
+#include <signal.h>
 #include <sys/socket.h>
 #include <termios.h>
 #include <unistd.h>
-
-#include <signal.h>
 
 #include <atomic>
 #include <cmath>
@@ -18,6 +15,9 @@
 #include <fstream>
 #include <functional>
 #include <sstream>
+#include <thread>
+
+#include "shore_fixture.hpp"
 
 namespace telltale::testing {
 namespace {
@@ -188,6 +188,53 @@ TEST_F(GnssTest, NmeaOverUdpBringsThePosition) {
   });
   expect_track_followed("gnss_udp", feed, true);
   ::close(tx);
+}
+
+// A wind instrument on the same NMEA line (a multiplexer's output): the boat reads its MWV,
+// makes the apparent wind true with its own course and speed, and publishes it; the shore records
+// it and the session's manoeuvres take their wind from it. Apparent 10 m/s from 45 deg off the bow
+// on a boat sailing north at 3 m/s (no heading source: the COG, 0, turns it): the air moves past
+// at -10 m/s along 45 deg, plus the boat's 3 m/s north leaves the air moving (-4.07 north, -7.07
+// east) over the ground: a true wind of 8.16 m/s from 60.1 deg.
+TEST_F(GnssTest, AWindInstrumentOnTheNmeaLineIsRecordedAsTheTrueWind) {
+  const int port = free_loopback_port(SOCK_DGRAM);
+  start_boat("gnss_wind", {"--gnss", "nmea:udp:" + std::to_string(port)});
+  const int tx = ::socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_port = htons(static_cast<std::uint16_t>(port));
+  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  std::atomic<bool> stop{false};
+  std::thread feeder([&] {
+    for (int k = 0; !stop; ++k) {
+      const std::string out = epoch(kNorthSpeed * 0.2 * k) + nmea("WIMWV,045.0,R,10.0,M,A") +
+                              nmea("WIMWV,045.0,R,10.0,M,V");  // status V: not a reading
+      (void)::sendto(tx, out.data(), out.size(), 0, reinterpret_cast<const sockaddr*>(&to),
+                     sizeof to);
+      std::this_thread::sleep_for(200ms);
+    }
+  });
+  const double wn = -10.0 * std::cos(M_PI / 4) + kNorthSpeed, we = -10.0 * std::sin(M_PI / 4);
+  const double expect_from = std::atan2(-we, -wn) * 180.0 / M_PI, expect_speed = std::hypot(wn, we);
+  json wind;
+  const bool recorded = eventually(
+      [&] {
+        const json sessions = get_json("/api/v1/sessions?boat=gnss_wind");
+        if (!sessions.is_array() || sessions.empty()) return false;
+        wind =
+            get_json("/api/v1/sessions/" + std::to_string(sessions[0]["id"].get<std::int64_t>()) +
+                     "/manoeuvres")["wind"];
+        return wind["instrument"].is_object() && wind["instrument"]["readings"].get<int>() >= 20;
+      },
+      30s);
+  stop = true;
+  feeder.join();
+  ::close(tx);
+  ASSERT_TRUE(recorded) << wind.dump() << "\n" << boats_.back()->output();
+  EXPECT_EQ(wind["source"], "instrument");
+  EXPECT_NEAR(wind["instrument"]["from_deg"].get<double>(), expect_from, 0.5) << wind.dump();
+  EXPECT_NEAR(wind["instrument"]["speed_m_s"].get<double>(), expect_speed, 0.05) << wind.dump();
+  EXPECT_LT(wind["instrument"]["spread_deg"].get<double>(), 0.5) << wind.dump();
 }
 
 std::string find_program(const std::string& name) {

@@ -117,6 +117,14 @@ static void print_fix(const void* v) {
          m->cog_deg, (int)m->fix, (unsigned)m->satellites, (double)m->hdop, m->boot_id);
 }
 
+static void print_wind(const void* v) {
+  const telltale_msg_BoatWind* m = v;
+  printf(" boat_id=%s seq=%" PRIu64 " t_utc_ns=%" PRIu64 " from_deg=%.6f speed_m_s=%.6f",
+         m->boat_id, m->seq, m->t_utc_ns, m->from_deg, m->speed_m_s);
+  print_text("source", m->source);
+  printf(" boot_id=%" PRIu64, m->boot_id);
+}
+
 enum Durable { kVolatileBestEffort, kVolatileReliable, kTransientLocalReliable };
 
 struct TopicSpec {
@@ -152,8 +160,10 @@ static struct TopicSpec topics[] = {
      0},
     {"telltale_boat_fix_backfill", &telltale_msg_BoatFix_desc, kVolatileReliable, print_fix, 0, 0,
      0, 0, 0},
-    {"telltale_shore_fix_ack", &telltale_msg_ShoreAck_desc, kVolatileBestEffort, print_ack, 0, 0,
-     0, 0, 0},
+    {"telltale_shore_fix_ack", &telltale_msg_ShoreAck_desc, kVolatileBestEffort, print_ack, 0, 0, 0,
+     0, 0},
+    {"telltale_boat_wind", &telltale_msg_BoatWind_desc, kVolatileBestEffort, print_wind, 0, 0, 0, 0,
+     0},
 };
 enum { kTopicCount = sizeof topics / sizeof topics[0] };
 

@@ -4,8 +4,8 @@
 // shore_server: receipts of both kinds, alarm rules, alarm events; wearable_node: wearable motion
 // and status) and, for
 // BoatFix, both the boat's simulated course and a Fast DDS writer in this test on the production
-// profiles whose every value is known. Everything on a private domain on 127.0.0.1
-// (tests/interop/cyclone_loopback.xml).
+// profiles whose every value is known, which also writes the BoatWind of a wind instrument.
+// Everything on a private domain on 127.0.0.1 (tests/interop/cyclone_loopback.xml).
 #include <signal.h>
 
 #include <cmath>
@@ -35,6 +35,9 @@ constexpr double kCog = 123.5;
 constexpr int kSatellites = 9;
 constexpr float kHdop = 0.75f;
 constexpr std::uint64_t kFixBoot = 4242;
+// And its BoatWind beside each fix (a wind instrument on that boat).
+constexpr double kWindFrom = 247.5;
+constexpr double kWindSpeed = 6.25;
 
 std::uint64_t now_ns() {
   return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -42,7 +45,8 @@ std::uint64_t now_ns() {
                                         .count());
 }
 
-/// Fast DDS BoatFix writer (profile fix_writer of the production profiles file) at 10 Hz.
+/// Fast DDS BoatFix and BoatWind writers (profile fix_writer of the production profiles file, as
+/// the boat node's) at 10 Hz.
 class FixPublisher {
  public:
   explicit FixPublisher(int domain) {
@@ -51,6 +55,9 @@ class FixPublisher {
     participant_ = std::make_unique<dds::Participant>(o, "interop_fix");
     writer_ = participant_->writer(
         participant_->topic(dds::kTopicBoatFix, fdds::TypeSupport(new msg::BoatFixPubSubType())),
+        "fix_writer");
+    wind_writer_ = participant_->writer(
+        participant_->topic(dds::kTopicBoatWind, fdds::TypeSupport(new msg::BoatWindPubSubType())),
         "fix_writer");
     thread_ = std::thread([this] { run(); });
   }
@@ -80,11 +87,21 @@ class FixPublisher {
       m.hdop(kHdop);
       m.boot_id(kFixBoot);
       writer_->write(&m);
+      msg::BoatWind w;
+      w.boat_id(kFixBoat);
+      w.seq(seq);
+      w.t_utc_ns(t);
+      w.from_deg(kWindFrom);
+      w.speed_m_s(kWindSpeed);
+      w.source("mwv_apparent");
+      w.boot_id(kFixBoot);
+      wind_writer_->write(&w);
       std::this_thread::sleep_for(100ms);
     }
   }
   std::unique_ptr<dds::Participant> participant_;
   fdds::DataWriter* writer_ = nullptr;
+  fdds::DataWriter* wind_writer_ = nullptr;
   std::atomic<bool> stop_{false};
   std::thread thread_;
 };
@@ -155,7 +172,8 @@ const std::map<std::string, long> kMinimum = {
     {"telltale_shore_ack", 3},          {"telltale_node_status", 3},
     {"telltale_alarm_rules", 1},        {"telltale_alarm_events", 1},
     {"telltale_wearable_motion", 3},    {"telltale_boat_fix", 10},
-    {"telltale_boat_fix_backfill", 10}, {"telltale_shore_fix_ack", 3}};
+    {"telltale_boat_fix_backfill", 10}, {"telltale_shore_fix_ack", 3},
+    {"telltale_boat_wind", 10}};
 
 /// A count of the reader's "counts" line; -1 when the topic is missing.
 long count_of(const std::map<std::string, std::string>& counts, const std::string& topic) {
@@ -343,6 +361,14 @@ TEST_F(InteropTest, CycloneReaderDecodesEveryTopic) {
       EXPECT_DOUBLE_EQ(s.num("hdop"), static_cast<double>(kHdop));
       EXPECT_EQ(s.u64("boot_id"), kFixBoot);
       EXPECT_EQ(s.u64("t_utc_ns") - s.u64("gnss_utc_ns"), 200'000'000ULL);
+    } else if (s.topic == "telltale_boat_wind") {
+      EXPECT_EQ(s.str("boat_id"), kFixBoat);
+      EXPECT_GE(s.u64("seq"), 1U);
+      EXPECT_TRUE(plausible_time(s.u64("t_utc_ns")));
+      EXPECT_DOUBLE_EQ(s.num("from_deg"), kWindFrom);
+      EXPECT_DOUBLE_EQ(s.num("speed_m_s"), kWindSpeed);
+      EXPECT_EQ(s.str("source"), "mwv_apparent");
+      EXPECT_EQ(s.u64("boot_id"), kFixBoot);
     } else {
       ADD_FAILURE() << "unknown topic " << s.topic;
     }

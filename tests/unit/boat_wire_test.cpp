@@ -92,6 +92,21 @@ TEST(BoatWire, EveryFixKindAsTheShoreReadsIt) {
   }
 }
 
+// A wind instrument's reading: every member back on the shore (a missing speed stays NaN).
+TEST(BoatWire, WindRoundTripsToTheShore) {
+  const boat::WindRecord r{5, kT, 212.5, kNaN, "mwv_apparent"};
+  msg::BoatWind m;
+  boat::to_wire(r, "gbr-7", kRun, m);
+  const shore::WindSample w = shore::from_wire(m);
+  EXPECT_EQ(w.boat_id, "gbr-7");
+  EXPECT_EQ(w.boot_id, kRun);
+  EXPECT_EQ(w.seq, r.seq);
+  EXPECT_EQ(w.t_utc_ns, r.t_utc_ns);
+  EXPECT_EQ(w.from_deg, r.from_deg);
+  EXPECT_TRUE(same(w.speed_m_s, r.speed_m_s));
+  EXPECT_EQ(w.source, "mwv_apparent");
+}
+
 TEST(BoatWire, EveryGaitAndPoseAsTheShoreReadsIt) {
   struct Case {
     double cadence;

@@ -34,13 +34,15 @@ struct Sinks {
   std::vector<std::pair<std::string, NodeStatusInfo>> status;
   std::vector<WearableSample> wearable;
   std::vector<FixSample> fixes, fix_backfill;
+  std::vector<WindSample> wind;
   IngestSinks sinks() {
     return {[this](const AttitudeSample& s) { attitude.push_back(s); },
             [this](const AttitudeSample& s) { backfill.push_back(s); },
             [this](const std::string& id, const NodeStatusInfo& s) { status.emplace_back(id, s); },
             [this](const WearableSample& w) { wearable.push_back(w); },
             [this](const FixSample& f) { fixes.push_back(f); },
-            [this](const FixSample& f) { fix_backfill.push_back(f); }};
+            [this](const FixSample& f) { fix_backfill.push_back(f); },
+            [this](const WindSample& w) { wind.push_back(w); }};
   }
 };
 
@@ -311,6 +313,45 @@ TEST_F(IngestTest, FixesOffTheContractAreRefusedAndCounted) {
 
 // A fix resent from a boat's log passes the same door, into its own sink (the recording only) and
 // its own counters; off the contract it is refused there, as a live one.
+TEST_F(IngestTest, WindReadingsOffTheContractAreRefusedAndCounted) {
+  msg::BoatWind m;
+  m.boat_id("ILCA-1");
+  m.seq(3);
+  m.t_utc_ns(kNow - 1'000'000'000ULL);
+  m.from_deg(212.5);
+  m.speed_m_s(std::nan(""));  // the instrument gave no speed: allowed
+  m.source("mwv_apparent");
+  m.boot_id(77);
+  EXPECT_EQ(ingest.wind(m), Reject::kNone);
+  ASSERT_EQ(got.wind.size(), 1u);
+  EXPECT_EQ(got.wind[0].boat_id, "ILCA-1");
+  EXPECT_EQ(got.wind[0].from_deg, 212.5);
+  EXPECT_EQ(got.wind[0].source, "mwv_apparent");
+  EXPECT_EQ(got.wind[0].boot_id, 77u);
+  auto bad = m;
+  bad.from_deg(std::nan(""));
+  EXPECT_EQ(ingest.wind(bad), Reject::kValue);
+  bad = m;
+  bad.from_deg(361.0);
+  EXPECT_EQ(ingest.wind(bad), Reject::kValue);
+  bad = m;
+  bad.speed_m_s(-2.0);
+  EXPECT_EQ(ingest.wind(bad), Reject::kValue);
+  bad = m;
+  bad.source("<script>");
+  EXPECT_EQ(ingest.wind(bad), Reject::kText);
+  bad = m;
+  bad.boat_id("");
+  EXPECT_EQ(ingest.wind(bad), Reject::kId);
+  bad = m;
+  bad.t_utc_ns(0);
+  EXPECT_EQ(ingest.wind(bad), Reject::kTime);
+  EXPECT_EQ(got.wind.size(), 1u);
+  EXPECT_EQ(ingest.counters().accepted(Topic::kWind), 1u);
+  EXPECT_EQ(ingest.counters().rejected(Topic::kWind, Reject::kValue), 3u);
+  EXPECT_TRUE(ingest.counters().to_json()["rejected"].contains("wind"));
+}
+
 TEST_F(IngestTest, BackfilledFixesPassTheSameDoorIntoTheirOwnSink) {
   EXPECT_EQ(ingest.fix(good_fix(), true), Reject::kNone);
   auto m = good_fix();

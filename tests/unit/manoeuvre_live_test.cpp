@@ -77,13 +77,24 @@ struct Reported : LiveManoeuvre {
 };
 
 // Both streams in time order, as the live worker passes them on.
-std::vector<Reported> feed(const Race& r, ManoeuvreTracker::Config config = {}) {
+/// `instrument`: a wind instrument on the boat reading this direction with every fix.
+std::vector<Reported> feed(const Race& r, ManoeuvreTracker::Config config = {},
+                           std::optional<double> instrument = std::nullopt) {
   std::vector<Reported> out;
   double now = 0.0;
   ManoeuvreTracker tracker([&](const LiveManoeuvre& m) { out.push_back({m, now}); }, config);
   std::size_t f = 0;
   const auto fix = [&](const FixSample& s) {
     now = static_cast<double>(s.t_utc_ns - kStartNs) * 1e-9;
+    if (instrument) {
+      WindSample w;
+      w.boat_id = s.boat_id;
+      w.t_utc_ns = s.t_utc_ns;
+      w.from_deg = *instrument;
+      w.speed_m_s = 6.0;
+      w.source = "mwd";
+      tracker.on_wind(w);
+    }
     tracker.on_fix(s);
   };
   for (const auto& a : r.attitude) {
@@ -204,6 +215,18 @@ TEST_P(ManoeuvreLiveRace, WithTheWindGivenReportsTheReviewsManoeuvresOnceFoundAn
   EXPECT_GE(c.checked, 10);
   EXPECT_EQ(c.kind_differs, 0);
   expect_mostly_prompt(c);
+}
+
+// A wind instrument on the boat (no coach's wind): its readings are the boat's wind, so the live
+// kinds are the review's with that wind given.
+TEST_P(ManoeuvreLiveRace, WithAWindInstrumentReportsTheKindsOfItsWind) {
+  const Race r = sail(GetParam().seed, 40 * 60, GetParam().drills);
+  ManoeuvreOptions given;
+  given.wind_from_deg = 255.0;
+  const Compared c =
+      compare(analyse_manoeuvres(r.course, r.heel, given), feed(r, {}, 255.0), r.course.back().t_s);
+  EXPECT_GE(c.checked, 10);
+  EXPECT_EQ(c.kind_differs, 0);
 }
 
 // The wind estimated (the shore's case): live from the session so far, the review from all of

@@ -18,8 +18,11 @@
 /// have one).
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <optional>
+#include <span>
 
 namespace telltale::fusion {
 
@@ -58,5 +61,17 @@ struct TrueWind {
 /// unknown) for a magnetic direction.
 [[nodiscard]] TrueWind true_wind(const WindReading& r, double heading_deg, double sog_m_s,
                                  double cog_deg, double declination_deg);
+
+/// A wind instrument's direction over a stretch of readings: the circular mean moved by the
+/// median of the readings' differences from it (a median, so a few readings taken head to wind or
+/// in a knockdown do not pull it), and the spread as the circular standard deviation
+/// sqrt(-2 ln R). Fewer than kMinWindReadings (a few seconds of an instrument), or readings all
+/// round the compass: nullopt.
+inline constexpr std::size_t kMinWindReadings = 10;
+struct WindMean {
+  double from_deg = 0.0;
+  double spread_deg = 0.0;
+};
+[[nodiscard]] std::optional<WindMean> wind_mean(std::span<const double> from_deg);
 
 }  // namespace telltale::fusion
