@@ -178,8 +178,11 @@ struct HttpApi::Impl {
                     {"wearable_backlog", sh.wearable_backlog},
                     {"fix_backlog", sh.fix_backlog},
                     {"wearable_dropped", sh.wearable_dropped},
-                    {"fixes_dropped", sh.fixes_dropped}};
-      if (sh.failing || sh.dropped > 0 || sh.wearable_dropped > 0 || sh.fixes_dropped > 0)
+                    {"fixes_dropped", sh.fixes_dropped},
+                    {"wind_backlog", sh.wind_backlog},
+                    {"wind_dropped", sh.wind_dropped}};
+      if (sh.failing || sh.dropped > 0 || sh.wearable_dropped > 0 || sh.fixes_dropped > 0 ||
+          sh.wind_dropped > 0)
         j["status"] = "degraded";
       // What the boats' cards show as badges, by problem: {"log_failing": ["b1"], ...}.
       json problems = json::object();

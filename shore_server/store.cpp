@@ -399,6 +399,7 @@ void Store::enqueue(const WindSample& wind) {
     return;
   }
   wind_queue_.push_back(wind);
+  ++wind_enqueued_;
 }
 
 bool Store::commit_wind(const std::vector<WindSample>& batch) {
@@ -614,9 +615,12 @@ void Store::flush() {
   std::unique_lock lock(mutex_);
   const std::uint64_t target = enqueued_;
   const std::uint64_t fix_target = fixes_enqueued_;
+  const std::uint64_t wind_target = wind_enqueued_;
   cv_.notify_all();
   flushed_cv_.wait_for(lock, std::chrono::seconds(10), [&] {
-    return (processed_ >= target && fixes_processed_ >= fix_target) || stopping_ ||
+    return (processed_ >= target && fixes_processed_ >= fix_target &&
+            wind_processed_ + dropped_wind_ >= wind_target) ||
+           stopping_ ||
            backoff_.count() > 0;
   });
 }
@@ -670,9 +674,15 @@ void Store::writer_loop() {
       }
     }
     fixes.clear();
-    if (!wind.empty() && !commit_wind(wind)) {
-      failed = true;
-      requeue(wind, wind_queue_, dropped_wind_);
+    if (!wind.empty()) {
+      const std::size_t n = wind.size();
+      if (commit_wind(wind)) {
+        std::lock_guard lock(mutex_);
+        wind_processed_ += n;
+      } else {
+        failed = true;
+        requeue(wind, wind_queue_, dropped_wind_);
+      }
     }
     wind.clear();
     if (work) {
@@ -1291,6 +1301,8 @@ StoreHealth Store::health() const {
   h.fix_backlog = fix_queue_.size();
   h.wearable_dropped = dropped_wearable_;
   h.fixes_dropped = dropped_fixes_;
+  h.wind_backlog = wind_queue_.size();
+  h.wind_dropped = dropped_wind_;
   h.failed_commits = failed_commits_;
   if (h.failing)
     h.retry_in_s = std::max(

@@ -72,6 +72,8 @@ struct StoreHealth {
   std::size_t fix_backlog = 0;         ///< GNSS fixes queued, kept while writes fail
   std::uint64_t wearable_dropped = 0;  ///< beyond the bound while failing: lost (no backfill)
   std::uint64_t fixes_dropped = 0;     ///< the same for fixes
+  std::size_t wind_backlog = 0;        ///< wind readings queued, kept while writes fail
+  std::uint64_t wind_dropped = 0;      ///< the same for wind readings
   std::uint64_t failed_commits = 0;
   double retry_in_s = 0.0;  ///< until the next attempt while failing
   std::string last_error;
@@ -309,7 +311,8 @@ class Store {
   std::vector<WearableSample> wearable_queue_;
   std::vector<FixSample> fix_queue_;
   std::vector<WindSample> wind_queue_;
-  std::uint64_t dropped_wind_ = 0;
+  std::uint64_t wind_enqueued_ = 0, wind_processed_ = 0;
+  std::uint64_t dropped_wind_ = 0;  ///< readings dropped (backlog full, or requeued past it)
   std::uint64_t fixes_enqueued_ = 0;
   std::uint64_t fixes_processed_ = 0;
   std::uint64_t fixes_committed_ = 0;

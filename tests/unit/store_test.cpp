@@ -569,7 +569,7 @@ TEST_F(StoreTest, FullDiskBacksOffBoundsTheBacklogAndSaysWhatIsLost) {
 
 // Given a full disk, wearable samples and GNSS fixes (which no boat can resend) are kept and
 // retried like attitude, and all of them are stored once space comes back.
-TEST_F(StoreTest, FullDiskKeepsWearablesAndFixesAndStoresThemLater) {
+TEST_F(StoreTest, FullDiskKeepsWearablesFixesAndWindAndStoresThemLater) {
   const auto mnt = dir_ / "full";
   const SmallTmpfs tmpfs(mnt);
   if (!tmpfs.mounted)
@@ -600,19 +600,33 @@ TEST_F(StoreTest, FullDiskKeepsWearablesAndFixesAndStoresThemLater) {
     f.sog_m_s = 3.0;
     f.cog_deg = 0.0;
     store.enqueue(f);
+    WindSample wind;
+    wind.boat_id = "w";
+    wind.t_utc_ns = f.t_utc_ns;
+    wind.from_deg = 250.0 + (i % 7);
+    wind.speed_m_s = 6.0;
+    wind.source = "mwv_apparent";
+    store.enqueue(wind);
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(600));
   StoreHealth h = store.health();
   EXPECT_TRUE(h.failing) << "the full disk must fail the writes";
   EXPECT_EQ(h.wearable_backlog, static_cast<std::size_t>(kN));
   EXPECT_EQ(h.fix_backlog, static_cast<std::size_t>(kN));
+  EXPECT_EQ(h.wind_backlog, static_cast<std::size_t>(kN));
   std::filesystem::remove(mnt / "ballast");
   for (int i = 0; i < 40 && store.health().failing; ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   store.flush();
   h = store.health();
   EXPECT_FALSE(h.failing) << h.last_error;
-  EXPECT_EQ(h.wearable_dropped + h.fixes_dropped, 0u);
+  EXPECT_EQ(h.wearable_dropped + h.fixes_dropped + h.wind_dropped, 0u);
+  const auto wind = store.wind("w", 0, UINT64_MAX, 100000);
+  ASSERT_EQ(wind.size(), static_cast<std::size_t>(kN));
+  EXPECT_EQ(wind[3].from_deg, 253.0);
+  EXPECT_EQ(wind[3].source, "mwv_apparent");
+  EXPECT_EQ(store.wind("w", 0, UINT64_MAX, 50).size(), 50u);  // thinned, first and last kept
+  EXPECT_EQ(store.wind("w", 0, UINT64_MAX, 50).back().t_utc_ns, wind.back().t_utc_ns);
   EXPECT_EQ(store.wearable_track("ann", 0, UINT64_MAX, 100000).size(),
             static_cast<std::size_t>(kN));
   EXPECT_EQ(store.track("w", 0, UINT64_MAX, 100000).size(), static_cast<std::size_t>(kN));
