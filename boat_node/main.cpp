@@ -347,14 +347,18 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   };
 
   // A wind instrument on the GNSS's NMEA line: each reading made the true wind with the boat's
-  // latest heading (the heading source's, else the COG) and GNSS velocity, then published. Not
-  // logged for backfill: a lost reading is one of dozens a minute the wind is a mean over.
+  // latest heading (the heading source's, else the COG) and GNSS velocity, then published. A
+  // velocity older than 2 s (the receiver gone quiet) is none: an apparent reading then waits.
+  // Not logged for backfill: the shore uses the wind as a mean over minutes, of which a lost
+  // reading is one of hundreds. A magnetic MWD is skipped (the node knows no declination).
   telltale::msg::BoatWind wind_msg;
   std::uint64_t wind_seq = 0;
   std::vector<telltale::boat::TimedWind> winds;
+  constexpr double kVelocityFreshS = 2.0;
   double last_heading_deg = std::numeric_limits<double>::quiet_NaN();
   double last_sog_m_s = std::numeric_limits<double>::quiet_NaN();
   double last_cog_deg = std::numeric_limits<double>::quiet_NaN();
+  double last_velocity_t = -1e9;
 
   while (!shutdown.stop_requested()) {
     const auto sample = source->next();
@@ -386,9 +390,10 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       gnss->take(fixes);
       for (const auto& f : fixes) {
         publish_fix(f, telltale::utc_now_ns());
-        last_sog_m_s = f.fix == telltale::sensors::GnssFixKind::kNone ? std::nan("") : f.sog_m_s;
-        last_cog_deg = f.cog_deg;
         const bool no_fix = f.fix == telltale::sensors::GnssFixKind::kNone;
+        last_sog_m_s = no_fix ? std::numeric_limits<double>::quiet_NaN() : f.sog_m_s;
+        last_cog_deg = f.cog_deg;
+        last_velocity_t = t;
         ground_speed.on_fix(t, no_fix ? std::numeric_limits<double>::quiet_NaN() : f.sog_m_s,
                             f.cog_deg);
       }
@@ -396,8 +401,11 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
     if (gnss) {
       gnss->take_wind(winds);
       for (const auto& w : winds) {
-        const auto tw = telltale::fusion::true_wind(w.reading, last_heading_deg, last_sog_m_s,
-                                                    last_cog_deg, std::nan(""));
+        const bool fresh = t - last_velocity_t <= kVelocityFreshS;
+        const double nan = std::numeric_limits<double>::quiet_NaN();
+        const auto tw = telltale::fusion::true_wind(w.reading, last_heading_deg,
+                                                    fresh ? last_sog_m_s : nan,
+                                                    fresh ? last_cog_deg : nan, nan);
         if (!std::isfinite(tw.from_deg)) continue;  // no heading nor course yet, or no direction
         const telltale::boat::WindRecord rec{++wind_seq, w.t_utc_ns, tw.from_deg, tw.speed_m_s,
                                              telltale::fusion::nmea_wind_source(w.reading.ref)};

@@ -134,8 +134,8 @@ void register_manoeuvre_routes(httplib::Server& server, ShoreContext& ctx) {
       heel.push_back({rel(r.t_utc_ns), r.heel_deg, r.pitch_deg});
       return true;
     });
-    // The wind, in order of trust: the coach's (the query), the boat's wind instrument (stored
-    // by an import), else the estimate from the tacks. When the wind is given either way the
+    // The wind, in order of trust: the coach's (the query), the boat's wind instrument (its
+    // stored readings: live BoatWind or an imported log's), else the estimate from the tacks. When the wind is given either way the
     // estimate is still made, and reported beside it: how far the track's own estimate is off.
     const char* wind_source = opt.wind_from_deg ? "coach" : "estimated";
     std::optional<InstrumentWind> instrument;
