@@ -347,11 +347,7 @@ void Store::enqueue(const AttitudeSample& sample) {
 
 void Store::enqueue(const WearableSample& sample) {
   std::lock_guard lock(mutex_);
-  if (wearable_queue_.size() >= config_.max_backlog) {
-    ++dropped_wearable_;
-    return;
-  }
-  wearable_queue_.push_back(sample);
+  push_bounded(wearable_queue_, sample, dropped_wearable_);
 }
 
 template <class T>
@@ -367,10 +363,25 @@ void Store::requeue(std::vector<T>& batch, std::vector<T>& queue, std::uint64_t&
   }
 }
 
-bool Store::commit_wearable(const std::vector<WearableSample>& batch) {
+bool Store::transaction(const char* what, const std::function<void()>& write,
+                        const std::function<void()>& committed) {
   std::lock_guard db_lock(db_mutex_);
   try {
     exec(db_, "BEGIN");
+    write();
+    exec(db_, "COMMIT");
+    if (committed) committed();
+    return true;
+  } catch (const StoreError& e) {
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    std::lock_guard lock(mutex_);
+    last_error_ = std::string(what) + ": " + e.what();
+    return false;
+  }
+}
+
+bool Store::commit_wearable(const std::vector<WearableSample>& batch) {
+  return transaction("wearable", [&] {
     Stmt ins(db_,
              "INSERT OR IGNORE INTO wearable (athlete_id, t_utc_ns, seq, steps, cadence_spm, "
              "gait, pose, x_m, y_m, heading_deg, distance_m) VALUES (?,?,?,?,?,?,?,?,?,?,?)");
@@ -382,84 +393,55 @@ bool Store::commit_wearable(const std::vector<WearableSample>& batch) {
       ins.bind(11, w.distance_m);
       ins.step();
     }
-    exec(db_, "COMMIT");
-    return true;
-  } catch (const StoreError& e) {
-    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
-    std::lock_guard lock(mutex_);
-    last_error_ = std::string("wearable: ") + e.what();
-    return false;
-  }
+  });
 }
 
 void Store::enqueue(const WindSample& wind) {
   std::lock_guard lock(mutex_);
-  if (wind_queue_.size() >= config_.max_backlog) {
-    ++dropped_wind_;
-    return;
-  }
-  wind_queue_.push_back(wind);
-  ++wind_enqueued_;
+  if (push_bounded(wind_queue_, wind, dropped_wind_)) ++wind_enqueued_;
 }
 
 bool Store::commit_wind(const std::vector<WindSample>& batch) {
-  std::lock_guard db_lock(db_mutex_);
-  try {
-    exec(db_, "BEGIN");
+  return transaction("wind", [&] {
     Stmt ins(db_, insert_sql("wind", kWindFields).c_str());
     for (const auto& w : batch) {
       ins.reset();
-      ins.bind(1, w.boat_id);
+      // A second node's run has its own id (recorded_id), as its fixes do.
+      const auto alias = aliases_.find({w.boat_id, w.boot_id});
+      ins.bind(1, alias == aliases_.end() ? w.boat_id : alias->second);
       ins.bind_u(2, w.t_utc_ns);
       bind_fields(ins.get(), 3, kWindFields, w);
       ins.step();
     }
-    exec(db_, "COMMIT");
-    return true;
-  } catch (const StoreError& e) {
-    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
-    std::lock_guard lock(mutex_);
-    last_error_ = std::string("wind: ") + e.what();
-    return false;
-  }
+  });
 }
 
 void Store::enqueue(const FixSample& fix) {
   std::lock_guard lock(mutex_);
-  if (fix_queue_.size() >= config_.max_backlog) {
-    ++dropped_fixes_;
-    return;
-  }
-  fix_queue_.push_back(fix);
-  ++fixes_enqueued_;
+  if (push_bounded(fix_queue_, fix, dropped_fixes_)) ++fixes_enqueued_;
 }
 
 bool Store::commit_fixes(const std::vector<FixSample>& batch) {
-  std::lock_guard db_lock(db_mutex_);
-  try {
-    exec(db_, "BEGIN");
-    Stmt ins(db_, insert_sql("fixes", kFixFields).c_str());
-    for (const auto& f : batch) {
-      ins.reset();
-      // A second node's run has its own id (recorded_id): its fixes go with its samples.
-      const auto alias = aliases_.find({f.boat_id, f.boot_id});
-      ins.bind(1, alias == aliases_.end() ? f.boat_id : alias->second);
-      ins.bind_u(2, f.t_utc_ns);
-      bind_fields(ins.get(), 3, kFixFields, f);
-      ins.step();
-    }
-    exec(db_, "COMMIT");
-    // On disk now: these fixes may be acknowledged to their boats.
-    for (const auto& f : batch) track_fix_receipt(f);
-    std::lock_guard lock(mutex_);
-    fixes_committed_ += batch.size();
-    return true;
-  } catch (const StoreError& e) {
-    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
-    std::lock_guard lock(mutex_);
-    last_error_ = std::string("fixes: ") + e.what();
-    return false;
-  }
+  return transaction(
+      "fixes",
+      [&] {
+        Stmt ins(db_, insert_sql("fixes", kFixFields).c_str());
+        for (const auto& f : batch) {
+          ins.reset();
+          // A second node's run has its own id (recorded_id): its fixes go with its samples.
+          const auto alias = aliases_.find({f.boat_id, f.boot_id});
+          ins.bind(1, alias == aliases_.end() ? f.boat_id : alias->second);
+          ins.bind_u(2, f.t_utc_ns);
+          bind_fields(ins.get(), 3, kFixFields, f);
+          ins.step();
+        }
+      },
+      [&] {
+        // On disk now: these fixes may be acknowledged to their boats.
+        for (const auto& f : batch) track_fix_receipt(f);
+        std::lock_guard lock(mutex_);
+        fixes_committed_ += batch.size();
+      });
 }
 
 std::vector<FixSample> Store::fix_page(const std::string& boat_id, std::uint64_t after_ns,

@@ -237,6 +237,22 @@ class Store {
   /// Commits a batch; on failure puts it back in the queue and returns false.
   bool commit(std::vector<AttitudeSample>& batch);
   /// Each false when the write failed (the caller requeues the batch).
+  /// One transaction on the writer's connection: `write`, COMMIT, then `committed` (still on
+  /// the connection: it may read). False, everything rolled back and the error kept, when
+  /// either throws a StoreError.
+  bool transaction(const char* what, const std::function<void()>& write,
+                   const std::function<void()>& committed = {});
+  /// Queues `item` unless the queue is at the backlog bound (then counted in `dropped`); true
+  /// when queued.
+  template <class T>
+  bool push_bounded(std::vector<T>& queue, const T& item, std::uint64_t& dropped) {
+    if (queue.size() >= config_.max_backlog) {
+      ++dropped;
+      return false;
+    }
+    queue.push_back(item);
+    return true;
+  }
   bool commit_wearable(const std::vector<WearableSample>& batch);
   bool commit_fixes(const std::vector<FixSample>& batch);
   bool commit_wind(const std::vector<WindSample>& batch);
