@@ -53,6 +53,21 @@ Eigen::Matrix3d held_in_front(double heading, double extra_pitch = 0.0) {
   return r;
 }
 
+/// The IMU of a phone held as `r` (phone -> world) at `t`, turning to `r1` by `t + dt`: gravity
+/// with 0.1 m/s^2 of noise per axis, the turn's rate plus `bias` with 0.005 rad/s of noise.
+ImuSample held_sample(double t, double dt, const Eigen::Matrix3d& r, const Eigen::Matrix3d& r1,
+                      const Eigen::Vector3d& bias, std::mt19937& rng) {
+  std::normal_distribution<double> n01(0.0, 1.0);
+  ImuSample s;
+  s.t_s = t;
+  s.acc_body_m_s2 = r.transpose() * (Eigen::Vector3d(0.0, 0.0, kG) +
+                                     0.1 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng)));
+  const Eigen::AngleAxisd d(Eigen::Matrix3d(r.transpose() * r1));
+  s.gyro_body_rad_s = d.axis() * d.angle() / dt + bias +
+                      0.005 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+  return s;
+}
+
 struct Walk {
   std::vector<ImuSample> samples;
   Truth truth;
@@ -306,13 +321,7 @@ double stand_bias_error(bool use_mag, unsigned seed, const Eigen::Vector3d& bias
   for (int i = 0; i <= n; ++i) {
     const double t = i * dt;
     const Eigen::Matrix3d r = rot_at(t), r1 = rot_at(t + dt);
-    ImuSample s;
-    s.t_s = t;
-    s.acc_body_m_s2 = r.transpose() * (Eigen::Vector3d(0.0, 0.0, kG) +
-                                       0.1 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng)));
-    const Eigen::AngleAxisd d(Eigen::Matrix3d(r.transpose() * r1));
-    s.gyro_body_rad_s = d.axis() * d.angle() / dt + bias +
-                        0.005 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+    ImuSample s = held_sample(t, dt, r, r1, bias, rng);
     // A magnet coming near the phone in the second half (the field is then not one fixed
     // vector): field_step_uT more downward and half of it east by the end.
     const Eigen::Vector3d extra =
@@ -384,13 +393,7 @@ double two_stand_bias_error(unsigned seed, const Eigen::Vector3d& bias, double s
   for (int i = 0; i <= n; ++i) {
     const double t = i * dt;
     const Eigen::Matrix3d r = rot_at(t), r1 = rot_at(t + dt);
-    ImuSample s;
-    s.t_s = t;
-    s.acc_body_m_s2 = r.transpose() * (Eigen::Vector3d(0.0, 0.0, kG) +
-                                       0.1 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng)));
-    const Eigen::AngleAxisd d(Eigen::Matrix3d(r.transpose() * r1));
-    s.gyro_body_rad_s = d.axis() * d.angle() / dt + bias +
-                        0.005 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+    ImuSample s = held_sample(t, dt, r, r1, bias, rng);
     const double bend =
         t < 8.0 ? swing_deg * M_PI / 180.0 * std::sin(2.0 * M_PI * t / 8.0) : 0.0;
     const Eigen::Vector3d field = Eigen::AngleAxisd(bend, Eigen::Vector3d::UnitZ()) * field_world;
