@@ -163,8 +163,11 @@ void register_manoeuvre_routes(httplib::Server& server, ShoreContext& ctx) {
       }
     }
     fusion::ManoeuvreReport rep = fusion::analyse_manoeuvres(fixes, heel, opt);
+    // The estimate beside a given wind: for the review (JSON, the whole session), not for a CSV
+    // nor for the fleet view's `from` stretch (45 s: no estimate to speak of), which would only
+    // run the detector twice on every open.
     std::optional<fusion::ManoeuvreReport> estimate;
-    if (rep.wind_given && !csv)
+    if (rep.wind_given && !csv && !from_param)
       estimate = fusion::analyse_manoeuvres(fixes, heel, fusion::ManoeuvreOptions{});
     const fusion::ManoeuvreReport& est = estimate ? *estimate : rep;
     if (from_param)
