@@ -47,7 +47,7 @@ using Mat2 = HeadingFusion::Mat2;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-bool has_bit(std::uint16_t mask, int i) { return ((mask >> i) & 1u) != 0; }
+bool has_bit(std::uint16_t mask, int i) { return ((static_cast<unsigned>(mask) >> i) & 1u) != 0; }
 
 Mat2 symmetrised(const Mat2& p) { return 0.5 * (p + p.transpose()); }
 

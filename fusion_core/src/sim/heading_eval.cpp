@@ -92,7 +92,7 @@ HeadingRunResult run_heading(const HeadingScenario& scenario,
     }
     for (std::size_t k = 1; k < m; ++k) {
       if (samples[k].t_s < f.t_end_s) continue;
-      if ((res.in_use[k] >> f.sensor) & 1u) {
+      if ((static_cast<unsigned>(res.in_use[k]) >> f.sensor) & 1u) {
         o.readmit_s = samples[k].t_s - f.t_end_s;
         o.readmit_jump_deg = std::abs(res.error_deg[k] - res.error_deg[k - 1]);
         break;
