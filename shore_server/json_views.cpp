@@ -1,5 +1,6 @@
 #include "json_views.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <ctime>
 #include <set>
@@ -27,6 +28,17 @@ std::string to_json_text(const json& j) {
 }
 
 json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+void append_json_number(std::string& out, double v) {
+  if (!std::isfinite(v)) {
+    out += "null";
+    return;
+  }
+  char buf[32];
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  // 32 characters hold every double's shortest form (at most 24), so ec is never an error.
+  out.append(buf, ec == std::errc() ? end : buf);
+}
 
 json boat_problems(const BoatView& v) {
   json out = json::array();

@@ -24,6 +24,10 @@ namespace telltale::shore {
 [[nodiscard]] std::string iso8601(std::uint64_t t_utc_ns);
 /// A number, or null when it is not finite.
 [[nodiscard]] nlohmann::json finite_or_null(double v);
+/// Appends `v` as JSON text: its shortest form that reads back to the same double, or null when
+/// it is not finite. For columns of thousands of numbers (charts), written straight to text
+/// instead of through a json array: a chart answer costs a tenth of what the array would.
+void append_json_number(std::string& out, double v);
 
 /// Sets `j[name]` for every exported field of `table` (sample_fields.hpp) from `record`: numbers
 /// that are not finite, and every field when there is no record, as null.

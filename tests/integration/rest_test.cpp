@@ -171,6 +171,16 @@ TEST_F(RestTest, SessionsAttitudeAndStreamedExportAgree) {
   const json full = get_json("/api/v1/sessions/" + sid + "/attitude");
   EXPECT_EQ(full["count"], samples);
   EXPECT_FALSE(full["downsampled"].get<bool>());
+  EXPECT_EQ(full["session_id"], s["id"]);
+  // The chart's columns are written as text directly: each number reads back to the stored
+  // value exactly, and a missing one is null, as in the export.
+  ASSERT_EQ(full["heel_deg"].size(), doc["samples"].size());
+  for (std::size_t i = 0; i < doc["samples"].size(); ++i) {
+    const json& row = doc["samples"][i];
+    EXPECT_EQ(full["heel_deg"][i], row["heel_deg"]) << i;
+    EXPECT_EQ(full["pitch_deg"][i], row["pitch_deg"]) << i;
+    EXPECT_EQ(full["heading_deg"][i], row["heading_deg"]) << i;
+  }
   const json small = get_json("/api/v1/sessions/" + sid + "/attitude?max_points=40");
   EXPECT_TRUE(small["downsampled"].get<bool>());
   EXPECT_LE(small["t_s"].size(), 40u);
