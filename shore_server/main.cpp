@@ -1,5 +1,7 @@
 // shore_server: subscribes to the fleet over DDS, records it, serves the REST API, the live
 // stream and the dashboard.
+#include <malloc.h>
+
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <condition_variable>
@@ -301,6 +303,14 @@ void run(Options o, telltale::ShutdownSignal& shutdown) {
 
 int main(int argc, char** argv) {
   telltale::ShutdownSignal shutdown;  // first: every later thread inherits the blocked signals
+  // A REST request builds its answer in a few transient buffers of 0.1-2 MB (a chart's tier
+  // buckets and rows, an export page). With glibc's defaults each HTTP worker's arena gave those
+  // pages back to the kernel after every request and faulted them in again on the next: page
+  // faults were ~70 % of a chart request (perf). Fixed thresholds keep up to 16 MB of free heap
+  // per arena for reuse and map only blocks over 8 MB on their own: chart requests 522 -> ~1750
+  // per second (deploy/bench_chart.sh), for at most a few tens of MB of resident memory.
+  mallopt(M_MMAP_THRESHOLD, 8 << 20);
+  mallopt(M_TRIM_THRESHOLD, 16 << 20);
   Options o;
   int domain = -1;
   CLI::App app{"Telltale shore server: fleet over DDS -> SQLite, REST API, live stream, dashboard"};
