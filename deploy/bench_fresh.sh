@@ -15,7 +15,8 @@ dir=${1:-$(mktemp -d)}
 mounts=()
 demo=
 cleanup() {
-  [ -n "$demo" ] && kill -INT "$demo" 2>/dev/null && wait "$demo" 2>/dev/null || true
+  # The demo's own process group: demo.sh and every node it started stop on SIGINT.
+  [ -n "$demo" ] && kill -INT -- -"$demo" 2>/dev/null && wait "$demo" 2>/dev/null || true
   for ((i = ${#mounts[@]} - 1; i >= 0; i--)); do umount "${mounts[i]}" 2>/dev/null || true; done
 }
 trap cleanup EXIT
@@ -34,7 +35,7 @@ rm -rf "$dir/root/telltale"
 git clone -q "$root" "$dir/root/telltale"
 port=$((20000 + $$ % 20000))
 start=$(date +%s)
-chroot "$dir" env TELLTALE_HTTP_PORT=$port bash -c 'cd /root/telltale && deploy/demo.sh' \
+setsid chroot "$dir" env TELLTALE_HTTP_PORT=$port bash -c 'cd /root/telltale && deploy/demo.sh' \
   >"$dir/root/demo.out" 2>&1 &
 demo=$!
 for _ in $(seq 3600); do grep -q "Dashboard" "$dir/root/demo.out" && break; sleep 0.5; done
