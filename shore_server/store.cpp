@@ -351,8 +351,10 @@ void Store::enqueue(const WearableSample& sample) {
 }
 
 template <class T>
-void Store::requeue(std::vector<T>& batch, std::vector<T>& queue, std::uint64_t& dropped) {
+void Store::requeue(std::vector<T>& batch, std::vector<T>& queue, std::uint64_t& dropped,
+                    std::size_t& in_hand) {
   std::lock_guard lock(mutex_);
+  in_hand = 0;
   // The failed batch is older than what came meanwhile: it goes first.
   batch.insert(batch.end(), queue.begin(), queue.end());
   queue.swap(batch);
@@ -625,6 +627,7 @@ void Store::writer_loop() {
       wearable.swap(wearable_queue_);
       fixes.swap(fix_queue_);
       wind.swap(wind_queue_);
+      in_hand_ = {batch.size(), wearable.size(), fixes.size(), wind.size()};
     }
     // Every kind is kept and retried when its write fails (a full disk): wearables and fixes
     // have no backfill, so a batch dropped here would be lost for good.
@@ -635,24 +638,31 @@ void Store::writer_loop() {
       const std::size_t n = batch.size();
       if (commit(batch)) {
         std::lock_guard lock(mutex_);
+        in_hand_.attitude = 0;
         processed_ += n;
       } else {
         failed = true;
       }
     }
-    if (!wearable.empty() && !commit_wearable(wearable)) {
-      failed = true;
-      requeue(wearable, wearable_queue_, dropped_wearable_);
+    if (!wearable.empty()) {
+      if (commit_wearable(wearable)) {
+        std::lock_guard lock(mutex_);
+        in_hand_.wearable = 0;
+      } else {
+        failed = true;
+        requeue(wearable, wearable_queue_, dropped_wearable_, in_hand_.wearable);
+      }
     }
     wearable.clear();
     if (!fixes.empty()) {
       const std::size_t n = fixes.size();
       if (commit_fixes(fixes)) {
         std::lock_guard lock(mutex_);
+        in_hand_.fixes = 0;
         fixes_processed_ += n;
       } else {
         failed = true;
-        requeue(fixes, fix_queue_, dropped_fixes_);
+        requeue(fixes, fix_queue_, dropped_fixes_, in_hand_.fixes);
       }
     }
     fixes.clear();
@@ -660,10 +670,11 @@ void Store::writer_loop() {
       const std::size_t n = wind.size();
       if (commit_wind(wind)) {
         std::lock_guard lock(mutex_);
+        in_hand_.wind = 0;
         wind_processed_ += n;
       } else {
         failed = true;
-        requeue(wind, wind_queue_, dropped_wind_);
+        requeue(wind, wind_queue_, dropped_wind_, in_hand_.wind);
       }
     }
     wind.clear();
@@ -757,6 +768,7 @@ bool Store::commit(std::vector<AttitudeSample>& batch) {
     // while the process lives.
     std::lock_guard lock(mutex_);
     last_error_ = e.what();
+    in_hand_.attitude = 0;
     queue_.insert(queue_.begin(), batch.begin(), batch.end());
     if (queue_.size() > config_.max_backlog) {
       // What came while this batch was out: the newest beyond the bound go (never acknowledged).
@@ -1277,13 +1289,13 @@ StoreHealth Store::health() const {
   std::lock_guard lock(mutex_);
   StoreHealth h;
   h.failing = backoff_.count() > 0;
-  h.backlog = queue_.size();
+  h.backlog = queue_.size() + in_hand_.attitude;
   h.dropped = dropped_;
-  h.wearable_backlog = wearable_queue_.size();
-  h.fix_backlog = fix_queue_.size();
+  h.wearable_backlog = wearable_queue_.size() + in_hand_.wearable;
+  h.fix_backlog = fix_queue_.size() + in_hand_.fixes;
   h.wearable_dropped = dropped_wearable_;
   h.fixes_dropped = dropped_fixes_;
-  h.wind_backlog = wind_queue_.size();
+  h.wind_backlog = wind_queue_.size() + in_hand_.wind;
   h.wind_dropped = dropped_wind_;
   h.failed_commits = failed_commits_;
   if (h.failing)

@@ -258,8 +258,10 @@ class Store {
   bool commit_wind(const std::vector<WindSample>& batch);
   /// A failed batch back at the head of its queue, the queue bounded by max_backlog (the oldest
   /// beyond it dropped and counted in `dropped`).
+  /// `in_hand` (the batch's count in in_hand_) goes to zero in the same step.
   template <class T>
-  void requeue(std::vector<T>& batch, std::vector<T>& queue, std::uint64_t& dropped);
+  void requeue(std::vector<T>& batch, std::vector<T>& queue, std::uint64_t& dropped,
+               std::size_t& in_hand);
   void extend_session(const std::string& boat_id, std::uint64_t t_ns);
   void apply_retention();
   /// Shore time (ns since 1970) of the batch being committed: the sessions' arrival time.
@@ -327,6 +329,11 @@ class Store {
   std::vector<WearableSample> wearable_queue_;
   std::vector<FixSample> fix_queue_;
   std::vector<WindSample> wind_queue_;
+  /// What the writer has taken out of each queue and not yet stored or put back: still the
+  /// backlog, so health() counts it (a retry of a full disk holds the whole backlog here).
+  struct InHand {
+    std::size_t attitude = 0, wearable = 0, fixes = 0, wind = 0;
+  } in_hand_;
   std::uint64_t wind_enqueued_ = 0, wind_processed_ = 0;
   std::uint64_t dropped_wind_ = 0;  ///< readings dropped (backlog full, or requeued past it)
   std::uint64_t fixes_enqueued_ = 0;
