@@ -17,7 +17,7 @@ targets=("$@")
 
 start=$(date +%s)
 CC=clang CXX=clang++ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DTELLTALE_FUZZ=ON -DBUILD_TESTING=OFF -DTELLTALE_BUILD_BENCHMARKS=OFF >/dev/null
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" -DTELLTALE_FUZZ=ON -DBUILD_TESTING=OFF -DTELLTALE_BUILD_BENCHMARKS=OFF >/dev/null
 cmake --build "$build" -j"$(nproc)" --target "${targets[@]}"
 echo "fuzz: build $(($(date +%s) - start)) s"
 
