@@ -451,25 +451,22 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   const double var_h = 0.5 * (st.bias_cov.trace() - up_b_prev.dot(st.bias_cov * up_b_prev));
   // At rest there is no acceleration to average out (that is what rest means): the low-pass may
   // follow the accelerometer faster and wipe out the tilt error the motion left behind.
-  double tau = 0.0;
-  if (!(var_h > sm2) && st.tau_scale == 1.0 && !start_ends) {
-    // The bias known to sigma_m or better (the usual case once the filter has settled: 98 % of
-    // the dinghy's updates keep tau_scale at 1): the ratio below is max(1, sqrt(var_h / sm2)) = 1
-    // exactly (NaN included, as std::max(1, NaN) is 1), Newton's step from z = 1 gives (2 + 1 / 1)
-    // * (1 / 3) = 1 exactly (3 times the double nearest 1/3 rounds to 1), and tau_acc_s / 1 is
-    // tau_acc_s: the same tau as the general path, bit for bit, without its square root and two
-    // divisions.
-    tau = at_rest ? std::min(p.tau_acc_rest_s, p.tau_acc_s) : p.tau_acc_s;
-  } else {
+  // The bias known to sigma_m or better (the usual case once the filter has settled: 98 % of the
+  // dinghy's updates keep tau_scale at 1) needs no root: max(1, sqrt(var_h / sm2)) is 1 (NaN
+  // included, as std::max(1, NaN) is 1) and Newton's step from z = 1 gives (2 + 1) * (1 / 3) = 1
+  // exactly (3 times the double nearest 1/3 rounds to 1). Skipping it gives the same z, bit for
+  // bit, without a square root and two divisions.
+  double z = 1.0;
+  if (var_h > sm2 || st.tau_scale != 1.0 || start_ends) {
     // x = (var_h / sigma_m^2)^(1/2) -> tau = tau_acc_s / cbrt(max(1, x)); Newton on z^3 = x.
     const double ratio = std::max(1.0, std::sqrt(var_h / sm2));
     // (At the start's end the covariance has jumped since the last step: the root itself.)
-    double z = start_ends ? std::cbrt(ratio) : st.tau_scale;
+    z = start_ends ? std::cbrt(ratio) : st.tau_scale;
     z = (2.0 * z + ratio / (z * z)) * (1.0 / 3.0);
     st.tau_scale = z;
-    const double tau_motion = p.tau_acc_s / z;
-    tau = at_rest ? std::min(p.tau_acc_rest_s, tau_motion) : tau_motion;
   }
+  const double tau_motion = p.tau_acc_s / z;
+  const double tau = at_rest ? std::min(p.tau_acc_rest_s, tau_motion) : tau_motion;
   const Butterworth c = butterworth(dt, M_SQRT1_2 / tau);
   if (start_ends) end_start_fit(st, r, c.b0, c.a2, tau, p.g_m_s2);
   if (gap) st.lp_running = false;
