@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "fleet.hpp"
@@ -28,6 +29,19 @@ namespace telltale::shore {
 /// it is not finite. For columns of thousands of numbers (charts), written straight to text
 /// instead of through a json array: a chart answer costs a tenth of what the array would.
 void append_json_number(std::string& out, double v);
+/// Appends `,"name":[...]`: `value(row)` of every row, each by append_json_number.
+template <class Row, class Value>
+void append_number_column(std::string& out, std::string_view name, const std::vector<Row>& rows,
+                          Value value) {
+  out += ",\"";
+  out += name;
+  out += "\":[";
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    if (i) out += ',';
+    append_json_number(out, static_cast<double>(value(rows[i])));
+  }
+  out += ']';
+}
 
 /// Sets `j[name]` for every exported field of `table` (sample_fields.hpp) from `record`: numbers
 /// that are not finite, and every field when there is no record, as null.

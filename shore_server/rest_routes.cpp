@@ -316,20 +316,12 @@ std::string attitude_columns(Store& store, const std::string& boat_id, std::uint
                     ",\"downsampled\":" + (downsample ? "true" : "false") +
                     ",\"points\":" + std::to_string(rows.size());
   out.reserve(out.size() + rows.size() * 4 * 14 + 256);
-  const auto column = [&](const char* name, auto value) {
-    out += ",\"";
-    out += name;
-    out += "\":[";
-    for (std::size_t i = 0; i < rows.size(); ++i) {
-      if (i) out += ',';
-      append_json_number(out, value(rows[i]));
-    }
-    out += ']';
-  };
-  column("t_s", [](const AttitudeRow& r) { return static_cast<double>(r.t_utc_ns) * 1e-9; });
-  column("heel_deg", [](const AttitudeRow& r) { return r.heel_deg; });
-  column("pitch_deg", [](const AttitudeRow& r) { return r.pitch_deg; });
-  column("heading_deg", [](const AttitudeRow& r) { return r.heading_deg; });
+  append_number_column(out, "t_s", rows,
+                       [](const AttitudeRow& r) { return static_cast<double>(r.t_utc_ns) * 1e-9; });
+  append_number_column(out, "heel_deg", rows, [](const AttitudeRow& r) { return r.heel_deg; });
+  append_number_column(out, "pitch_deg", rows, [](const AttitudeRow& r) { return r.pitch_deg; });
+  append_number_column(out, "heading_deg", rows,
+                       [](const AttitudeRow& r) { return r.heading_deg; });
   for (const auto& [key, value] : extra.items())
     out += "," + to_json_text(key) + ":" + to_json_text(value);
   return out + "}";

@@ -163,18 +163,20 @@ void register_track_routes(httplib::Server& server, ShoreContext& ctx) {
     if (!ctx.fleet.boat(id) && !ctx.store.knows_boat(id))
       throw HttpError(404, "unknown boat '" + id + "'");
     const auto points = ctx.store.track(id, range.from_ns, range.to_ns, max_points);
-    // One array per exported field of the fix (sample_fields.hpp), as the sample exports have.
-    json j = {{"boat_id", id}, {"points", points.size()}, {"t_s", json::array()}};
-    for (const auto& f : points) {
-      j["t_s"].push_back(static_cast<double>(f.t_utc_ns) * 1e-9);
-      json row = json::object();
-      add_exported(row, kFixFields, &f);
-      for (auto& [name, value] : row.items()) j[name].push_back(std::move(value));
-    }
+    // One array per exported field of the fix (sample_fields.hpp), as the sample exports have,
+    // written straight to text as the attitude's chart columns are.
+    std::string out =
+        "{\"boat_id\":" + to_json_text(id) + ",\"points\":" + std::to_string(points.size());
+    append_number_column(out, "t_s", points,
+                         [](const FixSample& f) { return static_cast<double>(f.t_utc_ns) * 1e-9; });
     for_each_field<kExported>(kFixFields, [&](const auto& field) {
-      if (!j.contains(field.name)) j[field.name] = json::array();
+      static_assert(std::is_floating_point_v<
+                        std::remove_cvref_t<decltype(field.get(std::declval<const FixSample&>()))>>,
+                    "the track's columns are numbers");
+      append_number_column(out, field.name, points,
+                           [&](const FixSample& f) { return field.get(f); });
     });
-    res.set_content(to_json_text(j), "application/json");
+    res.set_content(out + "}", "application/json");
   });
 
   server.Get(R"(/api/v1/sessions/([^/]+)/gpx)", [&ctx](const httplib::Request& req,
