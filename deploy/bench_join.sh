@@ -12,9 +12,27 @@ domain=$((100 + $$ % 50))
 dir=$(mktemp -d)
 token=bench-token
 pids=()
+# Every process is asked to stop (SIGINT) and given 10 s; one still running then is killed and
+# named, so a node stuck in its DDS shutdown cannot hang the benchmark.
+stop_all() {
+  local p
+  for p in "$@"; do kill -INT "$p" 2>/dev/null || true; done
+  for _ in $(seq 100); do
+    local alive=0
+    for p in "$@"; do kill -0 "$p" 2>/dev/null && alive=1; done
+    [ "$alive" = 0 ] && break
+    sleep 0.1
+  done
+  for p in "$@"; do
+    if kill -0 "$p" 2>/dev/null; then
+      echo "bench_join: process $p did not stop within 10 s of SIGINT; killed" >&2
+      kill -KILL "$p" 2>/dev/null || true
+    fi
+    wait "$p" 2>/dev/null || true
+  done
+}
 cleanup() {
-  for p in "${pids[@]}"; do kill -INT "$p" 2>/dev/null || true; done
-  for p in "${pids[@]}"; do wait "$p" 2>/dev/null || true; done
+  stop_all "${pids[@]}"
   rm -rf "$dir"
 }
 trap cleanup EXIT
@@ -22,7 +40,12 @@ trap cleanup EXIT
   >"$dir/shore.log" 2>&1 &
 pids+=($!)
 for _ in $(seq 100); do grep -q ready "$dir/shore.log" && break; sleep 0.1; done
-url=$(grep -o 'http://[^ /]*' "$dir/shore.log")
+url=$(grep -o 'http://[^ /]*' "$dir/shore.log" || true)
+if [ -z "$url" ]; then
+  echo "bench_join: the shore did not start within 10 s:" >&2
+  cat "$dir/shore.log" >&2
+  exit 1
+fi
 for i in $(seq "$running"); do
   "$bin/boat_node" --domain "$domain" --boat-id "sailing-$i" --log-dir "$dir/log-s$i" \
     >"$dir/s$i.log" 2>&1 &
@@ -46,10 +69,7 @@ for i in $(seq "$joins"); do
     fi
     sleep 0.005
   done
-  if [ "${KEEP:-0}" = 1 ]; then pids+=("$boat"); else
-    kill -INT "$boat" 2>/dev/null || true
-    wait "$boat" 2>/dev/null || true
-  fi
+  if [ "${KEEP:-0}" = 1 ]; then pids+=("$boat"); else stop_all "$boat"; fi
   if [ -z "$seen" ]; then echo "join $i: never seen"; results+=(99999); continue; fi
   echo "join $i: $((seen - ready)) ms"
   results+=($((seen - ready)))
