@@ -1,17 +1,24 @@
 #!/usr/bin/env bash
-# The demo on a fresh machine, timed: a new Debian 12 root made with debootstrap in DIR (default
-# a temporary folder; reused when it already holds one), with only what a new Debian build
-# machine has (compiler, CMake, git, Node.js and npm), a clone of this repository's HEAD in it,
-# then `deploy/demo.sh` run there from nothing: the Debian packages it installs, the build, the
-# demo up. Prints the seconds from the start to the dashboard link and checks that the link's
-# REST API lists the demo's boats sailing. Needs root (chroot, mounts) and Debian's debootstrap.
-# Nothing but the package mirror is contacted; the demo itself stays on loopback.
-#   deploy/bench_fresh.sh [DIR]
+# A fresh machine, timed: a new Debian 12 root made with debootstrap in DIR (default a temporary
+# folder; an existing DIR must be empty, so every run starts from nothing), with only what a new
+# Debian build machine has (compiler, CMake, git, Node.js and npm, this machine's CA bundle), and
+# a clone of this repository's HEAD in it. Then, from nothing (the Debian packages the project
+# installs, an empty compiler cache, the build):
+#   deploy/bench_fresh.sh [DIR]        `deploy/demo.sh`: prints the seconds to the dashboard link
+#                                      and checks that the link's REST API lists boats sailing;
+#   deploy/bench_fresh.sh --ci [DIR]   `bash .ci/run` (the README's test command): prints its
+#                                      seconds, its per-step line and CTest's summary.
+# Needs root (chroot, mounts) and Debian's debootstrap. Nothing but the package mirror and the
+# npm registry is contacted; the demo and the tests stay on loopback.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 [ "$(id -u)" -eq 0 ] || { echo "bench_fresh: needs root (chroot)" >&2; exit 1; }
 command -v debootstrap >/dev/null || { echo "bench_fresh: needs debootstrap (apt-get install debootstrap)" >&2; exit 1; }
+mode=demo
+[ "${1:-}" = "--ci" ] && { mode=ci; shift; }
 dir=${1:-$(mktemp -d)}
+mkdir -p "$dir"
+[ -z "$(ls -A "$dir")" ] || { echo "bench_fresh: $dir is not empty (every run needs a new root)" >&2; exit 1; }
 mounts=()
 demo=
 cleanup() {
@@ -20,9 +27,7 @@ cleanup() {
   for ((i = ${#mounts[@]} - 1; i >= 0; i--)); do umount "${mounts[i]}" 2>/dev/null || true; done
 }
 trap cleanup EXIT
-if [ ! -x "$dir/bin/bash" ]; then
-  debootstrap --variant=minbase bookworm "$dir" http://deb.debian.org/debian >/dev/null
-fi
+debootstrap --variant=minbase bookworm "$dir" http://deb.debian.org/debian >/dev/null
 cp /etc/resolv.conf "$dir/etc/resolv.conf"
 for m in proc sys dev dev/pts dev/shm; do
   mountpoint -q "$dir/$m" || { mount --bind "/$m" "$dir/$m"; mounts+=("$dir/$m"); }
@@ -31,8 +36,18 @@ done
 chroot "$dir" bash -c 'export DEBIAN_FRONTEND=noninteractive; apt-get update -qq &&
   apt-get install -y -qq --no-install-recommends g++ make cmake git nodejs npm ca-certificates \
   >/dev/null'
-rm -rf "$dir/root/telltale"
+# TLS through this machine's proxy, if it has one, needs the machine's own CA bundle.
+cp /etc/ssl/certs/ca-certificates.crt "$dir/etc/ssl/certs/ca-certificates.crt"
 git clone -q "$root" "$dir/root/telltale"
+if [ "$mode" = ci ]; then
+  start=$(date +%s)
+  rc=0
+  chroot "$dir" bash -c 'cd /root/telltale && bash .ci/run' >"$dir/root/ci.out" 2>&1 || rc=$?
+  end=$(date +%s)
+  echo "bash .ci/run on a fresh Debian 12 root: exit $rc after $((end - start)) s"
+  grep -E '^test: programs build|tests passed|tests failed' "$dir/root/ci.out" || tail -40 "$dir/root/ci.out"
+  exit "$rc"
+fi
 port=$((20000 + $$ % 20000))
 start=$(date +%s)
 setsid chroot "$dir" env TELLTALE_HTTP_PORT=$port bash -c 'cd /root/telltale && deploy/demo.sh' \
