@@ -69,4 +69,3 @@ BENCHMARK(BM_ManoeuvreLive10min)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
-BENCHMARK_MAIN();

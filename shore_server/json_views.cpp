@@ -76,56 +76,164 @@ json boat_problems(const BoatView& v) {
   return out;
 }
 
-json boat_object(const BoatView& v) {
-  const AttitudeSample& s = v.last;
-  json j = {
-      {"id", s.boat_id},
-      {"kind", "boat"},
-      {"group", v.status ? v.status->group : std::string()},
-      {"t_utc_ns", s.t_utc_ns},
-      {"last_sample_time", iso8601(s.t_utc_ns)},
-      {"leds",
-       {{"left", s.leds[0]},
-        {"right", s.leds[1]},
-        {"up", s.leds[2]},
-        {"down", s.leds[3]},
-        {"count", s.led_count}}},
-      {"alarm_state", v.alarm_state},
-      {"stale", v.stale},
-      {"samples_received", v.samples_received},
-      {"clock_offset_ms", finite_or_null(v.clock_offset_ms)},
-      {"clock_suspect", std::abs(v.clock_offset_ms) > kClockSuspectMs},
-  };
-  // The sample's fields, as in the exports (sample_fields.hpp).
-  add_exported(j, kAttitudeFields, &s);
-  // Position: null without a fresh fix with a position (never the last one as if it were new).
-  const bool positioned = v.fix && v.fix_fresh && v.fix->fix != "none";
-  add_exported(j, kFixFields, positioned ? &*v.fix : nullptr);
-  j["gnss_fix"] = v.fix && v.fix_fresh ? json(v.fix->fix) : json(nullptr);
-  if (v.fix) {
-    // GNSS time minus the boat's clock at the fix: the boat clock's true error (plus the
-    // receiver's output latency, tens of ms), beside clock_offset_ms (shore clock minus boat).
-    j["gnss"] = {{"satellites", v.fix->satellites},
-                 {"hdop", finite_or_null(v.fix->hdop)},
-                 {"fix_time", iso8601(v.fix->t_utc_ns)},
-                 {"clock_offset_ms",
-                  v.fix->gnss_utc_ns ? json((static_cast<double>(v.fix->gnss_utc_ns) -
-                                             static_cast<double>(v.fix->t_utc_ns)) *
-                                            1e-6)
-                                     : json(nullptr)}};
+namespace {
+
+/// `"text"` with JSON's escapes. Text with any byte above ASCII goes through nlohmann's
+/// serialiser, which replaces what is not valid UTF-8 (to_json_text); ids, groups and the
+/// shore's own words are ASCII, so the live frames take the short way.
+void append_json_string(std::string& out, std::string_view text) {
+  for (const char c : text) {
+    if (static_cast<unsigned char>(c) >= 0x80) {
+      out += to_json_text(json(std::string(text)));
+      return;
+    }
   }
-  j["duplicate_id"] = v.duplicate_id;
-  j["problems"] = boat_problems(v);
-  if (v.status) {
-    j["status"] = {{"software_version", v.status->software_version},
-                   {"uptime_s", v.status->uptime_s},
-                   {"sensor_health", v.status->sensor_health},
-                   {"health_text", v.status->health_text}};
+  out += '"';
+  for (const char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(c));
+      out += buf;
+    } else {
+      out += c;
+    }
   }
-  return j;
+  out += '"';
 }
 
-std::string boat_json(const BoatView& view) { return to_json_text(boat_object(view)); }
+/// A JSON object written straight to text, member by member (a live frame is written tens of
+/// thousands of times a second: through a json object it cost three times as much).
+class ObjectText {
+ public:
+  explicit ObjectText(std::string& out) : out_(out) { out_ += '{'; }
+  ~ObjectText() { out_ += '}'; }
+  ObjectText(const ObjectText&) = delete;
+  ObjectText& operator=(const ObjectText&) = delete;
+
+  /// `"name":`, after a comma when it is not the first member; the value follows.
+  std::string& key(std::string_view name) {
+    if (!first_) out_ += ',';
+    first_ = false;
+    out_ += '"';
+    out_ += name;
+    out_ += "\":";
+    return out_;
+  }
+  void string(std::string_view name, std::string_view v) { append_json_string(key(name), v); }
+  /// A number; null when it is not finite.
+  void number(std::string_view name, double v) { append_json_number(key(name), v); }
+  void integer(std::string_view name, std::uint64_t v) {
+    char buf[24];
+    const auto r = std::to_chars(buf, buf + sizeof buf, v);
+    key(name).append(buf, r.ptr);
+  }
+  void boolean(std::string_view name, bool v) { key(name) += v ? "true" : "false"; }
+  void null(std::string_view name) { key(name) += "null"; }
+  /// A value that is JSON text already.
+  void raw(std::string_view name, std::string_view json_text) { key(name) += json_text; }
+
+  /// Every exported field of `table` (sample_fields.hpp) from `record`: numbers that are not
+  /// finite, and every field when there is no record, as null.
+  template <class Table, class Record>
+  void exported(const Table& table, const Record* record) {
+    for_each_field<kExported>(table, [&](const auto& f) {
+      if (!record) return null(f.name);
+      const auto& v = f.get(*record);
+      using V = std::remove_cvref_t<decltype(v)>;
+      if constexpr (std::is_floating_point_v<V>) {
+        number(f.name, static_cast<double>(v));
+      } else if constexpr (std::is_integral_v<V>) {
+        integer(f.name, static_cast<std::uint64_t>(v));
+      } else {
+        string(f.name, v);
+      }
+    });
+  }
+
+ private:
+  std::string& out_;
+  bool first_ = true;
+};
+
+}  // namespace
+
+std::string boat_json(const BoatView& v) {
+  const AttitudeSample& s = v.last;
+  std::string out;
+  out.reserve(1024);
+  {
+    ObjectText o(out);
+    o.string("id", s.boat_id);
+    o.string("kind", "boat");
+    o.string("group", v.status ? v.status->group : std::string());
+    o.integer("t_utc_ns", s.t_utc_ns);
+    o.string("last_sample_time", iso8601(s.t_utc_ns));
+    o.key("leds");
+    {
+      ObjectText leds(out);
+      leds.integer("left", s.leds[0]);
+      leds.integer("right", s.leds[1]);
+      leds.integer("up", s.leds[2]);
+      leds.integer("down", s.leds[3]);
+      leds.integer("count", s.led_count);
+    }
+    o.string("alarm_state", v.alarm_state);
+    o.boolean("stale", v.stale);
+    o.integer("samples_received", v.samples_received);
+    o.number("clock_offset_ms", v.clock_offset_ms);
+    o.boolean("clock_suspect", std::abs(v.clock_offset_ms) > kClockSuspectMs);
+    // The sample's fields, as in the exports (sample_fields.hpp).
+    o.exported(kAttitudeFields, &s);
+    // Position: null without a fresh fix with a position (never the last one as if it were new).
+    const bool positioned = v.fix && v.fix_fresh && v.fix->fix != "none";
+    o.exported(kFixFields, positioned ? &*v.fix : static_cast<const FixSample*>(nullptr));
+    if (v.fix && v.fix_fresh) {
+      o.string("gnss_fix", v.fix->fix);
+    } else {
+      o.null("gnss_fix");
+    }
+    if (v.fix) {
+      // GNSS time minus the boat's clock at the fix: the boat clock's true error (plus the
+      // receiver's output latency, tens of ms), beside clock_offset_ms (shore clock minus boat).
+      o.key("gnss");
+      ObjectText g(out);
+      g.integer("satellites", v.fix->satellites);
+      g.number("hdop", v.fix->hdop);
+      g.string("fix_time", iso8601(v.fix->t_utc_ns));
+      if (v.fix->gnss_utc_ns) {
+        g.number("clock_offset_ms", (static_cast<double>(v.fix->gnss_utc_ns) -
+                                     static_cast<double>(v.fix->t_utc_ns)) *
+                                        1e-6);
+      } else {
+        g.null("clock_offset_ms");
+      }
+    }
+    o.boolean("duplicate_id", v.duplicate_id);
+    o.raw("problems", to_json_text(boat_problems(v)));
+    if (v.status) {
+      o.key("status");
+      ObjectText st(out);
+      st.string("software_version", v.status->software_version);
+      st.number("uptime_s", v.status->uptime_s);
+      st.integer("sensor_health", v.status->sensor_health);
+      st.string("health_text", v.status->health_text);
+    }
+  }
+  return out;
+}
+
+std::string boats_json(const std::vector<BoatView>& boats) {
+  std::string out = "[";
+  for (const auto& b : boats) {
+    if (out.size() > 1) out += ',';
+    out += boat_json(b);
+  }
+  out += ']';
+  return out;
+}
 
 json rule_object(const AlarmRule& r) {
   return {{"id", r.id},

@@ -66,8 +66,11 @@ void add_exported(nlohmann::json& j, const Table& table, const Record* record) {
 /// "clock_suspect" (its clock is off the shore's), "sensor" (the IMU's health flags). Empty when
 /// all is well. The dashboard shows each as a badge on the boat's card.
 [[nodiscard]] nlohmann::json boat_problems(const BoatView& view);
-[[nodiscard]] nlohmann::json boat_object(const BoatView& view);
+/// A boat as GET /boats/{id} and the live stream's `sample` frames carry it (openapi.json, Boat),
+/// written straight to text.
 [[nodiscard]] std::string boat_json(const BoatView& view);
+/// `[boat, ...]`: GET /boats.
+[[nodiscard]] std::string boats_json(const std::vector<BoatView>& boats);
 [[nodiscard]] nlohmann::json rule_object(const AlarmRule& rule);
 /// A rule from its JSON; throws HttpError 400 naming the field that is wrong.
 [[nodiscard]] AlarmRule rule_from_json(const nlohmann::json& j);

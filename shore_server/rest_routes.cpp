@@ -22,7 +22,7 @@ namespace {
 
 /// The fleet as a coach's GET /boats returns it, rebuilt at most every kMaxAge: a dashboard or a
 /// tool polling /boats gets the fleet as of at most 100 ms ago (the live stream is the fast path),
-/// and a thousand polls a second cost one build per tick instead of one each (3 ms per build
+/// and a thousand polls a second cost one build per tick instead of one each (0.5 ms per build
 /// with 200 boats).
 class BoatsSnapshot {
  public:
@@ -32,9 +32,7 @@ class BoatsSnapshot {
     std::lock_guard lock(mutex_);
     const auto now = std::chrono::steady_clock::now();
     if (!text_ || now - built_ >= kMaxAge) {
-      nlohmann::json arr = nlohmann::json::array();
-      for (const auto& b : fleet.boats()) arr.push_back(boat_object(b));
-      text_ = std::make_shared<const std::string>(to_json_text(arr));
+      text_ = std::make_shared<const std::string>(boats_json(fleet.boats()));
       built_ = now;
     }
     return text_;
@@ -372,9 +370,9 @@ void register_rest_routes(httplib::Server& server, ShoreContext& ctx) {
     const Principal p = who(ctx, req);
     allow_params(req, {});
     if (p.role == Role::kAthlete) {  // an athlete sees their own boat only, always fresh
-      json arr = json::array();
-      if (auto b = ctx.fleet.boat(p.boat_id)) arr.push_back(boat_object(*b));
-      res.set_content(to_json_text(arr), "application/json");
+      std::vector<BoatView> own;
+      if (auto b = ctx.fleet.boat(p.boat_id)) own.push_back(std::move(*b));
+      res.set_content(boats_json(own), "application/json");
       return;
     }
     res.set_content(*snapshot->get(ctx.fleet), "application/json");

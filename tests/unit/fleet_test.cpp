@@ -65,7 +65,7 @@ TEST(FleetDuplicates, TwoNodesUnderOneIdAreFlaggedAndClearedWhenOneStops) {
   const auto text = problems[0].at("text").get<std::string>();
   EXPECT_NE(text.find('7'), std::string::npos) << text;
   EXPECT_NE(text.find('9'), std::string::npos) << text;
-  EXPECT_EQ(boat_object(*v).at("duplicate_id"), true);
+  EXPECT_EQ(nlohmann::json::parse(boat_json(*v)).at("duplicate_id"), true);
   // Node 9 stops; node 7 sails on alone.
   for (std::uint64_t i = 51; i <= 400; ++i) feed(fleet, 7, i, t0 + i * milliseconds(40));
   v = fleet.boat("b1");

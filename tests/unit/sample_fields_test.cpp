@@ -7,12 +7,14 @@
 #include <sqlite3.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
+#include "json_views.hpp"
 #include "openapi_json.hpp"
 
 namespace telltale::shore {
@@ -272,6 +274,51 @@ TEST(SampleFieldsOpenApi, BoatAndTrackCarryTheExportedFields) {
   const ordered_json& track = schemas().at("Track").at("properties");
   EXPECT_TRUE(track.contains("t_s"));
   expect_described<FixSample>(track, kFixFields, {.nullable_checked = false});
+}
+
+// The live frame and GET /boats are written straight to text (json_views.cpp boat_json): a boat
+// with everything set carries exactly the properties the Boat schema describes, nested objects
+// included, and its numbers read back to the same doubles.
+TEST(SampleFieldsOpenApi, BoatJsonCarriesExactlyTheBoatSchema) {
+  BoatView v;
+  v.last.boat_id = "b-1";
+  v.last.t_utc_ns = 1780000000123456789ULL;
+  v.last.seq = 42;
+  v.last.heel_deg = 17.3125;
+  v.last.pitch_deg = -0.1;
+  v.last.heading_deg = std::nan("");
+  v.last.quality = 1.0 / 3.0;
+  v.status = NodeStatusInfo{"boat", "0.9 \"rc\"\n", 12.5, 0, "ok", 7, "ilca"};
+  v.fix = FixSample{};
+  v.fix->fix = "3d";
+  v.fix->lat_deg = 54.3412345678;
+  v.fix->gnss_utc_ns = v.last.t_utc_ns + 40000000;
+  v.fix->t_utc_ns = v.last.t_utc_ns;
+  v.fix_fresh = true;
+  const auto j = nlohmann::json::parse(boat_json(v));
+  const ordered_json& boat = schemas().at("Boat").at("properties");
+  std::vector<std::string> want = keys_of(boat);
+  std::vector<std::string> got;
+  for (const auto& [k, _] : j.items()) got.push_back(k);
+  std::sort(want.begin(), want.end());
+  std::sort(got.begin(), got.end());
+  EXPECT_EQ(got, want);
+  for (const char* nested : {"gnss", "leds"}) {
+    std::vector<std::string> w = keys_of(boat.at(nested).at("properties"));
+    std::vector<std::string> g;
+    for (const auto& [k, _] : j.at(nested).items()) g.push_back(k);
+    std::sort(w.begin(), w.end());
+    std::sort(g.begin(), g.end());
+    EXPECT_EQ(g, w) << nested;
+  }
+  EXPECT_EQ(j.at("t_utc_ns").get<std::uint64_t>(), v.last.t_utc_ns);
+  EXPECT_EQ(j.at("heel_deg").get<double>(), v.last.heel_deg);
+  EXPECT_EQ(j.at("quality").get<double>(), v.last.quality);
+  EXPECT_TRUE(j.at("heading_deg").is_null());
+  EXPECT_EQ(j.at("lat_deg").get<double>(), v.fix->lat_deg);
+  EXPECT_EQ(j.at("gnss").at("clock_offset_ms").get<double>(), 40.0);
+  EXPECT_EQ(j.at("status").at("software_version"), "0.9 \"rc\"\n");
+  EXPECT_EQ(j.at("group"), "ilca");
 }
 
 }  // namespace
