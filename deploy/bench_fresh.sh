@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # A fresh machine, timed: a new Debian 12 root made with debootstrap in DIR (default a temporary
 # folder; an existing DIR must be empty, so every run starts from nothing), with only what a new
-# Debian build machine has (compiler, CMake, git, Node.js and npm, this machine's CA bundle), and
-# a clone of this repository's HEAD in it. Then, from nothing (the Debian packages the project
+# Debian build machine has (compiler, CMake, git, this machine's Node.js, npm and CA bundle),
+# and a clone of this repository's HEAD in it. Then, from nothing (the Debian packages the project
 # installs, an empty compiler cache, the build):
 #   deploy/bench_fresh.sh [DIR]        `deploy/demo.sh`: prints the seconds to the dashboard link
 #                                      and checks that the link's REST API lists boats sailing;
@@ -29,13 +29,19 @@ cleanup() {
 trap cleanup EXIT
 debootstrap --variant=minbase bookworm "$dir" http://deb.debian.org/debian >/dev/null
 cp /etc/resolv.conf "$dir/etc/resolv.conf"
+# The root a mount point of its own, as a machine's / is: the fault tests' mount namespaces
+# (`mount --make-rslave /`) refuse a plain folder.
+mount --bind "$dir" "$dir"
+mounts+=("$dir")
 for m in proc sys dev dev/pts dev/shm; do
   mountpoint -q "$dir/$m" || { mount --bind "/$m" "$dir/$m"; mounts+=("$dir/$m"); }
 done
 # What a new build machine has before the project touches it (not timed).
 chroot "$dir" bash -c 'export DEBIAN_FRONTEND=noninteractive; apt-get update -qq &&
-  apt-get install -y -qq --no-install-recommends g++ make cmake git nodejs npm ca-certificates \
-  >/dev/null'
+  apt-get install -y -qq --no-install-recommends g++ make cmake git ca-certificates >/dev/null'
+# Node.js and npm as this machine has them (a build machine of this kind comes with Node.js 20
+# and npm 11; Debian 12's own nodejs is 18, which the browser tests refuse).
+tar -C / -cf - usr/bin/node usr/bin/npm usr/bin/npx usr/lib/node_modules | tar -C "$dir" -xf -
 # TLS through this machine's proxy, if it has one, needs the machine's own CA bundle.
 cp /etc/ssl/certs/ca-certificates.crt "$dir/etc/ssl/certs/ca-certificates.crt"
 git clone -q "$root" "$dir/root/telltale"

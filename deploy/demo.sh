@@ -54,7 +54,11 @@ echo "Telltale demo on DDS domain $TELLTALE_DOMAIN: shore + 4 boats + 1 wearable
 echo "Dashboard (the fleet map): ${url}#token=${token}&view=map"
 echo "Coach token: ${token}   (curl -H 'Authorization: Bearer ${token}' ${url}api/v1/boats)"
 echo "Ctrl-C to stop."
-wait -n "${pids[@]}" || true
-echo "a demo process exited unexpectedly:" >&2
+rc=0
+wait -n "${pids[@]}" || rc=$?
+# Ctrl-C reaches every process of the terminal's group at once: a node that stopped on it (0, or
+# 130 if killed by it) is the user's stop, not a failure.
+if [ "$rc" -eq 0 ] || [ "$rc" -eq 130 ]; then stop 0; fi
+echo "a demo process exited unexpectedly (exit $rc):" >&2
 tail -n 5 "$log"/* >&2
 stop 1
