@@ -54,6 +54,17 @@ NetnsFleet::NetnsFleet(int boats) {
   remove_orphans();
   prefix_ = "ttn" + std::to_string(getpid());
   shore_ns_ = prefix_ + "s";
+  try {
+    build(boats);
+  } catch (...) {
+    // A half-built fleet has no destructor run: its namespaces go now, not at the next run's
+    // orphan sweep (which a machine that never runs the tests again would not have).
+    remove_created();
+    throw;
+  }
+}
+
+void NetnsFleet::build(int boats) {
   run_command({ip_bin(), "netns", "add", shore_ns_});
   created_.push_back(shore_ns_);
   run_command({ip_bin(), "-n", shore_ns_, "link", "set", "lo", "up"});
@@ -86,6 +97,10 @@ NetnsFleet::NetnsFleet(int boats) {
 
 NetnsFleet::~NetnsFleet() {
   delays_.clear();  // stops the delay helpers (their SIGTERM releases what they hold)
+  remove_created();
+}
+
+void NetnsFleet::remove_created() {
   for (auto it = created_.rbegin(); it != created_.rend(); ++it) {
     try {
       run_command({ip_bin(), "netns", "del", *it});

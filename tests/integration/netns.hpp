@@ -87,6 +87,10 @@ class NetnsFleet {
   void iptables(const std::string& ns, std::vector<std::string> rule);
   /// Deletes namespaces left by test processes that no longer exist (a crashed earlier run).
   static void remove_orphans();
+  /// The namespaces and links of the constructor, one step each (throws NetnsError).
+  void build(int boats);
+  /// Deletes every namespace created, newest first (best effort).
+  void remove_created();
 
   std::string prefix_;
   std::string shore_ns_;
