@@ -259,8 +259,9 @@ struct HttpApi::Impl {
       }
       res.set_chunked_content_provider(
           "text/event-stream",
-          [this, client, pending = std::move(snapshot)](std::size_t,
-                                                        httplib::DataSink& sink) mutable {
+          [this, client, pending = std::move(snapshot),
+           buffer = config.stream_send_buffer_bytes](std::size_t,
+                                                     httplib::DataSink& sink) mutable {
             bool closed = false;
             std::string out = std::move(pending);
             pending.clear();
@@ -270,6 +271,15 @@ struct HttpApi::Impl {
               return false;
             }
             if (out.empty()) out = ": keep-alive\n\n";
+            // The send buffer grows to hold the biggest batch (up to kMaxStreamSendBuffer): a
+            // batch bigger than the buffer went out in buffer-sized turns, each waiting for the
+            // client to read (1000 boats, ~700 KB a batch through 32 KB: the last boats of a
+            // batch arrived ~150 ms after the first). A client that stops reading still fills it
+            // within one batch, and the write timeout frees its slot.
+            if (out.size() > buffer && buffer < kMaxStreamSendBuffer) {
+              buffer = std::min(out.size(), kMaxStreamSendBuffer);
+              GuardedServer::cap_send_buffer(static_cast<int>(buffer));
+            }
             return sink.write(out.data(), out.size());
           },
           [this, client](bool) { ctx.hub.disconnect(client); });

@@ -36,10 +36,14 @@ struct HttpConfig {
   std::size_t spare_threads = 32;
   /// An idle keep-alive connection is closed after this long (sooner while threads are short).
   int keep_alive_s = 5;
-  /// Send buffer of a live-stream connection: a client that stops reading is dropped once this
-  /// and its receive buffer are full and a write has waited 5 s.
+  /// Send buffer of a live-stream connection at its start: a client that stops reading is
+  /// dropped once this and its receive buffer are full and a write has waited 5 s. It grows to
+  /// hold the stream's biggest batch (a big fleet), up to kMaxStreamSendBuffer.
   std::size_t stream_send_buffer_bytes = 32 * 1024;
 };
+
+/// The most a live stream's send buffer grows to: a batch of ~5000 boats.
+inline constexpr std::size_t kMaxStreamSendBuffer = 4 * 1024 * 1024;
 
 /// What the routes work on.
 struct ShoreContext {
