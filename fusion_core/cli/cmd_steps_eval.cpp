@@ -1,6 +1,6 @@
-// fusion_cli steps-eval: the accuracy tables of issues 5 and 19 (simulated gaits x methods, every
-// real set present -- IPOL foot and lower-back IMUs, Oxford phone traces --, pose classification
-// on held-out people, PDR closed loops).
+// fusion_cli steps-eval: the step and dead-reckoning accuracy tables (simulated gaits x methods,
+// every real set present -- IPOL foot and lower-back IMUs, Oxford phone traces --, pose
+// classification on held-out people, PDR closed loops).
 #include <unistd.h>
 
 #include <algorithm>
@@ -31,7 +31,7 @@ namespace sim = fusion::sim;
 struct EvalOptions {
   int people = 10;
   std::string oxford_dir;
-  /// The real recordings (SPEC section 7): --data, else $TELLTALE_DATA, else ../shared/data.
+  /// The real recordings: --data, else $TELLTALE_DATA, else ../shared/data.
   std::string data_dir;
   std::string tables = "gait,ipol,oxford,pose,pdr,ipin";
   int loops = 40;
