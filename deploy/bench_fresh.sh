@@ -25,6 +25,8 @@ cleanup() {
   # The demo's own process group: demo.sh and every node it started stop on SIGINT.
   [ -n "$demo" ] && kill -INT -- -"$demo" 2>/dev/null && wait "$demo" 2>/dev/null || true
   for ((i = ${#mounts[@]} - 1; i >= 0; i--)); do umount "${mounts[i]}" 2>/dev/null || true; done
+  # What the tests mounted inside the root (ip netns keeps /run/netns) goes with it.
+  umount -R "$dir" 2>/dev/null || true
 }
 trap cleanup EXIT
 debootstrap --variant=minbase bookworm "$dir" http://deb.debian.org/debian >/dev/null
