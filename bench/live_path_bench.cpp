@@ -63,7 +63,9 @@ void BM_BoatJson(benchmark::State& state) {
 }
 BENCHMARK(BM_BoatJson)->Unit(benchmark::kMicrosecond);
 
-/// What the live worker does per sample for `boats` boats: update, publish (render deferred).
+/// The live worker's per-sample core for `boats` boats: the fleet model's update and the hub's
+/// publish (the frame rendered later, by a stream). The alarms and the manoeuvre tracker it also
+/// feeds are apart (BM_ManoeuvreLive10min for the tracker).
 void BM_LiveWorkerPerSample(benchmark::State& state) {
   const auto boats = static_cast<int>(state.range(0));
   FleetModel fleet(std::chrono::milliseconds(2000));

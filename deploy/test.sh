@@ -11,6 +11,8 @@
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 t0=$(date +%s)
+# The build's packages first (build.sh, fuzz.sh and test_sanitized.sh then find them all), so
+# that the browser's apt-get below runs alone: two at once would fight over dpkg's lock.
 "$root/deploy/bootstrap.sh"
 # The browser's packages (Chromium, ~30 s to install on a new machine) come in while the compiler
 # runs, not in the browser test's own time at the end, where it runs alone.

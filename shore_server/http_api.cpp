@@ -273,9 +273,10 @@ struct HttpApi::Impl {
             if (out.empty()) out = ": keep-alive\n\n";
             // The send buffer grows to hold the biggest batch (up to kMaxStreamSendBuffer): a
             // batch bigger than the buffer went out in buffer-sized turns, each waiting for the
-            // client to read (1000 boats, ~700 KB a batch through 32 KB: the last boats of a
-            // batch arrived ~150 ms after the first). A client that stops reading still fills it
-            // within one batch, and the write timeout frees its slot.
+            // client to read (1000 boats: ~700 KB a batch through 32 KB; boat -> dashboard p50
+            // 235 ms, 31 ms with the buffer grown, deploy/bench_fleet.sh 1000 60 1). A client
+            // that stops reading still fills it within one batch; the write timeout frees its
+            // slot.
             if (out.size() > buffer && buffer < kMaxStreamSendBuffer) {
               buffer = std::min(out.size(), kMaxStreamSendBuffer);
               GuardedServer::cap_send_buffer(static_cast<int>(buffer));

@@ -76,8 +76,6 @@ json boat_problems(const BoatView& v) {
   return out;
 }
 
-namespace {
-
 /// `"text"` with JSON's escapes. Text with any byte above ASCII goes through nlohmann's
 /// serialiser, which replaces what is not valid UTF-8 (to_json_text); ids, groups and the
 /// shore's own words are ASCII, so the live frames take the short way.
@@ -104,68 +102,12 @@ void append_json_string(std::string& out, std::string_view text) {
   out += '"';
 }
 
-/// A JSON object written straight to text, member by member (a live frame is written tens of
-/// thousands of times a second: through a json object it cost three times as much).
-class ObjectText {
- public:
-  explicit ObjectText(std::string& out) : out_(out) { out_ += '{'; }
-  ~ObjectText() { out_ += '}'; }
-  ObjectText(const ObjectText&) = delete;
-  ObjectText& operator=(const ObjectText&) = delete;
-
-  /// `"name":`, after a comma when it is not the first member; the value follows.
-  std::string& key(std::string_view name) {
-    if (!first_) out_ += ',';
-    first_ = false;
-    out_ += '"';
-    out_ += name;
-    out_ += "\":";
-    return out_;
-  }
-  void string(std::string_view name, std::string_view v) { append_json_string(key(name), v); }
-  /// A number; null when it is not finite.
-  void number(std::string_view name, double v) { append_json_number(key(name), v); }
-  void integer(std::string_view name, std::uint64_t v) {
-    char buf[24];
-    const auto r = std::to_chars(buf, buf + sizeof buf, v);
-    key(name).append(buf, r.ptr);
-  }
-  void boolean(std::string_view name, bool v) { key(name) += v ? "true" : "false"; }
-  void null(std::string_view name) { key(name) += "null"; }
-  /// A value that is JSON text already.
-  void raw(std::string_view name, std::string_view json_text) { key(name) += json_text; }
-
-  /// Every exported field of `table` (sample_fields.hpp) from `record`: numbers that are not
-  /// finite, and every field when there is no record, as null.
-  template <class Table, class Record>
-  void exported(const Table& table, const Record* record) {
-    for_each_field<kExported>(table, [&](const auto& f) {
-      if (!record) return null(f.name);
-      const auto& v = f.get(*record);
-      using V = std::remove_cvref_t<decltype(v)>;
-      if constexpr (std::is_floating_point_v<V>) {
-        number(f.name, static_cast<double>(v));
-      } else if constexpr (std::is_integral_v<V>) {
-        integer(f.name, static_cast<std::uint64_t>(v));
-      } else {
-        string(f.name, v);
-      }
-    });
-  }
-
- private:
-  std::string& out_;
-  bool first_ = true;
-};
-
-}  // namespace
-
 std::string boat_json(const BoatView& v) {
   const AttitudeSample& s = v.last;
   std::string out;
   out.reserve(1024);
   {
-    ObjectText o(out);
+    JsonObjectText o(out);
     o.string("id", s.boat_id);
     o.string("kind", "boat");
     o.string("group", v.status ? v.status->group : std::string());
@@ -173,7 +115,7 @@ std::string boat_json(const BoatView& v) {
     o.string("last_sample_time", iso8601(s.t_utc_ns));
     o.key("leds");
     {
-      ObjectText leds(out);
+      JsonObjectText leds(out);
       leds.integer("left", s.leds[0]);
       leds.integer("right", s.leds[1]);
       leds.integer("up", s.leds[2]);
@@ -199,7 +141,7 @@ std::string boat_json(const BoatView& v) {
       // GNSS time minus the boat's clock at the fix: the boat clock's true error (plus the
       // receiver's output latency, tens of ms), beside clock_offset_ms (shore clock minus boat).
       o.key("gnss");
-      ObjectText g(out);
+      JsonObjectText g(out);
       g.integer("satellites", v.fix->satellites);
       g.number("hdop", v.fix->hdop);
       g.string("fix_time", iso8601(v.fix->t_utc_ns));
@@ -215,7 +157,7 @@ std::string boat_json(const BoatView& v) {
     o.raw("problems", to_json_text(boat_problems(v)));
     if (v.status) {
       o.key("status");
-      ObjectText st(out);
+      JsonObjectText st(out);
       st.string("software_version", v.status->software_version);
       st.number("uptime_s", v.status->uptime_s);
       st.integer("sensor_health", v.status->sensor_health);

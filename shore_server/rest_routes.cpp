@@ -124,11 +124,12 @@ std::string csv_row(const AttitudeRow& r, const FixSample* f) {
   return out + "\n";
 }
 
-json row_object(const AttitudeRow& r, const FixSample* f) {
-  json j = {{"time_utc", iso8601(r.t_utc_ns)}, {"t_s", static_cast<double>(r.t_utc_ns) * 1e-9}};
-  add_exported(j, kAttitudeFields, &r);
-  add_exported(j, kFixFields, f);
-  return j;
+void append_row_json(std::string& out, const AttitudeRow& r, const FixSample* f) {
+  JsonObjectText o(out);
+  o.string("time_utc", iso8601(r.t_utc_ns));
+  o.number("t_s", static_cast<double>(r.t_utc_ns) * 1e-9);
+  o.exported(kAttitudeFields, &r);
+  o.exported(kFixFields, f);
 }
 
 /// Streams every stored sample of a boat in [from, to] as CSV or JSON, a page at a time: a long
@@ -175,7 +176,7 @@ void stream_rows(httplib::Response& res, Store& store, const std::string& boat_i
             out += csv_row(r, fix);
           } else {
             if (!cursor->first_row) out += ",";
-            out += to_json_text(row_object(r, fix));
+            append_row_json(out, r, fix);
             cursor->first_row = false;
           }
         }
