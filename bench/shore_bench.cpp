@@ -1,4 +1,5 @@
-// The shore's benchmarks (manoeuvre_live_bench.cpp, live_path_bench.cpp) in one program.
+// The shore's benchmarks (manoeuvre_live_bench.cpp, live_path_bench.cpp, store_bench.cpp) in one
+// program.
 #include <benchmark/benchmark.h>
 
 BENCHMARK_MAIN();

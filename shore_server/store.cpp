@@ -6,6 +6,7 @@
 #include <limits>
 #include <map>
 
+#include "chart_tiers.hpp"
 #include "sample_fields.hpp"
 #include "sqlite_stmt.hpp"
 
@@ -88,69 +89,10 @@ sqlite3* open_db(const std::string& path, int flags) {
 /// The schema this build writes. Version 1: attitude gained boot_id (the boats' run id, for
 /// backfill receipts). Version 2: sessions gained received_ns (the shore's arrival time, for
 /// retention; 0 in older rows: their end_ns stands in). Databases from earlier builds are
-/// migrated in place; a database from a newer build is refused rather than misread.
-constexpr int kSchemaVersion = 3;
-
-// Chart tiers (schema 3): per boat and time bucket of each of kTierWidths seconds, the number of
-// samples and the four samples with the lowest and highest heel and pitch (time, heel, pitch,
-// heading of each), which is what a chart keeps when it thins. A trigger keeps them as samples are
-// inserted by any path (live, backfill, import; an ignored duplicate fires nothing), merging in
-// any order, so a chart of a 4-hour session reads a few thousand tier rows, not 360 000 samples.
-constexpr const char* kTierTable = R"sql(
-CREATE TABLE IF NOT EXISTS attitude_tier (
-  boat_id TEXT NOT NULL,
-  width_s INTEGER NOT NULL,
-  bucket INTEGER NOT NULL,
-  n INTEGER NOT NULL,
-  e0_t INTEGER, e0_heel REAL, e0_pitch REAL, e0_hdg REAL,
-  e1_t INTEGER, e1_heel REAL, e1_pitch REAL, e1_hdg REAL,
-  e2_t INTEGER, e2_heel REAL, e2_pitch REAL, e2_hdg REAL,
-  e3_t INTEGER, e3_heel REAL, e3_pitch REAL, e3_hdg REAL,
-  PRIMARY KEY (boat_id, width_s, bucket)
-) WITHOUT ROWID;
-)sql";
-
-/// The upsert that merges the rows `select_from` yields (alias `a`: an attitude row) into the tier
-/// of `width_s`. e0/e1: lowest/highest heel; e2/e3: lowest/highest pitch. SQLite evaluates every
-/// SET expression on the row as it was, so each CASE compares with the old extreme.
-std::string tier_upsert(std::uint64_t width_s, const std::string& select_from) {
-  const std::string w = std::to_string(width_s);
-  const std::string w_ns = std::to_string(width_s * 1000000000ULL);
-  std::string sql =
-      "INSERT INTO attitude_tier SELECT a.boat_id, " + w + ", a.t_utc_ns / " + w_ns + ", 1";
-  for (int e = 0; e < 4; ++e) sql += ", a.t_utc_ns, a.heel_deg, a.pitch_deg, a.heading_deg";
-  sql += " " + select_from +
-         " ON CONFLICT (boat_id, width_s, bucket) DO UPDATE SET n = n + excluded.n";
-  static constexpr std::array<std::pair<const char*, const char*>, 4> kExtremes = {
-      {{"heel", "<"}, {"heel", ">"}, {"pitch", "<"}, {"pitch", ">"}}};
-  for (std::size_t e = 0; e < kExtremes.size(); ++e) {
-    const std::string p = "e" + std::to_string(e) + "_";
-    const std::string wins = std::string("excluded.") + p + kExtremes[e].first + " " +
-                             kExtremes[e].second + " " + p + kExtremes[e].first;
-    for (const char* col : {"t", "heel", "pitch", "hdg"})
-      sql += ", " + p + col + " = CASE WHEN " + wins + " THEN excluded." + p + col + " ELSE " + p +
-             col + " END";
-  }
-  return sql;
-}
-
-/// The trigger that keeps every tier as samples are inserted.
-std::string tier_trigger() {
-  std::string sql = "CREATE TRIGGER IF NOT EXISTS attitude_tiers AFTER INSERT ON attitude BEGIN ";
-  for (const auto w : kTierWidths_s)
-    sql += tier_upsert(w,
-                       "FROM (SELECT NEW.boat_id AS boat_id, NEW.t_utc_ns AS t_utc_ns, "
-                       "NEW.heel_deg AS heel_deg, NEW.pitch_deg AS pitch_deg, "
-                       "NEW.heading_deg AS heading_deg) a WHERE true") +
-           "; ";
-  return sql + "END;";
-}
-
-/// Rebuilds the tiers of `boat_id` over [from_ns, to_ns] (widened to whole buckets of every width)
-/// from the samples there: after samples were deleted, or to build tiers for a database written
-/// before they existed (boat_id empty: every boat, the whole time).
-void rebuild_tiers(sqlite3* db, const std::string& boat_id, std::uint64_t from_ns,
-                   std::uint64_t to_ns);
+/// migrated in place; a database from a newer build is refused rather than misread. Version 3:
+/// chart tiers (chart_tiers.hpp), built for older databases. Version 4: the tiers are kept by the
+/// inserting code, no longer by a trigger, which is dropped.
+constexpr int kSchemaVersion = 4;
 
 /// ALTER TABLE ADD COLUMN for every stored field of `table` that `table_name` lacks.
 template <class Table>
@@ -179,31 +121,8 @@ void migrate(sqlite3* db) {
   if (has_received.step() && has_received.i64(0) == 0)
     exec(db, "ALTER TABLE sessions ADD COLUMN received_ns INTEGER NOT NULL DEFAULT 0");
   if (version < 3) rebuild_tiers(db, "", 0, std::numeric_limits<std::int64_t>::max());
+  if (version < 4) exec(db, "DROP TRIGGER IF EXISTS attitude_tiers");
   exec(db, ("PRAGMA user_version = " + std::to_string(kSchemaVersion)).c_str());
-}
-
-void rebuild_tiers(sqlite3* db, const std::string& boat_id, std::uint64_t from_ns,
-                   std::uint64_t to_ns) {
-  const std::uint64_t widest_ns = kTierWidths_s.back() * 1000000000ULL;
-  const std::uint64_t lo = from_ns / widest_ns * widest_ns;
-  const std::uint64_t hi = std::min<std::uint64_t>(to_ns / widest_ns * widest_ns + widest_ns - 1,
-                                                   std::numeric_limits<std::int64_t>::max());
-  const std::string match = boat_id.empty() ? "?1 = ''" : "boat_id = ?1";
-  for (const auto w : kTierWidths_s) {
-    const std::uint64_t w_ns = w * 1000000000ULL;
-    Stmt del(db, ("DELETE FROM attitude_tier WHERE " + match +
-                  " AND width_s = ?2 AND bucket BETWEEN ?3 AND ?4")
-                     .c_str());
-    del.bind(1, boat_id).bind_u(2, w).bind_u(3, lo / w_ns).bind_u(4, hi / w_ns);
-    del.step();
-    Stmt add(db, tier_upsert(w, "FROM attitude a WHERE (" +
-                                    std::string(boat_id.empty() ? "?1 = ''" : "a.boat_id = ?1") +
-                                    ") AND a.t_utc_ns BETWEEN ?2 AND ?3 "
-                                    "ORDER BY a.boat_id, a.t_utc_ns")
-                     .c_str());
-    add.bind(1, boat_id).bind_u(2, lo).bind_u(3, hi);
-    add.step();
-  }
 }
 
 SessionInfo session_from(const Stmt& s) {
@@ -270,11 +189,15 @@ Store::Store(StoreConfig config) : config_(std::move(config)) {
   db_ = open_db(config_.path, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
   try {
     exec(db_, kSchema);
+    // The writer's page cache: SQLite's default 2 MB holds the index pages of a few hundred
+    // boats; beyond that every insert re-reads pages from the WAL (pread was the writer's second
+    // cost at 1000 boats, and a 64 MB cache cut its CPU per commit by a quarter:
+    // bench/store_bench.cpp). Readers keep the default: they read ranges, not scattered pages.
+    exec(db_, "PRAGMA cache_size = -65536");
     exec(db_, create_table_sql("attitude", kAttitudeFields).c_str());
     exec(db_, create_table_sql("fixes", kFixFields).c_str());
     exec(db_, create_table_sql("wind", kWindFields).c_str());
-    exec(db_, kTierTable);
-    exec(db_, tier_trigger().c_str());
+    create_tier_table(db_);
     migrate(db_);
     load_aliases();
     for (std::size_t i = 0; i < kReaders; ++i)
@@ -714,6 +637,7 @@ bool Store::commit(std::vector<AttitudeSample>& batch) {
     });
     const AttitudeSample* run_of_id = nullptr;  // the id is looked up once per run in a row
     const std::string* recorded = nullptr;
+    TierFold tiers;
     for (const auto& s : batch) {
       if (!run_of_id || run_of_id->boat_id != s.boat_id || run_of_id->boot_id != s.boot_id) {
         recorded = &recorded_id(s);
@@ -729,6 +653,7 @@ bool Store::commit(std::vector<AttitudeSample>& batch) {
       if (sqlite3_changes(db_) == 1) {  // a duplicate (re-sent sample) changes nothing
         ++inserted;
         extend_session(id, s.t_utc_ns);
+        tiers.add(id, s.t_utc_ns, s.heel_deg, s.pitch_deg, s.heading_deg);
       }
     }
     Stmt up(db_,
@@ -742,6 +667,7 @@ bool Store::commit(std::vector<AttitudeSample>& batch) {
       up.step();
     }
     dirty_sessions_.clear();
+    tiers.write(db_);
     for (const auto& boat : backfilled_) merge_sessions(boat);
     backfilled_.clear();
     exec(db_, "COMMIT");
@@ -907,12 +833,16 @@ void Store::note_stored(std::map<std::pair<std::string, std::uint64_t>, Receipt>
     }
   }
   r.touched = now;
-  if (seq > r.acked) {
+  // The next in line (nearly every sample) moves the mark without touching the set, which
+  // otherwise allocated and freed a node per sample.
+  if (seq == r.acked + 1) {
+    r.acked = seq;
+  } else if (seq > r.acked) {
     r.ahead.insert(seq);
-    while (!r.ahead.empty() && *r.ahead.begin() <= r.acked + 1) {
-      r.acked = std::max(r.acked, *r.ahead.begin());
-      r.ahead.erase(r.ahead.begin());
-    }
+  }
+  while (!r.ahead.empty() && *r.ahead.begin() <= r.acked + 1) {
+    r.acked = std::max(r.acked, *r.ahead.begin());
+    r.ahead.erase(r.ahead.begin());
   }
 }
 

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "chart_tiers.hpp"
 #include "course_from_positions.hpp"
 #include "detect.hpp"
 #include "sample_fields.hpp"
@@ -101,6 +102,11 @@ class StoreSink : public ImportSink {
       attitude_.bind_u(2, p.t_utc_ns).bind(3, p.heel_deg).bind(4, p.pitch_deg).bind(5, p.heading_deg);
       added = static_cast<std::uint64_t>(attitude_.run());
       samples_added += added;
+      if (added != 0) {
+        tiers_.add(boat_, p.t_utc_ns, p.heel_deg, p.pitch_deg, p.heading_deg);
+        // Bounded memory for a file of any length: merging early gives the same tiers.
+        if (tiers_.buckets() >= kTierFoldBuckets) tiers_.write(db_);
+      }
     }
     if (std::isfinite(p.lat_deg) && std::isfinite(p.lon_deg)) {
       fix_.bind_u(2, p.t_utc_ns).bind(3, p.lat_deg).bind(4, p.lon_deg).bind(5, p.sog_m_s).bind(6, p.cog_deg);
@@ -124,8 +130,10 @@ class StoreSink : public ImportSink {
   }
   void device(std::string_view d) override { device_name = std::string(d.substr(0, 200)); }
 
-  /// Joins each span of the file to the boat's sessions and links them to the import.
+  /// Writes the last chart tier buckets, then joins each span of the file to the boat's sessions
+  /// and links them to the import.
   std::vector<std::int64_t> sessions() {
+    tiers_.write(db_);
     std::vector<std::int64_t> out;
     const std::uint64_t received = now_ns();
     for (const Span& sp : spans_) {
@@ -216,6 +224,9 @@ class StoreSink : public ImportSink {
   Stmt attitude_, fix_, wind_, event_;
   std::uint64_t points_ = 0;
   std::vector<Span> spans_;
+  /// About 1 MB of folded buckets (an hour of 25 Hz samples) before they are merged.
+  static constexpr std::size_t kTierFoldBuckets = 4096;
+  TierFold tiers_;
 };
 
 }  // namespace

@@ -1,3 +1,5 @@
+#include "import_store.hpp"
+
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 #include <unistd.h>
@@ -9,7 +11,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "import_store.hpp"
+#include "tier_check.hpp"
 
 namespace telltale::shore::import {
 namespace {
@@ -155,6 +157,7 @@ TEST_F(ImportStoreTest, OverlapWithLiveDataMergesByTime) {
   EXPECT_EQ(rows("SELECT heel_deg FROM attitude WHERE t_utc_ns = " +
                  std::to_string((kT0s + 100) * kSecond)),
             3);  // the live sample kept
+  expect_tiers_hold(store, "ILCA-1");  // the file's buckets merged into the live minute's
   // Live data after the import still extends that session.
   AttitudeSample later;
   later.boat_id = "ILCA-1";
@@ -239,6 +242,8 @@ TEST_F(ImportStoreTest, FourHourAtlasCsvAtTwoHertz) {
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ASSERT_EQ(r.state, "done") << r.error;
   EXPECT_EQ(r.points, 28800u);
+  // 15 300 tier buckets: the fold is merged several times during the import.
+  expect_tiers_hold(store, "ILCA-1");
   std::printf("4 h at 2 Hz (%ju bytes, 28800 rows): imported in %.3f s\n",
               static_cast<std::uintmax_t>(std::filesystem::file_size(path)), s);
   EXPECT_LT(s, 5.0);  // target 1 s on an idle core; the bound leaves room for a loaded machine
