@@ -5,14 +5,16 @@
 //       --shore-pid PID --boats 200 --rate-hz 25 --fix-hz 10 --seconds 300 --sse-clients 1
 //
 // Prints one JSON object: samples and GNSS fixes written, what the shore committed, latency
-// percentiles, shore CPU (% of one core) and peak RSS.
-#include <CLI/CLI.hpp>
+// percentiles, shore CPU (% of one core) and peak RSS, and where a loss happened (datagrams the
+// kernel dropped on the shore's UDP sockets, samples its store refused).
 #include <httplib.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -56,6 +58,34 @@ ProcStat read_proc(int pid) {
   while (std::getline(status, line))
     if (line.rfind("VmRSS:", 0) == 0) p.rss_kb = std::stol(line.substr(6));
   return p;
+}
+
+/// Datagrams the kernel dropped on `pid`'s UDP sockets (receive buffer full): the samples a busy
+/// shore lost before DDS saw them. The sockets are found by inode in /proc/PID/fd, their drop
+/// counters in the last column of /proc/PID/net/udp and udp6.
+long udp_drops(int pid) {
+  std::vector<std::string> inodes;
+  std::error_code ec;
+  const std::string proc = "/proc/" + std::to_string(pid);
+  for (const auto& fd : std::filesystem::directory_iterator(proc + "/fd", ec)) {
+    const std::string target = std::filesystem::read_symlink(fd.path(), ec).string();
+    if (target.rfind("socket:[", 0) == 0) inodes.push_back(target.substr(8, target.size() - 9));
+  }
+  long drops = 0;
+  for (const char* table : {"/net/udp", "/net/udp6"}) {
+    std::ifstream in(proc + table);
+    std::string line;
+    std::getline(in, line);  // header
+    while (std::getline(in, line)) {
+      std::istringstream f(line);
+      std::vector<std::string> col;
+      std::string tok;
+      while (f >> tok) col.push_back(tok);
+      if (col.size() > 12 && std::find(inodes.begin(), inodes.end(), col[9]) != inodes.end())
+        drops += std::stol(col[12]);
+    }
+  }
+  return drops;
 }
 
 }  // namespace
@@ -187,25 +217,34 @@ int main(int argc, char** argv) {
   long written = 0;
   long failed = 0;
   std::uint64_t seq = 0;
+  // Real boats sample on clocks of their own, so a fleet's datagrams arrive spread over each
+  // period, not all at once: each tick writes the fleet in kSlices slices spread over the period
+  // (one burst of 2000 boats' attitude and fixes is ~4000 datagrams, more than a 4 MB socket
+  // buffer holds, and no fleet sends that).
+  constexpr std::size_t kSlices = 8;
   while (!shutdown.stop_requested() &&
          std::chrono::duration<double>(Clock::now() - start).count() < seconds) {
     ++seq;
-    for (auto& s : samples) {
-      s.seq(seq);
-      s.t_utc_ns(telltale::utc_now_ns());
-      s.heel_deg(10.0 * std::sin(static_cast<double>(seq) * 0.05));
-      s.pitch_deg(2.0);
-      s.heading_deg(std::nan(""));
-      if (writer->write(&s)) {
-        ++written;
-      } else {
-        ++failed;
+    const bool fix_due = fix_every > 0 && static_cast<double>(seq) >= next_fix_tick;
+    if (fix_due) next_fix_tick += fix_every;
+    const double t = static_cast<double>(seq) / rate_hz;
+    for (std::size_t k = 0; k < kSlices; ++k) {
+      const std::size_t lo = k * samples.size() / kSlices;
+      const std::size_t hi = (k + 1) * samples.size() / kSlices;
+      for (std::size_t b = lo; b < hi; ++b) {
+        auto& s = samples[b];
+        s.seq(seq);
+        s.t_utc_ns(telltale::utc_now_ns());
+        s.heel_deg(10.0 * std::sin(static_cast<double>(seq) * 0.05));
+        s.pitch_deg(2.0);
+        s.heading_deg(std::nan(""));
+        if (writer->write(&s)) {
+          ++written;
+        } else {
+          ++failed;
+        }
       }
-    }
-    if (fix_every > 0 && static_cast<double>(seq) >= next_fix_tick) {
-      next_fix_tick += fix_every;
-      const double t = static_cast<double>(seq) / rate_hz;
-      for (std::size_t b = 0; b < fixes.size(); ++b) {
+      for (std::size_t b = lo; fix_due && b < hi; ++b) {
         auto& f = fixes[b];
         f.seq(f.seq() + 1);
         f.t_utc_ns(telltale::utc_now_ns());
@@ -223,6 +262,7 @@ int main(int argc, char** argv) {
           ++failed;
         }
       }
+      if (k + 1 < kSlices) std::this_thread::sleep_until(tick + period * (k + 1) / kSlices);
     }
     if (shore_pid && seq % 25 == 0) peak_rss = std::max(peak_rss, read_proc(shore_pid).rss_kb);
     tick += period;
@@ -238,6 +278,8 @@ int main(int argc, char** argv) {
   const json h = health ? json::parse(health->body, nullptr, false) : json();
   const long committed = h.is_object() ? h.value("samples_committed", -1L) : -1;
   const long fixes_committed = h.is_object() ? h.value("fixes_committed", -1L) : -1;
+  const long store_dropped =
+      h.is_object() && h.contains("store") ? h["store"].value("dropped", -1L) : -1;
   for (auto& t : clients) t.join();  // each returns on its next event (the shore keeps streaming)
 
   std::sort(latencies_ms.begin(), latencies_ms.end());
@@ -262,7 +304,9 @@ int main(int argc, char** argv) {
   if (shore_pid) {
     out["shore_cpu_percent_of_one_core"] = 100.0 * (after.cpu_s - before.cpu_s) / elapsed;
     out["shore_rss_mb_peak"] = static_cast<double>(peak_rss) / 1024.0;
+    out["shore_udp_receive_drops"] = udp_drops(shore_pid);
   }
+  out["shore_store_dropped"] = store_dropped;
   std::printf("%s\n", out.dump(1).c_str());
   return 0;
 }

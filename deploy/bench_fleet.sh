@@ -2,7 +2,9 @@
 # Load benchmark: N boats x 25 Hz attitude + 10 Hz GNSS fixes (fleet_load's defaults) for
 # S seconds through real DDS into one shore, with SSE clients connected; optionally wrk against
 # GET /api/v1/boats meanwhile. Loopback only.
-#   deploy/bench_fleet.sh [BOATS] [SECONDS] [SSE_CLIENTS] [WRK_SECONDS]
+#   [SHORE_ARGS="--commit-ms 1000"] deploy/bench_fleet.sh [BOATS] [SECONDS] [SSE_CLIENTS] [WRK_SECONDS]
+# Losses are located in its output: shore_udp_receive_drops (the kernel, before DDS) and
+# shore_store_dropped (the store's bounded queue).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 bin="$root/build/bin"
@@ -15,7 +17,7 @@ domain=$((150 + $$ % 50))
 dir=$(mktemp -d)
 token=bench-token
 "$bin/shore_server" --domain "$domain" --http-port 0 --db "$dir/bench.db" --coach-token "$token" \
-  --max-streams $((sse + 8)) >"$dir/shore.log" 2>&1 &
+  --max-streams $((sse + 8)) ${SHORE_ARGS:-} >"$dir/shore.log" 2>&1 &
 shore=$!
 trap 'kill -INT $shore 2>/dev/null || true; wait $shore 2>/dev/null || true; rm -rf "$dir"' EXIT
 for _ in $(seq 100); do grep -q ready "$dir/shore.log" && break; sleep 0.1; done
