@@ -3,8 +3,11 @@
 # Atlas CSV (heel, trim, heading, position, SOG, COG per row), imports it into a fresh shore with
 # telltale_import (one session), then loads GET /sessions/1/attitude?max_points=2000 (the review's
 # chart request) with wrk, C connections (default 16) for S seconds (default 15), and prints
-# wrk's figures and the size of one answer. Needs wrk (apt-get install wrk). Loopback only.
-#   deploy/bench_chart.sh [HOURS] [CONNECTIONS] [SECONDS] [--bin-dir DIR]
+# wrk's figures and the size of one answer. With BOATS set, a live fleet of that many boats
+# (fleet_load, 25 Hz + 10 Hz fixes, one dashboard stream) sails through the whole wrk run, and its
+# boat -> SSE latency is printed after wrk's: the live view while an analyst loads charts.
+# Needs wrk (apt-get install wrk). Loopback only.
+#   [BOATS=200] deploy/bench_chart.sh [HOURS] [CONNECTIONS] [SECONDS] [--bin-dir DIR]
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 bin="$root/build/bin"
@@ -46,4 +49,18 @@ curl -sf -H 'Authorization: Bearer t' "$q" > "$dir/one.json"
 echo "session: $(curl -sf -H 'Authorization: Bearer t' "$url/api/v1/sessions/1" |
   grep -o '"samples":[0-9]*'); one answer: $(stat -c %s "$dir/one.json") bytes," \
   "$(grep -o '"points":[0-9]*' "$dir/one.json")"
+boats=${BOATS:-0}
+if [ "$boats" -gt 0 ]; then
+  # fleet_load measures from 3 s after its start (discovery); wrk starts 2 s later and ends 1 s
+  # before it.
+  "$bin/fleet_load" --domain $((150 + $$ % 50)) --shore-url "$url" --token t --shore-pid "$shore" \
+    --boats "$boats" --seconds $((seconds + 3)) --sse-clients 1 > "$dir/load.json" &
+  load=$!
+  sleep 5
+fi
 wrk -t2 -c"$conns" -d"${seconds}s" --latency -H 'Authorization: Bearer t' "$q"
+if [ "$boats" -gt 0 ]; then
+  wait $load
+  echo "live fleet meanwhile: $boats boats"
+  grep -E '"(samples_written|samples_committed_by_shore|latency_ms_p50|latency_ms_p99|shore_cpu_percent_of_one_core)"' "$dir/load.json"
+fi
