@@ -86,9 +86,13 @@ test('live: the fleet card shows the tack the stream pushes, its distance lost w
   const t0 = secondsOf(m.t_utc);
   assert.equal(seen.kind, 'tack');
   assert.ok(Math.abs(Number(seen.t0) - t0) < 0.01, `card t0 ${seen.t0} vs REST ${t0}`);
-  // Driven by the stream: the card is the shore's final event of that tack, found first.
-  const events = (await page.evaluate(() => window.__manoeuvres)).filter((e) => e.boat_id === A);
-  const fin = events.find((e) => e.final && Math.abs(secondsOf(e.t_utc) - t0) < 12);
+  // Driven by the stream: the card is the shore's final event of that tack, found first. This
+  // page's second stream gets it on its own tick, which may come a little after the card's.
+  let events = [];
+  const fin = await eventually(async () => {
+    events = (await page.evaluate(() => window.__manoeuvres)).filter((e) => e.boat_id === A);
+    return events.find((e) => e.final && Math.abs(secondsOf(e.t_utc) - t0) < 12) ?? null;
+  }, { timeoutMs: 5000, intervalMs: 100, what: `the final manoeuvre event for ${A} on the test's own stream` }).catch(() => null);
   assert.ok(fin, `a final manoeuvre event for ${A}: ${JSON.stringify(events)}`);
   assert.equal(fin.kind, seen.kind);
   assert.equal(secondsOf(fin.t_utc), Number(seen.t0), `card t0 ${seen.t0} vs event ${fin.t_utc}`);
