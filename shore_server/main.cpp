@@ -146,6 +146,9 @@ std::string default_db_path() {
 }
 
 void run(Options o, telltale::ShutdownSignal& shutdown) {
+  // The domain (flag or TELLTALE_DOMAIN) is checked before the database is touched: a bad setting
+  // is one error line, not a database folder created or a database migrated on the way to it.
+  o.dds.domain = telltale::dds::resolve_domain(o.dds.domain);
   if (o.store.path.empty()) o.store.path = default_db_path();
   TokenStore tokens;
   if (o.coach_token.empty()) {

@@ -77,8 +77,10 @@ std::string domain_env() { return "TELLTALE_DOMAIN=" + std::to_string(unique_dom
 INSTANTIATE_TEST_SUITE_P(
     Binaries, CliErrors,
     ::testing::Values(
-        Case{"shore_domain_not_a_number", "TELLTALE_DOMAIN=abc", "shore_server --http-port 0",
-             "TELLTALE_DOMAIN"},
+        // Refused before the default database is looked for (that folder cannot exist): a bad
+        // setting never creates or migrates a user's database on its way to the error.
+        Case{"shore_domain_not_a_number", "TELLTALE_DOMAIN=abc XDG_DATA_HOME=/dev/null/telltale",
+             "shore_server --http-port 0", "TELLTALE_DOMAIN"},
         Case{"shore_domain_out_of_range", "", "shore_server --domain 500 --http-port 0", "0..232"},
         Case{"shore_db_in_missing_folder", domain_env(),
              "shore_server --http-port 0 --db /nonexistent-telltale-dir/x.db", "x.db"},
