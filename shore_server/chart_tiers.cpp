@@ -96,10 +96,10 @@ void TierFold::add(const std::string& boat_id, std::uint64_t t_utc_ns, double he
     const std::uint64_t w = kTierWidths_s[i];
     const std::uint64_t bucket = t_utc_ns / (w * kSecondNs);
     auto it = last_[i];
-    if (!has_last_[i] || std::get<2>(it->first) != bucket || std::get<0>(it->first) != boat_id) {
+    if (it == open_.end() || std::get<2>(it->first) != bucket ||
+        std::get<0>(it->first) != boat_id) {
       it = open_.try_emplace(Key{boat_id, w, bucket}).first;
       last_[i] = it;
-      has_last_[i] = true;
     }
     Bucket& b = it->second;
     if (b.n++ == 0) {
@@ -136,7 +136,7 @@ void TierFold::write(sqlite3* db) {
 
 void TierFold::clear() {
   open_.clear();
-  has_last_.fill(false);
+  last_.fill(open_.end());
 }
 
 }  // namespace telltale::shore

@@ -42,6 +42,11 @@ void rebuild_tiers(sqlite3* db, const std::string& boat_id, std::uint64_t from_n
 /// merging them one by one.
 class TierFold {
  public:
+  TierFold() = default;
+  // last_ points into open_: a copy would point into the other fold's map.
+  TierFold(const TierFold&) = delete;
+  TierFold& operator=(const TierFold&) = delete;
+
   /// One inserted sample (heading NaN: none).
   void add(const std::string& boat_id, std::uint64_t t_utc_ns, double heel_deg, double pitch_deg,
            double heading_deg);
@@ -65,10 +70,10 @@ class TierFold {
   };
   using Key = std::tuple<std::string, std::uint64_t, std::uint64_t>;  // boat, width_s, bucket
   std::map<Key, Bucket> open_;
-  // The bucket each width touched last: samples come in time order per boat, so nearly every
-  // sample lands in it and skips the map search.
-  std::array<std::map<Key, Bucket>::iterator, 2> last_{};
-  std::array<bool, 2> has_last_{};
+  // The bucket each width touched last (open_.end(): none yet): samples come in time order per
+  // boat, so nearly every sample lands in it and skips the map search. A map's end() stays
+  // valid through inserts and clear().
+  std::array<std::map<Key, Bucket>::iterator, 2> last_{open_.end(), open_.end()};
 };
 
 }  // namespace telltale::shore

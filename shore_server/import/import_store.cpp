@@ -224,7 +224,8 @@ class StoreSink : public ImportSink {
   Stmt attitude_, fix_, wind_, event_;
   std::uint64_t points_ = 0;
   std::vector<Span> spans_;
-  /// About 1 MB of folded buckets (an hour of 25 Hz samples) before they are merged.
+  /// Folded buckets merged early: 4096 is ~68 minutes of data at any sample rate (3840 one-second
+  /// buckets and 240 sixteen-second ones); at ~250 B per map node, ~1 MB (an estimate).
   static constexpr std::size_t kTierFoldBuckets = 4096;
   TierFold tiers_;
 };
