@@ -53,6 +53,7 @@ std::optional<GnssFix> GnssGate::on_epoch(const sensors::GnssReading& r, double 
                                           std::uint64_t boat_utc_ns) {
   ++stats_.epochs;
   GnssFix out;
+  out.t_boat_ns = boat_utc_ns;
   out.gnss_utc_ns =
       r.utc_ns != 0 ? r.utc_ns : gnss_utc_ns(r.time_of_day_s, r.date_ddmmyy, boat_utc_ns);
   if (out.gnss_utc_ns != 0)

@@ -46,6 +46,7 @@ struct GnssFix {
   int satellites = 0;
   double hdop = 0.0;
   std::uint64_t gnss_utc_ns = 0;  ///< 0 when the receiver gave no time
+  std::uint64_t t_boat_ns = 0;    ///< the boat clock at the epoch's arrival: the record's time
 };
 
 struct GnssGateStats {
@@ -60,8 +61,9 @@ struct GnssGateStats {
 class GnssGate {
  public:
   explicit GnssGate(GnssGateParams p = {}) : p_(p) {}
-  /// One epoch received at `t_s` (monotonic seconds) when the boat clock read `boat_utc_ns`.
-  /// Returns the fix to publish, or nothing when the epoch is rejected.
+  /// One epoch received at `t_s` (monotonic seconds) when the boat clock (the node's RunClock)
+  /// read `boat_utc_ns`, which becomes the fix's time. Returns the fix to publish, or nothing
+  /// when the epoch is rejected.
   std::optional<GnssFix> on_epoch(const sensors::GnssReading& r, double t_s,
                                   std::uint64_t boat_utc_ns);
   [[nodiscard]] const GnssGateStats& stats() const { return stats_; }

@@ -38,7 +38,8 @@ std::uint16_t parse_port(const std::string& s) {
 
 }  // namespace
 
-GnssInput::GnssInput(const std::string& spec, GnssGateParams params) : gate_(params) {
+GnssInput::GnssInput(const std::string& spec, RunClock clock, GnssGateParams params)
+    : clock_(clock), gate_(params) {
   if (spec == "gpsd" || spec.rfind("gpsd:", 0) == 0) {
     std::string host = "localhost";
     std::string port = DEFAULT_GPSD_PORT;
@@ -97,7 +98,7 @@ GnssInput::~GnssInput() {
 void GnssInput::on_epoch(const sensors::GnssReading& r) {
   const auto fix = [&] {
     std::lock_guard lock(mutex_);
-    return gate_.on_epoch(r, mono_s(), utc_now_ns());
+    return gate_.on_epoch(r, mono_s(), clock_.now_ns());
   }();
   if (!fix) return;
   std::lock_guard lock(mutex_);
@@ -119,7 +120,7 @@ void GnssInput::run_nmea() {
       if (w.status == sensors::NmeaStatus::kOk) {
         std::lock_guard lock(mutex_);
         if (wind_.size() >= kMaxQueued) wind_.pop_front();
-        wind_.push_back({utc_now_ns(), w.reading});
+        wind_.push_back({clock_.now_ns(), w.reading});
       }
       return w.status;
     }

@@ -19,6 +19,7 @@
 
 #include "gnss_gate.hpp"
 #include "nmea.hpp"
+#include "run_clock.hpp"
 #include "telltale/fusion/wind.hpp"
 
 namespace telltale::boat {
@@ -42,8 +43,8 @@ class GnssInput {
  public:
   /// Parses the spec and opens the source (throws std::invalid_argument for a bad spec,
   /// std::system_error when a device or port cannot be opened; a gpsd not running yet is not an
-  /// error: the reader keeps trying). `utc_now_ns` is the boat clock.
-  GnssInput(const std::string& spec, GnssGateParams params = {});
+  /// error: the reader keeps trying). `clock` stamps each fix and wind reading at its arrival.
+  GnssInput(const std::string& spec, RunClock clock, GnssGateParams params = {});
   ~GnssInput();
   GnssInput(const GnssInput&) = delete;
   GnssInput& operator=(const GnssInput&) = delete;
@@ -63,6 +64,7 @@ class GnssInput {
   void run_gpsd(const std::string& host, const std::string& port);
 
   std::string describe_;
+  RunClock clock_;
   std::unique_ptr<sensors::NmeaStreamReader> nmea_;
   int port_ = 0;
   std::atomic<bool> stop_{false};

@@ -24,8 +24,8 @@
 #include <string>
 
 #include "backfill.hpp"
-#include "boat_wire.hpp"
 #include "boat_dds.hpp"
+#include "boat_wire.hpp"
 #include "console.hpp"
 #include "course_sim.hpp"
 #include "csv.hpp"
@@ -33,6 +33,7 @@
 #include "gnss_input.hpp"
 #include "heading_input.hpp"
 #include "imu_source.hpp"
+#include "run_clock.hpp"
 #include "session_log.hpp"
 #include "shutdown.hpp"
 #include "telltale/fusion/alarm_engine.hpp"
@@ -182,9 +183,11 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
     race = std::make_shared<telltale::fusion::sim::RaceCourse>(seed);
   auto source = telltale::boat::make_imu_source(
       o.source, seed, o.imu_rate_hz, o.replay, [&] { return shutdown.stop_requested(); }, race);
+  // Every record of this run is stamped on one clock (run_clock.hpp says why).
+  const telltale::boat::RunClock run_clock;
   // GNSS: an explicit --gnss receiver, else the simulated race course with --source sim.
   std::unique_ptr<telltale::boat::GnssInput> gnss;
-  if (!o.gnss.empty()) gnss = std::make_unique<telltale::boat::GnssInput>(o.gnss);
+  if (!o.gnss.empty()) gnss = std::make_unique<telltale::boat::GnssInput>(o.gnss, run_clock);
   std::unique_ptr<telltale::boat::CourseSim> course;
   telltale::boat::GnssGate course_gate;
   if (!gnss && o.source.rfind("sim", 0) == 0)
@@ -226,7 +229,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   };
   callbacks.on_rules = [&](std::vector<telltale::fusion::AlarmRule> rules) {
     shore_rules = true;
-    alarms.set_rules(rules.empty() ? default_rules(o) : std::move(rules), telltale::utc_now_ns());
+    alarms.set_rules(rules.empty() ? default_rules(o) : std::move(rules), run_clock.now_ns());
   };
   callbacks.on_event = [&](const telltale::msg::AlarmEvent& e) {
     silenced = e.phase() == telltale::msg::ALARM_PHASE_SILENCED;
@@ -304,7 +307,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   std::fflush(stdout);
 
   const auto start = Clock::now();
-  const unsigned long long start_utc_ns = telltale::utc_now_ns();
+  const unsigned long long start_utc_ns = run_clock.at(start);
   const double publish_period_s = 1.0 / o.rate_hz;
   double first_t = std::numeric_limits<double>::quiet_NaN();
   double next_publish_s = 0.0;
@@ -328,10 +331,10 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   double next_course_s = 0.0;
   // Every fix is logged before it is published, as the attitude is: what the link loses, the
   // fix backfill resends from the log.
-  const auto publish_fix = [&](const telltale::boat::GnssFix& f, unsigned long long t_utc_ns) {
+  const auto publish_fix = [&](const telltale::boat::GnssFix& f) {
     telltale::boat::FixRecord r;
     r.seq = ++fix_seq;
-    r.t_utc_ns = t_utc_ns;
+    r.t_utc_ns = f.t_boat_ns;
     r.gnss_utc_ns = f.gnss_utc_ns;
     r.lat_deg = f.lat_deg;
     r.lon_deg = f.lon_deg;
@@ -389,7 +392,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
     if (gnss) {
       gnss->take(fixes);
       for (const auto& f : fixes) {
-        publish_fix(f, telltale::utc_now_ns());
+        publish_fix(f);
         const bool no_fix = f.fix == telltale::sensors::GnssFixKind::kNone;
         last_sog_m_s = no_fix ? std::numeric_limits<double>::quiet_NaN() : f.sog_m_s;
         last_cog_deg = f.cog_deg;
@@ -418,7 +421,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       next_course_s = t + 0.1;
       const unsigned long long t_ns = start_utc_ns + static_cast<unsigned long long>(t * 1e9);
       if (auto f = course_gate.on_epoch(course->at(t, t_ns), t, t_ns)) {
-        publish_fix(*f, t_ns);
+        publish_fix(*f);
         if (course_is_imu_boat) ground_speed.on_fix(t, f->sog_m_s, f->cog_deg);
       }
     }
@@ -547,7 +550,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
           text += buf;
         }
       }
-      status.t_utc_ns(telltale::utc_now_ns());
+      status.t_utc_ns(run_clock.now_ns());
       status.uptime_s(std::chrono::duration<double>(now - start).count());
       status.samples_published(seq);
       status.sensor_health(h);

@@ -12,6 +12,7 @@
 #include "dds_cli.hpp"
 #include "dds_participant.hpp"
 #include "dds_security.hpp"
+#include "run_clock.hpp"
 #include "shutdown.hpp"
 #include "telltale/fusion/handheld_pdr.hpp"
 #include "telltale/fusion/pdr.hpp"
@@ -202,8 +203,10 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
               participant.domain(), o.source.c_str());
   std::fflush(stdout);
 
+  // Every record of this run is stamped on one clock (run_clock.hpp says why).
+  const telltale::boat::RunClock run_clock;
   const auto start = Clock::now();
-  const unsigned long long start_utc = telltale::utc_now_ns();
+  const unsigned long long start_utc = run_clock.at(start);
   double first_t = std::numeric_limits<double>::quiet_NaN();
   double next_publish = 0.0;
   auto next_status = start;
@@ -247,7 +250,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       const unsigned bad =
           handheld ? rejected_non_finite
                    : pdr->diagnostics().rejected_non_finite + pdr->diagnostics().rejected_time;
-      status.t_utc_ns(telltale::utc_now_ns());
+      status.t_utc_ns(run_clock.now_ns());
       status.uptime_s(std::chrono::duration<double>(Clock::now() - start).count());
       status.samples_published(seq);
       status.sensor_health(bad ? telltale::msg::SENSOR_NON_FINITE : telltale::msg::SENSOR_OK);

@@ -17,6 +17,7 @@
 #include <sstream>
 #include <thread>
 
+#include "../unit/nmea_sentence.hpp"
 #include "shore_fixture.hpp"
 
 namespace telltale::testing {
@@ -29,13 +30,7 @@ constexpr double kLat0 = 54.3440, kLon0 = 10.1900;  // Kiel outer fjord
 constexpr double kNorthSpeed = 3.0;                 // m/s
 constexpr double kMPerDegLat = 111195.0;
 
-std::string nmea(const std::string& body) {
-  unsigned char cs = 0;
-  for (char c : body) cs ^= static_cast<unsigned char>(c);
-  char tail[8];
-  std::snprintf(tail, sizeof tail, "*%02X\r\n", cs);
-  return "$" + body + tail;
-}
+using telltale::test::nmea;
 
 std::string ddmm(double deg, bool lat) {
   const double a = std::abs(deg);

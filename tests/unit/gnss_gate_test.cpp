@@ -108,3 +108,11 @@ TEST(GnssGate, GnssTimeGivesTheBoatClockOffset) {
   EXPECT_EQ(gnss_utc_ns(86399.5, -1, midnight + 200000000ull), midnight - 500000000ull);
   EXPECT_EQ(gnss_utc_ns(kNaN, -1, kNow), 0u);
 }
+
+TEST(GnssGate, TheFixIsTimedByTheBoatClockItArrivedAtWithOrWithoutAPosition) {
+  GnssGate gate;
+  EXPECT_EQ(gate.on_epoch(at(0), 0.0, kNow)->t_boat_ns, kNow);
+  GnssReading none = at(1.0);
+  none.fix = GnssFixKind::kNone;
+  EXPECT_EQ(gate.on_epoch(none, 0.1, kNow + 100000000ull)->t_boat_ns, kNow + 100000000ull);
+}
