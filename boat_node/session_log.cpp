@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <concepts>
 #include <cstring>
 #include <map>
 #include <stdexcept>
@@ -157,73 +158,71 @@ bool intact(const std::filesystem::path& p, std::uint64_t first_seq, std::uint64
 
 }  // namespace
 
-void AttitudeCodec::encode(const Record& r, unsigned char* body) {
-  unsigned char* p = body;
-  put(p, r.seq);
-  put(p, r.t_utc_ns);
-  put(p, r.heel_deg);
-  put(p, r.pitch_deg);
-  put(p, r.heading_deg);
-  put(p, r.heel_rate_deg_s);
-  put(p, r.pitch_rate_deg_s);
-  put(p, r.yaw_rate_deg_s);
-  put(p, r.accel_weight);
-  put(p, r.quality);
-  for (auto l : r.leds) put(p, l);
-  put(p, r.led_count);
-  put(p, r.level);
+namespace {
+
+// Each kind's body is its members in one order, written once here: encode and decode both walk
+// it, so a member added to a record is one line (and a frame that grows past 96 bytes is a
+// compile error, below).
+template <class R, class F>
+constexpr void members(R& r, F&& f) requires std::same_as<std::remove_const_t<R>, LogRecord> {
+  f(r.seq);
+  f(r.t_utc_ns);
+  f(r.heel_deg);
+  f(r.pitch_deg);
+  f(r.heading_deg);
+  f(r.heel_rate_deg_s);
+  f(r.pitch_rate_deg_s);
+  f(r.yaw_rate_deg_s);
+  f(r.accel_weight);
+  f(r.quality);
+  for (auto& l : r.leds) f(l);
+  f(r.led_count);
+  f(r.level);
 }
 
-LogRecord AttitudeCodec::decode(const unsigned char* body) {
-  LogRecord r;
-  const unsigned char* p = body;
-  r.seq = get<std::uint64_t>(p);
-  r.t_utc_ns = get<std::uint64_t>(p);
-  r.heel_deg = get<double>(p);
-  r.pitch_deg = get<double>(p);
-  r.heading_deg = get<double>(p);
-  r.heel_rate_deg_s = get<double>(p);
-  r.pitch_rate_deg_s = get<double>(p);
-  r.yaw_rate_deg_s = get<double>(p);
-  r.accel_weight = get<float>(p);
-  r.quality = get<float>(p);
-  for (auto& l : r.leds) l = get<std::uint8_t>(p);
-  r.led_count = get<std::uint8_t>(p);
-  r.level = get<std::uint8_t>(p);
+template <class R, class F>
+constexpr void members(R& r, F&& f) requires std::same_as<std::remove_const_t<R>, FixRecord> {
+  f(r.seq);
+  f(r.t_utc_ns);
+  f(r.gnss_utc_ns);
+  f(r.lat_deg);
+  f(r.lon_deg);
+  f(r.sog_m_s);
+  f(r.cog_deg);
+  f(r.fix);
+  f(r.satellites);
+  f(r.hdop);
+}
+
+template <class Record>
+constexpr std::size_t body_bytes() {
+  std::size_t n = 0;
+  Record r{};
+  members(r, [&](const auto& v) { n += sizeof v; });
+  return n;
+}
+static_assert(body_bytes<LogRecord>() <= kLogRecordBytes - kLogHeaderBytes,
+              "a sample fits a frame");
+static_assert(body_bytes<FixRecord>() <= kLogRecordBytes - kLogHeaderBytes, "a fix fits a frame");
+
+template <class Record>
+void encode_members(const Record& r, unsigned char* body) {
+  members(r, [&](const auto& v) { put(body, v); });
+}
+
+template <class Record>
+Record decode_members(const unsigned char* body) {
+  Record r;
+  members(r, [&](auto& v) { v = get<std::remove_reference_t<decltype(v)>>(body); });
   return r;
 }
 
-static_assert(8 * 7 + 1 + 1 + 4 <= kLogRecordBytes - kLogHeaderBytes, "a fix fits a frame");
+}  // namespace
 
-void FixCodec::encode(const Record& r, unsigned char* body) {
-  unsigned char* p = body;
-  put(p, r.seq);
-  put(p, r.t_utc_ns);
-  put(p, r.gnss_utc_ns);
-  put(p, r.lat_deg);
-  put(p, r.lon_deg);
-  put(p, r.sog_m_s);
-  put(p, r.cog_deg);
-  put(p, r.fix);
-  put(p, r.satellites);
-  put(p, r.hdop);
-}
-
-FixRecord FixCodec::decode(const unsigned char* body) {
-  FixRecord r;
-  const unsigned char* p = body;
-  r.seq = get<std::uint64_t>(p);
-  r.t_utc_ns = get<std::uint64_t>(p);
-  r.gnss_utc_ns = get<std::uint64_t>(p);
-  r.lat_deg = get<double>(p);
-  r.lon_deg = get<double>(p);
-  r.sog_m_s = get<double>(p);
-  r.cog_deg = get<double>(p);
-  r.fix = get<std::uint8_t>(p);
-  r.satellites = get<std::uint8_t>(p);
-  r.hdop = get<float>(p);
-  return r;
-}
+void AttitudeCodec::encode(const Record& r, unsigned char* body) { encode_members(r, body); }
+LogRecord AttitudeCodec::decode(const unsigned char* body) { return decode_members<Record>(body); }
+void FixCodec::encode(const Record& r, unsigned char* body) { encode_members(r, body); }
+FixRecord FixCodec::decode(const unsigned char* body) { return decode_members<Record>(body); }
 
 void encode_record(const LogRecord& r, unsigned char* out) { encode_frame<AttitudeCodec>(r, out); }
 void encode_record(const FixRecord& r, unsigned char* out) { encode_frame<FixCodec>(r, out); }
