@@ -334,6 +334,33 @@ TEST_F(SessionLogRuns, OneDiskBudgetOverBothKinds) {
   EXPECT_EQ(SessionLogReader(dir_, "bd", 0x2).read(31, 35).size(), 5u);
 }
 
+// Given a budget too small for both kinds' open files, each log still keeps the file the other is
+// writing: a deleted file takes what is written to it afterwards with it, without an error (the
+// writer's descriptor stays valid), so that loss would be silent.
+TEST_F(SessionLogRuns, NeitherKindDeletesTheFileTheOtherIsWriting) {
+  constexpr std::uint64_t kPerFile = 4;
+  constexpr std::uint64_t kBudget = kPerFile * kLogRecordBytes;  // one file
+  FixLog fixes({dir_, "nd", 0x3, kPerFile, kBudget});
+  for (std::uint64_t seq = 1; seq <= 3; ++seq) ASSERT_TRUE(fixes.append(fix_record(seq)));
+  ASSERT_TRUE(fixes.flush());
+  // The attitude log opens its first file: over budget with the fix file's 3 records.
+  SessionLog att({dir_, "nd", 0x3, kPerFile, kBudget});
+  for (std::uint64_t seq = 1; seq <= 3; ++seq) {
+    LogRecord r;
+    r.seq = seq;
+    r.t_utc_ns = seq * 40'000'000;
+    ASSERT_TRUE(att.append(r));
+  }
+  ASSERT_TRUE(att.flush());
+  // And the fix log opens its second file: over budget with both.
+  for (std::uint64_t seq = 4; seq <= 6; ++seq) ASSERT_TRUE(fixes.append(fix_record(seq)));
+  ASSERT_TRUE(fixes.flush());
+  EXPECT_EQ(SessionLogReader(dir_, "nd", 0x3).read(1, 3).size(), 3u);
+  EXPECT_EQ(FixLogReader(dir_, "nd", 0x3).read(5, 6).size(), 2u);
+  // What the budget could take went: the fix log's first file, no longer written.
+  EXPECT_EQ(FixLogReader(dir_, "nd", 0x3).read(1, 4).size(), 0u);
+}
+
 // Given a run that published no fix (no receiver, or no data from it), the stop's drain of the
 // fixes returns at once: the shore sends no fix receipt for a run it has no fix of, and waiting
 // for one held every such boat's stop for 3 s.
