@@ -7,11 +7,13 @@ secure=()
 shore_secure=()
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 bin="$root/build/bin"
+source "$root/deploy/lib/stop.sh"
 if [[ "${1:-}" == --secure ]]; then shift; secure=(1); fi
 seconds=${1:-60}
 domain=$((150 + $$ % 50))
 dir=$(mktemp -d)
-trap 'kill -INT $shore 2>/dev/null || true; wait 2>/dev/null || true; rm -rf "$dir"' EXIT
+shore= boat=
+trap 'stop_all "$boat" "$shore"; rm -rf "$dir"' EXIT
 if [[ ${#secure[@]} -gt 0 ]]; then
   "$root/deploy/security/make_fleet_pki.sh" "$dir/pki" bench >/dev/null
   secure=(--security-dir "$dir/pki/bench")
@@ -32,7 +34,7 @@ read -r u1 s1 < <(awk '{print $14, $15}' /proc/$boat/stat)
 rss_kb=$(awk '/VmRSS/ {print $2}' /proc/$boat/status)
 hwm_kb=$(awk '/VmHWM/ {print $2}' /proc/$boat/status)
 threads=$(awk '/Threads/ {print $2}' /proc/$boat/status)
-kill -INT $boat; wait $boat || true
+stop_all "$boat"
 cpu=$(awk -v d=$((u1 + s1 - u0 - s0)) -v t="$ticks" -v s="$seconds" 'BEGIN {printf "%.2f", 100 * d / t / s}')
 echo "boat_node over ${seconds}s: CPU ${cpu}% of one core, RSS $((rss_kb / 1024)) MB (peak $((hwm_kb / 1024)) MB), $threads threads"
 tail -n 1 "$dir/boat"

@@ -11,6 +11,7 @@
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 bin="$root/build/bin"
+source "$root/deploy/lib/stop.sh"
 args=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -21,8 +22,8 @@ done
 hours=${args[0]:-4}; conns=${args[1]:-16}; seconds=${args[2]:-15}
 command -v wrk >/dev/null || { echo "bench_chart: needs wrk (apt-get install wrk)" >&2; exit 1; }
 dir=$(mktemp -d)
-shore=
-trap '[ -n "$shore" ] && kill -INT $shore 2>/dev/null; wait 2>/dev/null || true; rm -rf "$dir"' EXIT
+shore= load=
+trap 'stop_all "$load" "$shore"; rm -rf "$dir"' EXIT
 # A boat beating and reaching: heel swinging with the waves (period 4 s) and flipping side every
 # 5 minutes (a tack), so every chart bucket has a real lowest and highest sample.
 perl -e '

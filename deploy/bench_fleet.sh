@@ -8,6 +8,7 @@
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 bin="$root/build/bin"
+source "$root/deploy/lib/stop.sh"
 boats=${1:-200}; seconds=${2:-300}; sse=${3:-1}; wrk_s=${4:-0}
 if [ "$wrk_s" -gt 0 ] && ! command -v wrk >/dev/null; then
   echo "bench_fleet: the wrk part needs wrk (apt-get install wrk)" >&2
@@ -19,7 +20,7 @@ token=bench-token
 "$bin/shore_server" --domain "$domain" --http-port 0 --db "$dir/bench.db" --coach-token "$token" \
   --max-streams $((sse + 8)) ${SHORE_ARGS:-} >"$dir/shore.log" 2>&1 &
 shore=$!
-trap 'kill -INT $shore 2>/dev/null || true; wait $shore 2>/dev/null || true; rm -rf "$dir"' EXIT
+trap 'stop_all "${load:-}" "$shore"; rm -rf "$dir"' EXIT
 for _ in $(seq 100); do grep -q ready "$dir/shore.log" && break; sleep 0.1; done
 url=$(grep -o 'http://[^ /]*' "$dir/shore.log")
 "$bin/fleet_load" --domain "$domain" --shore-url "$url" --token "$token" --shore-pid "$shore" \

@@ -7,6 +7,7 @@
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 bin="$root/build/bin"
+source "$root/deploy/lib/stop.sh"
 mb=100
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -16,7 +17,7 @@ while [ $# -gt 0 ]; do
 done
 dir=$(mktemp -d)
 shore=
-trap '[ -n "$shore" ] && kill -INT $shore 2>/dev/null; wait 2>/dev/null || true; rm -rf "$dir"' EXIT
+trap 'stop_all "$shore"; rm -rf "$dir"' EXIT
 perl -e '
   use POSIX qw(strftime);
   my ($limit, $t0) = ($ARGV[0] * 1048576, 1770537600);

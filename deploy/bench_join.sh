@@ -7,30 +7,12 @@
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 bin="${TELLTALE_BIN_DIR:-$root/build/bin}"
+source "$root/deploy/lib/stop.sh"
 joins=${1:-20}; running=${2:-0}
 domain=$((100 + $$ % 50))
 dir=$(mktemp -d)
 token=bench-token
 pids=()
-# Every process is asked to stop (SIGINT) and given 10 s; one still running then is killed and
-# named, so a node stuck in its DDS shutdown cannot hang the benchmark.
-stop_all() {
-  local p
-  for p in "$@"; do kill -INT "$p" 2>/dev/null || true; done
-  for _ in $(seq 100); do
-    local alive=0
-    for p in "$@"; do kill -0 "$p" 2>/dev/null && alive=1; done
-    [ "$alive" = 0 ] && break
-    sleep 0.1
-  done
-  for p in "$@"; do
-    if kill -0 "$p" 2>/dev/null; then
-      echo "bench_join: process $p did not stop within 10 s of SIGINT; killed" >&2
-      kill -KILL "$p" 2>/dev/null || true
-    fi
-    wait "$p" 2>/dev/null || true
-  done
-}
 cleanup() {
   stop_all "${pids[@]}"
   rm -rf "$dir"
