@@ -92,11 +92,11 @@ TEST(Regimes, StartedUnderWayBeatsTheBaselines) {
 }
 
 // Given the same start under way, then the worst error after 5 s is within 2 deg and after 15 s
-// within 1 deg, the targets (measured: 1.32 / 1.80 and 0.85 / 0.90, 3 seeds,
+// within 1 deg, the targets (measured: 1.32 / 1.78 and 0.85 / 0.90, 3 seeds,
 // 25 / 100 Hz; the start's fit begins with the receiver's first fix, 0.1 s after the first
 // sample). Seen failing against the filter without the sensor's offset (the tack's swing of the
 // bow about the centre read as heel): 2.66 / 2.69 and 1.67 / 1.78; against the filter of commit
-// 752b1fc: 6.07 / 6.19 and 4.46 / 4.26. Over 30 seeds the worst is 1.64 / 1.87 after 5 s and
+// 752b1fc: 6.07 / 6.19 and 4.46 / 4.26. Over 30 seeds the worst is 1.63 / 1.86 after 5 s and
 // 1.11 / 1.09 after 15 s (one seed: the bias about the vertical left by the start, turned
 // horizontal by its first tack; docs/attitude.md).
 TEST(Regimes, StartedUnderWayWorstErrorWithinBounds) {

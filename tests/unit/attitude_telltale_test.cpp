@@ -237,11 +237,16 @@ TEST(GroundSpeedHold, HoldsRatesAndForgets) {
 }
 
 // An unknown speed leaves the filter exactly as without GNSS (the change-indication file and
-// every recording rely on it), and a speed that is not a number is unknown.
+// every recording rely on it), and a speed that is not a number is unknown. The sensor's offset
+// from the centre is the speed model's other half: without the speed it changes nothing either
+// (seen failing with the offset applied whatever the speed: the first update differs).
 TEST(TelltaleAttitudeFilter, UnknownSpeedChangesNothing) {
   auto sc = sim::make_scenario("dinghy", 3, 25.0, 120.0);
   TelltaleAttitudeFilter plain;
   TelltaleAttitudeFilter told;
+  TelltaleAttitudeParams on_the_bow;
+  on_the_bow.lever_arm_m = {1.5, 0.0, 0.25};
+  TelltaleAttitudeFilter offset(on_the_bow);
   ImuSample s;
   sim::AttitudeTruth t;
   int k = 0;
@@ -252,10 +257,14 @@ TEST(TelltaleAttitudeFilter, UnknownSpeedChangesNothing) {
     } else {
       told.set_speed(k % 2 ? -1.0 : std::numeric_limits<double>::infinity(), nan, nan);
     }
+    offset.set_speed(nan, 1.0, 0.1);
     plain.update(s);
     told.update(s);
+    offset.update(s);
     ASSERT_EQ(plain.output().heel_rad, told.output().heel_rad);
     ASSERT_EQ(plain.output().pitch_rad, told.output().pitch_rad);
+    ASSERT_EQ(plain.output().heel_rad, offset.output().heel_rad) << t.t_s;
+    ASSERT_EQ(plain.output().pitch_rad, offset.output().pitch_rad) << t.t_s;
   }
 }
 

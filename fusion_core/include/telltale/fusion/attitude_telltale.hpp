@@ -123,7 +123,9 @@ struct TelltaleAttitudeParams {
   /// moves relative to it at omega x r: the bow of a dinghy (1.5 m ahead) swings sideways at
   /// 1.2 m/s through a tack's 0.8 rad/s turn, and pitches and yaws with every wave. That motion
   /// is bounded, but over a tack it is one direction in I for the seconds the low-pass averages
-  /// (update), and what is left is heel.
+  /// (update), and what is left is heel. Used with the speed (set_speed) only: it makes the
+  /// sensor's specific force the centre's, which the speed's model describes; with the speed
+  /// unknown the filter is exactly as without it.
   Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();
 };
 
