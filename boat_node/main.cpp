@@ -65,6 +65,8 @@ struct Options {
   double log_max_mb = 1024;
   std::string axis_remap = "x=x,y=y,z=z";
   std::string mount_file;
+  /// The sensor's position from the boat's centre, boat axes (m): the filter's lever_arm_m.
+  std::vector<double> sensor_offset_m{0.0, 0.0, 0.0};
   double calibrate_s = 0;
   bool console = false;
   std::string warn_command;
@@ -293,6 +295,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   telltale::fusion::TelltaleAttitudeParams filter_params;
   filter_params.gyro_range_rad_s = o.gyro_range_dps * M_PI / 180.0;
   filter_params.acc_range_m_s2 = o.acc_range_g * telltale::fusion::kStandardGravity_m_s2;
+  filter_params.lever_arm_m = {o.sensor_offset_m[0], o.sensor_offset_m[1], o.sensor_offset_m[2]};
   telltale::fusion::TelltaleAttitudeFilter filter(filter_params);
   const telltale::fusion::LedPanelParams led_params{o.led_step_deg,
                                                     static_cast<std::uint8_t>(o.leds_per_bar)};
@@ -661,6 +664,15 @@ int main(int argc, char** argv) {
       ->group(mounting);
   app.add_option("--mount-file", o.mount_file,
                  "heel/pitch zero offsets (read, and written by --calibrate-s)")
+      ->group(mounting);
+  app.add_option("--sensor-offset", o.sensor_offset_m,
+                 "where the IMU sits from the boat's centre (pivot, GNSS reference), boat axes in "
+                 "m: FORWARD,PORT,UP, e.g. 1.5,0,0.25 on a dinghy's bow (the sim's boats). Its "
+                 "swing through a tack is otherwise read as heel")
+      ->delimiter(',')
+      ->expected(3)
+      ->check(CLI::Range(-50.0, 50.0))
+      ->capture_default_str()
       ->group(mounting);
   app.add_option("--calibrate-s", o.calibrate_s,
                  "with the boat level at the dock: average this long and store the offsets")

@@ -3,10 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "no_heap_guard.hpp"
 #include "telltale/fusion/attitude.hpp"
+#include "telltale/fusion/attitude_telltale.hpp"
 
 namespace telltale::fusion {
 namespace {
@@ -25,8 +29,16 @@ TEST(AttitudeNoHeap, UpdateAllocatesNothing) {
     if (k == 1100) s.gyro_body_rad_s = {5.0, 5.0, 5.0};
     samples.push_back(s);
   }
-  for (const auto& name : attitude_filter_names()) {
-    auto filter = make_attitude_filter(name);
+  std::vector<std::pair<std::string, std::unique_ptr<AttitudeFilter>>> filters;
+  for (const auto& name : attitude_filter_names())
+    filters.emplace_back(name, make_attitude_filter(name));
+  // The production filter as a boat's node runs it, with its sensor off the centre (the lever
+  // arm's path in the update).
+  TelltaleAttitudeParams on_the_bow;
+  on_the_bow.lever_arm_m = {1.5, 0.0, 0.25};
+  filters.emplace_back("telltale, sensor offset",
+                       std::make_unique<TelltaleAttitudeFilter>(on_the_bow));
+  for (auto& [name, filter] : filters) {
     double sink = 0.0;
     const std::size_t n = telltale::test::allocations_in([&] {
       for (std::size_t k = 0; k < samples.size(); ++k) {

@@ -32,7 +32,9 @@
 ///     turning at w about the vertical at speed v accelerates at w v toward the inside of the
 ///     turn, and speeding up at dv/dt along its heading. A tack's few seconds of that are one
 ///     direction in I for longer than the low-pass can average out (it would read as heel);
-///     known, it is taken off the specific force before the low-pass;
+///     known, it is taken off the specific force before the low-pass; and a sensor away from the
+///     boat's centre (Params::lever_arm_m, the installation's offset) swings about it at
+///     omega x r, which is taken off too (d(omega)/dt x r + omega x (omega x r));
 ///   - non-uniform time steps, dropped samples, saturated samples, NaN/Inf.
 ///
 /// Call order: update() once per sample, time strictly increasing; read output() afterwards.
@@ -114,6 +116,17 @@ struct TelltaleAttitudeParams {
   /// within it as one measurement (their variance times this over dt), so that 100 Hz is not
   /// believed four times better than 25 Hz.
   double wave_corr_s = 0.3;
+  /// Where the sensor is mounted (m, body frame: x forward, y to port, z up) from the point the
+  /// hull turns about and whose velocity set_speed gives (the boat's centre; its GNSS antenna
+  /// when that is there). An installation figure, like sensor_delay_s: measured on the boat, not
+  /// tuned; zero (the default) leaves the filter exactly as without it. A sensor off the centre
+  /// moves relative to it at omega x r: the bow of a dinghy (1.5 m ahead) swings sideways at
+  /// 1.2 m/s through a tack's 0.8 rad/s turn, and pitches and yaws with every wave. That motion
+  /// is bounded, but over a tack it is one direction in I for the seconds the low-pass averages
+  /// (update), and what is left is heel. Used with the speed (set_speed) only: it makes the
+  /// sensor's specific force the centre's, which the speed's model describes; with the speed
+  /// unknown the filter is exactly as without it.
+  Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();
 };
 
 class TelltaleAttitudeFilter final : public AttitudeFilter {
@@ -167,6 +180,9 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
     double course_gyro_rad = 0.0;
     double course_turn_rad = 0.0;
     Eigen::Vector3d course_up_s = Eigen::Vector3d::Zero();
+    /// The raw gyro of the last update, for the lever arm's angular acceleration (update); kept
+    /// only when Params::lever_arm_m is not zero.
+    Eigen::Vector3d lever_gyro_prev_rad_s = Eigen::Vector3d::Zero();
   };
   /// The gate's counts (gaps: not integrated, the low-pass restarted; accelerometer saturated:
   /// not used for the bias or rest) and the samples spent learning the bias at rest.
@@ -187,9 +203,11 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
   /// under way knows it only to bias_sigma_init (5.8 deg/s: 0.25 m/s^2 of false turn at
   /// 2.5 m/s), and there the course rate is better; once a rest has measured the bias, the gyro
   /// (no latency, no noise) is. In a current c the turn term of a speed over ground is off by
-  /// w x c (0.5 m/s of current against 2.5 m/s of boat speed: a fifth). The lever arm from the
-  /// boat's centre to the sensor is not modelled (its centripetal part points along the arm and
-  /// a turn starting and ending cancels its tangential part).
+  /// w x c (0.5 m/s of current against 2.5 m/s of boat speed: a fifth). The model is the
+  /// centre's: a sensor away from it (on the bow) swings about it, which Params::lever_arm_m
+  /// takes off when the installation gives it (the tangential part of a tack's turn does not
+  /// cancel within the low-pass: 1.2 m/s of sideways swing on a dinghy's bow, 1.3-1.6 deg of
+  /// heel, docs/attitude.md).
   void set_speed(double speed_m_s, double speed_rate_m_s2, double cog_rate_rad_s) override;
   /// Computed on demand from the state (update() does not pay for the two atan2).
   [[nodiscard]] AttitudeOutput output() const override;
@@ -214,8 +232,15 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
   /// The bias about the vertical from the GNSS course (every tau_acc_s while the course is
   /// known). Called only while the course is known or a window is open; not inlined (the same).
   [[gnu::noinline]] void course_update(const Eigen::Vector3d& gyro_raw, bool usable, double dt);
+  /// The specific force of the sensor's motion about the centre (Params::lever_arm_m), from the
+  /// raw gyro (its change since the last update) and the bias-corrected one. Only with an offset
+  /// configured; not inlined (inlined, the untaken branch alone cost +48 instructions per update
+  /// through the compiler's inlining of the steady path, callgrind).
+  [[gnu::noinline]] Eigen::Vector3d lever_arm_force(const Eigen::Vector3d& gyro_raw,
+                                                    const Eigen::Vector3d& gyro, double dt) const;
   Params params_;
   ImuGateParams gate_;  ///< the sensor's ranges and the longest gap, from params_
+  bool lever_ = false;  ///< params_.lever_arm_m is not zero
   State state_;
   Diagnostics diag_;
 };

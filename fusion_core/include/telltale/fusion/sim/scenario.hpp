@@ -100,6 +100,10 @@ class ImuScenario {
   [[nodiscard]] double rate_hz() const { return rate_hz_; }
   /// Start-up rest of the scenario: score accuracy after it (filters are initialising).
   [[nodiscard]] double warmup_s() const { return warmup_s_; }
+  /// Where the sensor is from the trajectory's origin (m, body frame), the point whose velocity
+  /// the GNSS fixes give: the installation's offset a boat node is configured with.
+  [[nodiscard]] const Eigen::Vector3d& lever_arm() const { return lever_arm_; }
+  [[nodiscard]] bool has_gnss() const { return has_gnss_; }
 
  private:
   std::unique_ptr<Trajectory> trajectory_;
