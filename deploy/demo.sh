@@ -40,9 +40,11 @@ pids+=($!)
 for _ in $(seq 100); do grep -qs "ready" "$log/shore" && break; sleep 0.1; done
 grep -q "ready" "$log/shore" || { cat "$log/shore"; exit 1; }
 for boat in ILCA-1 ILCA-2 ILCA-3 ILCA-4; do
+  # The simulated dinghy carries its sensor on the bow, 1.5 m ahead of and 0.25 m above its
+  # centre: installed as a real one would be (--sensor-offset, docs/attitude.md).
   # shellcheck disable=SC2046
   "$bin/boat_node" --boat-id "$boat" --group ILCA7 --log-dir "$root/build/demo_boat_log" \
-    $(sec "$boat") >"$log/$boat" 2>&1 &
+    --sensor-offset 1.5,0,0.25 $(sec "$boat") >"$log/$boat" 2>&1 &
   pids+=($!)
 done
 # shellcheck disable=SC2046
