@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fstream>
@@ -671,6 +672,16 @@ int main(int argc, char** argv) {
                  "swing through a tack is otherwise read as heel")
       ->delimiter(',')
       ->expected(3)
+      // Range alone lets "nan" through (every comparison with NaN is false).
+      ->check(
+          [](const std::string& v) {
+            char* end = nullptr;
+            const double d = std::strtod(v.c_str(), &end);
+            return end != v.c_str() && *end == '\0' && std::isfinite(d)
+                       ? std::string()
+                       : "'" + v + "' is not a finite number of metres";
+          },
+          "FINITE")
       ->check(CLI::Range(-50.0, 50.0))
       ->capture_default_str()
       ->group(mounting);

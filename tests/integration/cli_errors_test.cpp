@@ -94,6 +94,8 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"boat_domain_not_a_number", "TELLTALE_DOMAIN=7x", "boat_node --boat-id b1",
              "TELLTALE_DOMAIN"},
         Case{"boat_unknown_source", domain_env(), "boat_node --boat-id b1 --source bogus", "bogus"},
+        Case{"boat_sensor_offset_not_finite", domain_env(),
+             "boat_node --boat-id b1 --sensor-offset nan,0,0", "finite"},
         Case{"wearable_without_id", "", "wearable_node", "athlete-id"},
         Case{"wearable_domain_out_of_range", "", "wearable_node --athlete-id a1 --domain 233",
              "0..232"},
