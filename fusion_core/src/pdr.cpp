@@ -22,8 +22,6 @@ double wrap_2pi(double a) {
   return a < 0.0 ? a + kTwoPi : a;
 }
 
-double sigmoid(double x) { return 1.0 / (1.0 + std::exp(-x)); }
-
 bool gyro_ok(const ImuSample& s) { return s.gyro_body_rad_s.allFinite(); }
 
 /// Slot of a (possibly negative) running index in a ring of n.
@@ -50,141 +48,6 @@ bool horizontal_axes(const Eigen::Vector3d& up, Eigen::Vector3d& fwd, Eigen::Vec
 }
 
 }  // namespace
-
-// --- features ---------------------------------------------------------------------------------
-void PoseFeatureWindow::pop() {
-  const ImuSample& s = buf_[head_];
-  const double m = s.acc_body_m_s2.norm();
-  sum_f_ -= s.acc_body_m_s2;
-  sum_f2_ -= s.acc_body_m_s2.cwiseAbs2();
-  sum_m_ -= m;
-  sum_m2_ -= m * m;
-  if (s.gyro_body_rad_s.allFinite()) {
-    sum_w_ -= s.gyro_body_rad_s;
-    sum_w2_ -= s.gyro_body_rad_s.cwiseAbs2();
-    --gyro_count_;
-  }
-  head_ = (head_ + 1) % kCapacity;
-  --size_;
-}
-
-void PoseFeatureWindow::push(const ImuSample& s) {
-  while (size_ > 0 && (size_ == kCapacity || buf_[head_].t_s < s.t_s - window_s_)) pop();
-  buf_[(head_ + size_) % kCapacity] = s;
-  ++size_;
-  const double m = s.acc_body_m_s2.norm();
-  sum_f_ += s.acc_body_m_s2;
-  sum_f2_ += s.acc_body_m_s2.cwiseAbs2();
-  sum_m_ += m;
-  sum_m2_ += m * m;
-  if (s.gyro_body_rad_s.allFinite()) {
-    sum_w_ += s.gyro_body_rad_s;
-    sum_w2_ += s.gyro_body_rad_s.cwiseAbs2();
-    ++gyro_count_;
-  }
-}
-
-double PoseFeatureWindow::span_s() const {
-  if (size_ < 2) return 0.0;
-  return buf_[(head_ + size_ - 1) % kCapacity].t_s - buf_[head_].t_s;
-}
-
-Eigen::Vector3d PoseFeatureWindow::mean_acc() const {
-  return size_ ? Eigen::Vector3d(sum_f_ / static_cast<double>(size_)) : Eigen::Vector3d::Zero();
-}
-
-PoseFeatures PoseFeatureWindow::features() const {
-  PoseFeatures f;
-  if (size_ == 0) return f;
-  const double n = static_cast<double>(size_);
-  const Eigen::Vector3d mean_f = sum_f_ / n;
-  f.acc_energy = std::max(0.0, (sum_f2_ / n - mean_f.cwiseAbs2()).sum());
-  const double mean_m = sum_m_ / n;
-  f.acc_variance = std::max(0.0, sum_m2_ / n - mean_m * mean_m);
-  if (gyro_count_ == 0) {
-    f.gyro_variance = std::nan("");
-  } else {
-    const double ng = static_cast<double>(gyro_count_);
-    const Eigen::Vector3d mean_w = sum_w_ / ng;
-    f.gyro_variance = std::max(0.0, (sum_w2_ / ng - mean_w.cwiseAbs2()).sum());
-  }
-  return f;
-}
-
-// --- BP network -------------------------------------------------------------------------------
-PoseNetwork::Input PoseNetwork::input(const PoseFeatures& f) const {
-  // Log features: the variances span three decades between a phone at the ear and a swinging
-  // arm, and their ratios (not differences) separate the poses.
-  const Input raw(std::log(f.acc_energy + 1e-4), std::log(f.acc_variance + 1e-4),
-                  std::log(f.gyro_variance + 1e-6));
-  return (raw - in_mean).cwiseQuotient(in_scale);
-}
-
-PoseNetwork::Output PoseNetwork::forward(const Input& x) const {
-  // Eq. (4): H_j = f(sum_i w_ij x_i - a_j) with a sigmoid f; eq. (5): O_k = sum_j H_j w_jk - b_k.
-  const Eigen::Matrix<double, kHidden, 1> h = (w_ih * x + b_h).unaryExpr(&sigmoid);
-  return w_ho * h + b_o;
-}
-
-std::optional<PhonePose> PoseNetwork::classify(const PoseFeatures& f) const {
-  if (!trained) return std::nullopt;
-  const Input x = input(f);
-  if (!x.allFinite()) return std::nullopt;
-  Eigen::Index k = 0;
-  forward(x).maxCoeff(&k);
-  return static_cast<PhonePose>(k);
-}
-
-PoseNetwork train_pose_network(const std::vector<PoseFeatures>& features,
-                               const std::vector<PhonePose>& labels, PoseTrainingParams params) {
-  PoseNetwork net;
-  const std::size_t n = std::min(features.size(), labels.size());
-  if (n == 0) return net;
-  // Standardisation from the data (log features).
-  std::vector<PoseNetwork::Input> raw(n);
-  for (std::size_t i = 0; i < n; ++i) raw[i] = net.input(features[i]);
-  PoseNetwork::Input mean = PoseNetwork::Input::Zero(), sq = PoseNetwork::Input::Zero();
-  for (const auto& r : raw) mean += r;
-  mean /= static_cast<double>(n);
-  for (const auto& r : raw) sq += (r - mean).cwiseAbs2();
-  net.in_mean = mean;
-  net.in_scale = (sq / static_cast<double>(n)).cwiseSqrt().cwiseMax(1e-6);
-  std::vector<PoseNetwork::Input> x(n);
-  for (std::size_t i = 0; i < n; ++i) x[i] = (raw[i] - mean).cwiseQuotient(net.in_scale);
-
-  // Step 1: small random initial weights (seeded; uniform +-0.5 from our own transform).
-  std::mt19937_64 rng(params.seed);
-  auto uni = [&rng] { return static_cast<double>(rng() >> 11) * 0x1.0p-53 - 0.5; };
-  for (int i = 0; i < net.w_ih.size(); ++i) net.w_ih.data()[i] = uni();
-  for (int i = 0; i < net.b_h.size(); ++i) net.b_h.data()[i] = uni();
-  for (int i = 0; i < net.w_ho.size(); ++i) net.w_ho.data()[i] = uni();
-  for (int i = 0; i < net.b_o.size(); ++i) net.b_o.data()[i] = uni();
-  std::vector<std::size_t> order(n);
-  std::iota(order.begin(), order.end(), 0);
-  for (int epoch = 0; epoch < params.epochs; ++epoch) {
-    for (std::size_t i = n - 1; i > 0; --i) std::swap(order[i], order[rng() % (i + 1)]);
-    for (const std::size_t i : order) {
-      // Steps 2-3: forward pass.
-      const Eigen::Matrix<double, PoseNetwork::kHidden, 1> h =
-          (net.w_ih * x[i] + net.b_h).unaryExpr(&sigmoid);
-      const PoseNetwork::Output o = net.w_ho * h + net.b_o;
-      // Step 4: error e_k = Y_k - O_k against the one-hot target.
-      PoseNetwork::Output e = -o;
-      e[static_cast<Eigen::Index>(labels[i])] += 1.0;
-      // Steps 5-6 (eqs. (7)-(10)): weights and thresholds along the error gradient.
-      const Eigen::Matrix<double, PoseNetwork::kHidden, 1> back =
-          (net.w_ho.transpose() * e)
-              .cwiseProduct(
-                  h.cwiseProduct(Eigen::Matrix<double, PoseNetwork::kHidden, 1>::Ones() - h));
-      net.w_ho += params.eta * e * h.transpose();
-      net.b_o += params.eta * e;
-      net.w_ih += params.eta * back * x[i].transpose();
-      net.b_h += params.eta * back;
-    }
-  }
-  net.trained = true;
-  return net;
-}
 
 // --- step length ------------------------------------------------------------------------------
 StepLengthModel::StepLengthModel() {
@@ -299,13 +162,6 @@ const Builtin& builtin() {
 
 const PoseNetwork& builtin_pose_network() { return builtin().net; }
 const StepLengthModel& builtin_step_length_model() { return builtin().len; }
-
-Eigen::Matrix3d pose_rotation(PhonePose pose) {
-  Eigen::Matrix3d m = Eigen::Matrix3d::Identity();
-  if (pose == PhonePose::kCall) m << 0, 0, -1, 0, -1, 0, -1, 0, 0;  // eq. (14)
-  if (pose == PhonePose::kPocket) m << 0, 0, -1, 0, 1, 0, 1, 0, 0;  // eq. (15)
-  return m;
-}
 
 // --- heading ----------------------------------------------------------------------------------
 double HeadingFilter::magnetic_heading_rad(const Eigen::Vector3d& mag, const Eigen::Vector3d& up) {
@@ -450,13 +306,12 @@ void HeadingFilter::update(double t_s, const Eigen::Vector3d& gyro, const Eigen:
 // --- PDR --------------------------------------------------------------------------------------
 Pdr::Pdr(Params params, const PoseNetwork& net, const StepLengthModel& lengths)
     : params_(params),
-      net_(net),
       lengths_(lengths),
       foot_steps_([] {
         AdaptiveStepParams p;
         return p;
       }()),
-      features_(params.feature_window_s),
+      pose_(params.pose, net),
       heading_(params.heading),
       mag_cal_(params.hard_iron) {
   heading_bin_id_.fill(std::numeric_limits<std::int64_t>::min());
@@ -501,7 +356,7 @@ void Pdr::on_step(double t_s, StepSource source) {
   if (!foot && last_step_t_s_ >= 0.0 && interval_s_ > 0.0) {
     const double ratio = gap / interval_s_;
     if (ratio > params_.fill_min_ratio && gap < params_.fill_max_gap_s &&
-        features_.features().acc_energy > params_.fill_min_energy && !source.after_stand)
+        pose_.window().features().acc_energy > params_.fill_min_energy && !source.after_stand)
       missed = static_cast<int>(std::lround(ratio)) - 1;
   }
   // Filling in needs a cadence that was measured. A gap after every step is no missed step but a
@@ -605,7 +460,7 @@ void Pdr::on_step(double t_s, StepSource source) {
             // The phone is steady again: wait for fresh classifications of the new pose.
             settling_ = true;
             settling_steps_ = 0;
-            candidate_count_ = 0;
+            pose_.restart_vote();
           }
         }
       }
@@ -616,70 +471,22 @@ void Pdr::on_step(double t_s, StepSource source) {
       ++wave_count_;
     }
     step_up_.setZero();
-    // Pose: classify the feature window at every step. A pose can only change around a detected
-    // switch (turns fool the gyro-variance feature), or when one answer persists for
-    // pose_fallback_steps; the first pose is the first confirmed answer.
-    if (settling_ && ++settling_steps_ > params_.pose_window_steps) {
-      settling_ = switching_ = false;  // no confirmed pose: keep the previous one
-    }
-    // The classifier sees only the three features of seed 003; the rotation matrices of eqs.
-    // (14)-(15) also assume how the phone sits in each pose. We keep the best-scoring pose whose
-    // matrix brings the window's mean gravity near the walking frame's up (our addition: without
-    // it a pocket taken for a phone call turns the heading upside down).
-    std::optional<PhonePose> pose;
-    if (net_.trained) {
-      const PoseNetwork::Input x = net_.input(features_.features());
-      const Eigen::Vector3d g = features_.mean_acc();
-      if (x.allFinite() && g.norm() > 1.0) {
-        PoseNetwork::Output score = net_.forward(x);
-        const double cos_max = std::cos(params_.pose_gravity_deg * M_PI / 180.0);
-        for (int k = 0; k < kPoseCount; ++k) {
-          Eigen::Index best = 0;
-          score.maxCoeff(&best);
-          const auto p = static_cast<PhonePose>(best);
-          if ((pose_rotation(p) * g).normalized().z() > cos_max) {
-            pose = p;
-            break;
-          }
-          score[best] = -std::numeric_limits<double>::infinity();
-        }
+    // Pose: classified at every step (PoseClassifier); a switch that saw no confirmed pose
+    // within pose_window_steps keeps the previous one.
+    if (settling_ && ++settling_steps_ > params_.pose_window_steps) settling_ = switching_ = false;
+    if (const auto change = pose_.at_step(settling_, out_.steps)) {
+      settling_ = switching_ = false;
+      const Eigen::Matrix3d r = pose_rotation(change->to) * pose_rotation(change->from).transpose();
+      if (!r.isIdentity(1e-9)) {
+        heading_.change_frame(r);  // new walking frame: heading again from the magnetometer
+        sum_sin_ = sum_cos_ = 0.0;
+        heading_bins_from_t_s_ = t_s;
       }
-    }
-    if (pose) {
-      if (*pose == candidate_pose_) {
-        ++candidate_count_;
-      } else {
-        candidate_pose_ = *pose;
-        candidate_count_ = 1;
+      if (change->to != change->from) {
+        if (!change->first) ++diag_.pose_changes;
+        reset_walking_direction();
+        forget_vertical_field();
       }
-      // (The fallback is for a pose that changes: the old pose's long run of answers must not
-      // end a switch the moment it is detected.)
-      const bool same_frame = pose_rotation(candidate_pose_).isApprox(pose_rotation(applied_pose_));
-      const int fallback =
-          same_frame ? params_.pose_fallback_same_frame_steps : params_.pose_fallback_steps;
-      const bool may_change = !pose_known_ || settling_ ||
-                              (candidate_pose_ != applied_pose_ && candidate_count_ >= fallback);
-      if (candidate_count_ >= params_.pose_confirm_steps && may_change) {
-        settling_ = switching_ = false;
-        const Eigen::Matrix3d r =
-            pose_rotation(candidate_pose_) * pose_rotation(applied_pose_).transpose();
-        if (!r.isIdentity(1e-9)) {
-          heading_.change_frame(r);  // new walking frame: heading again from the magnetometer
-          sum_sin_ = sum_cos_ = 0.0;
-          heading_bins_from_t_s_ = t_s;
-        }
-        if (pose_known_ && candidate_pose_ != applied_pose_) ++diag_.pose_changes;
-        if (candidate_pose_ != applied_pose_) {
-          reset_walking_direction();
-          forget_vertical_field();
-        }
-        applied_pose_ = candidate_pose_;
-        pose_known_ = true;
-      }
-    } else if (!pose_known_ && out_.steps >= static_cast<std::size_t>(params_.pose_confirm_steps)) {
-      // No classification possible (no gyroscope, or no model): keep the hand-held frame
-      // (M = I) rather than holding the track back for ever.
-      pose_known_ = true;
     }
   }
 
@@ -700,7 +507,7 @@ void Pdr::on_step(double t_s, StepSource source) {
     step_yaw_sq_ += a * a;
     ++straight_steps_;
   }
-  if (applied_pose_ == PhonePose::kArmSwing) swing_axis_direction();
+  if (pose_.pose() == PhonePose::kArmSwing) swing_axis_direction();
   last_fwd_ = step_fwd_;
   last_left_ = step_left_;
   step_fwd_ = step_left_ = 0.0;
@@ -733,8 +540,8 @@ void Pdr::on_step(double t_s, StepSource source) {
   }
   // Eq. (13) and eq. (11). The first step has no frequency yet: the person's usual walk.
   const double hz = out_.step_hz > 0.0 ? out_.step_hz : 1.8;
-  const double step_m = lengths_.length_m(applied_pose_, params_.height_m, hz) *
-                        params_.step_scale[static_cast<std::size_t>(applied_pose_)];
+  const double step_m = lengths_.length_m(pose_.pose(), params_.height_m, hz) *
+                        params_.step_scale[static_cast<std::size_t>(pose_.pose())];
   double len = (per_event + missed) * step_m;
   out_.last_step_length_m = len;
   heading_.set_speed(step_m * hz);
@@ -746,7 +553,7 @@ void Pdr::on_step(double t_s, StepSource source) {
     heading = wrap_2pi(heading + std::atan2(turn.y(), turn.x()));
     len *= turn.norm();
   }
-  if (!foot && (!pose_known_ || !heading_.initialised())) {
+  if (!foot && (!pose_.known() || !heading_.initialised())) {
     // At the start the pose (hence the walking frame and the heading) is not known yet: the
     // first steps are laid along the first heading we get (a straight start).
     pending_m_ += len;
@@ -778,14 +585,14 @@ void Pdr::on_step(double t_s, StepSource source) {
   if (switching_ && switch_steps_ < static_cast<int>(switch_.size()))
     switch_[static_cast<std::size_t>(switch_steps_++)] = laid;
   if (!switching_ && switch_steps_ > 0) {
-    relay_switch_steps(heading, applied_pose_);
+    relay_switch_steps(heading, pose_.pose());
     switch_steps_ = 0;
-  } else if (switching_ && candidate_count_ > 0) {
+  } else if (const auto candidate = pose_.candidate(); switching_ && candidate) {
     // Meanwhile the switch's steps are laid as the pose the classifier now sees would lay them
     // (again at every step, each time from the latest up direction): a walk may end before the
     // new pose is confirmed (a phone put away on arrival), and its last metres then point
     // where they went, not along the heading from before the switch.
-    relay_switch_steps(std::nullopt, candidate_pose_);
+    relay_switch_steps(std::nullopt, *candidate);
   }
   if (!switching_ && !foot) {
     for (std::size_t i = 0; i + 1 < kLookback; ++i) {
@@ -1232,7 +1039,7 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
   out_.t_s = s.t_s;
   const bool foot = params_.mount == StepMount::kFoot;
   if (!foot) {
-    features_.push(s);
+    pose_.push(s);
     if (raw_size_ == kRaw) {
       raw_head_ = (raw_head_ + 1) % kRaw;
       --raw_size_;
@@ -1244,7 +1051,7 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
     ++raw_size_;
   }
   // Into the walking frame of the pose in force (eqs. (14)-(15)).
-  const Eigen::Matrix3d m = foot ? Eigen::Matrix3d::Identity() : pose_rotation(applied_pose_);
+  const Eigen::Matrix3d m = foot ? Eigen::Matrix3d::Identity() : pose_rotation(pose_.pose());
   Eigen::Vector3d mag = mag_uT;
   if (params_.calibrate_mag && mag.allFinite()) {
     // The hard-iron residual rotates with the phone, so its heading error changes with the
@@ -1254,10 +1061,10 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
   }
   heading_.update(s.t_s, m * s.gyro_body_rad_s, m * (s.acc_body_m_s2 - acc_bias_), m * mag);
   if (!foot && !switching_ && params_.learn_acc_bias && mag.allFinite() && heading_.initialised() &&
-      gyro_ok(s) && applied_pose_ != PhonePose::kArmSwing && s.t_s > tilt_settled_t_s_)
+      gyro_ok(s) && pose_.pose() != PhonePose::kArmSwing && s.t_s > tilt_settled_t_s_)
     add_vertical_field(s.gyro_body_rad_s, m.transpose() * heading_.state().up, mag);
   if (!foot && !switching_ && params_.walking_direction && gyro_ok(s) &&
-      applied_pose_ != PhonePose::kArmSwing) {
+      pose_.pose() != PhonePose::kArmSwing) {
     // Walking direction from the acceleration pattern of the step (our addition): the trunk
     // brakes after heel strike and speeds up before the next one, so the forward acceleration
     // is in quadrature with the vertical one, correlated with its time derivative; sideways
@@ -1278,7 +1085,7 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
     last_av_t_ = s.t_s;
     have_av_ = true;
   } else if (!foot && !switching_ && params_.walking_direction && gyro_ok(s) &&
-             applied_pose_ == PhonePose::kArmSwing) {
+             pose_.pose() == PhonePose::kArmSwing) {
     // A swinging arm turns the phone about the shoulder's axis, across the walking direction
     // whatever the phone's yaw in the hand: its rotations are summed for the step's principal
     // axis (swing_axis_direction), in place of the acceleration pattern (the arm's, not the
@@ -1326,7 +1133,7 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
     on_step(ev.t_s, source);
     out_.step = true;
   }
-  out_.pose = applied_pose_;
+  out_.pose = pose_.pose();
   out_.switching = switching_;
   return out_;
 }

@@ -47,85 +47,12 @@
 
 #include "telltale/fusion/hard_iron.hpp"
 #include "telltale/fusion/imu_sample.hpp"
+#include "telltale/fusion/pdr/pose_classifier.hpp"
 #include "telltale/fusion/phone_pose.hpp"
 #include "telltale/fusion/steps.hpp"
 
 namespace telltale::fusion {
 
-// ---------------------------------------------------------------------------------------------
-/// The three features seed 003 kept after PCA (Table 1), over a sliding time window:
-/// acceleration energy = total (3-axis) variance of the specific force, m^2/s^4;
-/// acceleration variance = variance of |f|, m^2/s^4; gyro variance = total (3-axis) variance of
-/// the angular rate, rad^2/s^2 (NaN when the samples carry no gyro).
-struct PoseFeatures {
-  double acc_energy = 0.0;
-  double acc_variance = 0.0;
-  double gyro_variance = 0.0;
-};
-
-class PoseFeatureWindow {
- public:
-  static constexpr std::size_t kCapacity = 1024;
-  explicit PoseFeatureWindow(double window_s = 2.0) : window_s_(window_s) {}
-  /// Adds one sample (t strictly increasing, finite acc; gyro may be NaN).
-  void push(const ImuSample& s);
-  [[nodiscard]] PoseFeatures features() const;
-  /// Mean specific force over the window (sensor frame): the gravity direction, m/s^2.
-  [[nodiscard]] Eigen::Vector3d mean_acc() const;
-  [[nodiscard]] std::size_t size() const { return size_; }
-  [[nodiscard]] double span_s() const;
-
- private:
-  void pop();
-  double window_s_;
-  std::array<ImuSample, kCapacity> buf_{};
-  std::size_t head_ = 0, size_ = 0;
-  Eigen::Vector3d sum_f_ = Eigen::Vector3d::Zero(), sum_f2_ = Eigen::Vector3d::Zero();
-  Eigen::Vector3d sum_w_ = Eigen::Vector3d::Zero(), sum_w2_ = Eigen::Vector3d::Zero();
-  double sum_m_ = 0.0, sum_m2_ = 0.0;
-  std::size_t gyro_count_ = 0;
-};
-
-// ---------------------------------------------------------------------------------------------
-/// BP network of seed 003 (eqs. (4)-(10)): 3 inputs, one sigmoid hidden layer, 4 linear outputs
-/// (one per pose, trained toward one-hot targets), pose = the largest output. Hidden size 8: the
-/// rules of eqs. (1)-(3) give sqrt(n+m)+a = 3..13, log2(n) = 2, sqrt(nm) = 3.5; 8 was the
-/// smallest that reached the training accuracy plateau (tools/train_pose.cpp).
-/// Inputs are log features, standardised with the training mean and scale.
-struct PoseNetwork {
-  static constexpr int kInputs = 3;
-  static constexpr int kHidden = 8;
-  static constexpr int kOutputs = kPoseCount;
-  using Input = Eigen::Matrix<double, kInputs, 1>;
-  using Output = Eigen::Matrix<double, kOutputs, 1>;
-  Eigen::Matrix<double, kHidden, kInputs> w_ih = Eigen::Matrix<double, kHidden, kInputs>::Zero();
-  Eigen::Matrix<double, kHidden, 1> b_h = Eigen::Matrix<double, kHidden, 1>::Zero();
-  Eigen::Matrix<double, kOutputs, kHidden> w_ho = Eigen::Matrix<double, kOutputs, kHidden>::Zero();
-  Output b_o = Output::Zero();
-  Input in_mean = Input::Zero();
-  Input in_scale = Input::Ones();
-  bool trained = false;
-
-  /// Network input for a feature triple (log, then standardised). NaN gyro variance -> NaN.
-  [[nodiscard]] Input input(const PoseFeatures& f) const;
-  [[nodiscard]] Output forward(const Input& x) const;
-  /// Pose for a feature triple; nullopt when untrained or a feature is not finite.
-  [[nodiscard]] std::optional<PhonePose> classify(const PoseFeatures& f) const;
-};
-
-/// Deterministic back-propagation training (seed 003, steps 1-7): per-sample gradient descent on
-/// the squared error with learning rate `eta`, samples visited in a seeded shuffled order each
-/// epoch. Sets the input standardisation from the data.
-struct PoseTrainingParams {
-  int epochs = 400;
-  double eta = 0.05;
-  std::uint64_t seed = 1;
-};
-[[nodiscard]] PoseNetwork train_pose_network(const std::vector<PoseFeatures>& features,
-                                             const std::vector<PhonePose>& labels,
-                                             PoseTrainingParams params = {});
-
-// ---------------------------------------------------------------------------------------------
 /// Seed 003 eq. (13): step length L = a*h + b*f_step + c per pose (h in m, f_step in Hz).
 struct StepLengthModel {
   std::array<Eigen::Vector3d, kPoseCount> abc{};  ///< per pose: a (m/m), b (m/Hz), c (m)
@@ -153,9 +80,6 @@ struct CalibrationWalk {
 /// The model shipped with the library (pose_bp.txt compiled in); untrained if it was missing.
 [[nodiscard]] const PoseNetwork& builtin_pose_network();
 [[nodiscard]] const StepLengthModel& builtin_step_length_model();
-
-/// Seed 003 eqs. (14)-(15): v_walking = M v_sensor for a pose (identity for hand-held, arm swing).
-[[nodiscard]] Eigen::Matrix3d pose_rotation(PhonePose pose);
 
 // ---------------------------------------------------------------------------------------------
 /// Heading of the walking frame's x axis from gyro + magnetometer (seed 004, Fig. 2): a two-state
@@ -260,22 +184,12 @@ class HeadingFilter {
 struct PdrParams {
   StepMount mount = StepMount::kBody;  ///< kBody: phone (seed 003); kFoot: toe sensor (seed 004)
   double height_m = 1.75;              ///< walker's height, m
-  double feature_window_s = 2.0;       ///< pose feature window, s
   double switch_correlation = 0.5;     ///< step waveforms correlating less = pose switch...
   double switch_tilt_deg = 15.0;       ///< ...if gravity also moved this much in the sensor frame
                                        ///< (twice this much is a switch whatever the correlation)
   int switch_exit_steps = 2;           ///< correlated steps needed to leave a switch
   int pose_window_steps = 10;          ///< steps after a switch to confirm the new pose
-  int pose_fallback_steps = 10;        ///< identical answers that change the pose without a switch
-  /// The same between poses with one walking frame (hand-held and arm swing: no re-orientation
-  /// for the waveforms to see). Fewer are needed: no frame turns with a wrong answer, and until
-  /// the change the old pose's walking-direction correction is applied to the new pose's steps
-  /// (~10 deg after an arm swing, measured).
-  int pose_fallback_same_frame_steps = 5;
-  double pose_gravity_deg = 45.0;  ///< a pose whose M does not bring gravity this close to
-                                   ///< the walking frame's up is not plausible
-  double straight_deg = 10.0;      ///< 3 steps within this of their mean are "straight"
-  int pose_confirm_steps = 3;      ///< identical classifications before the pose changes
+  double straight_deg = 10.0;          ///< 3 steps within this of their mean are "straight"
   double fill_min_ratio = 1.6;     ///< a gap this many step intervals long has missed steps...
   double fill_max_gap_s = 4.0;     ///< ...if shorter than this...
   double fill_min_energy = 0.5;    ///< ...and the phone's acceleration energy says walking
@@ -331,6 +245,7 @@ struct PdrParams {
   /// Personal factor on the model's step length, per pose (1 = the population model). Set it from
   /// a calibration walk of known length: known distance / `output().distance_m` of that walk.
   std::array<double, kPoseCount> step_scale{1.0, 1.0, 1.0, 1.0};
+  PoseClassifierParams pose;
   HeadingFilterParams heading;
   bool calibrate_mag = true;  ///< online hard-iron calibration (hard_iron.hpp) before the heading
   HardIronParams hard_iron;
@@ -399,7 +314,6 @@ class Pdr {
   [[nodiscard]] Wave step_wave(double t0_s, double t1_s) const;
 
   Params params_;
-  PoseNetwork net_;
   StepLengthModel lengths_;
   PeakValleyStepDetector phone_steps_;
   SwingStepDetector swing_steps_;  ///< steps while the phone swings (its turns)
@@ -413,14 +327,11 @@ class Pdr {
   int filled_row_ = 0;               ///< steps in a row that filled a gap
   double start_pending_t_s_ = -1.0;  ///< a walk's first event after a stand, held (phone_step)
   AdaptiveStepDetector foot_steps_;
-  PoseFeatureWindow features_;
+  PoseClassifier pose_;
   HeadingFilter heading_;
   HardIronCalibrator mag_cal_;
   Diagnostics diag_;
   PdrOutput out_;
-  PhonePose applied_pose_ = PhonePose::kHandHeld;
-  PhonePose candidate_pose_ = PhonePose::kHandHeld;
-  int candidate_count_ = 0;
   // Recent raw accelerations for the step waveforms.
   static constexpr std::size_t kRaw = 512;
   std::array<double, kRaw> raw_t_{};
@@ -438,7 +349,6 @@ class Pdr {
   std::array<Eigen::Vector3d, 2> ups_{};
   bool settling_ = false;  ///< switch over, waiting for the new pose to be confirmed
   int settling_steps_ = 0;
-  bool pose_known_ = false;
   double pending_m_ = 0.0;  ///< distance walked before the first heading
   /// A step walked during a pose switch, re-laid when the switch is over.
   struct SwitchStep {
