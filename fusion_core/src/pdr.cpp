@@ -5,8 +5,6 @@
 #include <charconv>
 #include <cmath>
 #include <limits>
-#include <numeric>
-#include <random>
 #include <sstream>
 
 #include "pose_bp_data.hpp"
@@ -48,34 +46,6 @@ bool horizontal_axes(const Eigen::Vector3d& up, Eigen::Vector3d& fwd, Eigen::Vec
 }
 
 }  // namespace
-
-// --- step length ------------------------------------------------------------------------------
-StepLengthModel::StepLengthModel() {
-  // Generic walking coefficients (overridden by the shipped calibration in pose_bp.txt).
-  for (auto& c : abc) c = Eigen::Vector3d(0.3, 0.4, -0.51);
-}
-
-double StepLengthModel::length_m(PhonePose pose, double height_m, double step_hz) const {
-  const Eigen::Vector3d& c = abc[static_cast<std::size_t>(pose)];
-  return std::max(0.0, c[0] * height_m + c[1] * step_hz + c[2]);
-}
-
-Eigen::Vector3d calibrate_step_length(const std::vector<CalibrationWalk>& walks,
-                                      const Eigen::Vector3d& prior, double prior_weight) {
-  // Each walk: a (N h) + b (sum f) + c N = D. Rows are divided by N so every walk weighs the
-  // same whatever its length; ridge toward the prior keeps the unobservable combinations.
-  Eigen::Matrix3d ata = prior_weight * Eigen::Matrix3d::Identity();
-  Eigen::Vector3d atb = prior_weight * prior;
-  for (const auto& w : walks) {
-    if (w.step_hz.empty()) continue;
-    const double n = static_cast<double>(w.step_hz.size());
-    const double mean_f = std::accumulate(w.step_hz.begin(), w.step_hz.end(), 0.0) / n;
-    const Eigen::Vector3d row(w.height_m, mean_f, 1.0);
-    ata += row * row.transpose();
-    atb += row * (w.distance_m / n);
-  }
-  return ata.ldlt().solve(atb);
-}
 
 // --- model file -------------------------------------------------------------------------------
 std::string format_pdr_model(const PoseNetwork& net, const StepLengthModel& len) {
@@ -306,7 +276,7 @@ void HeadingFilter::update(double t_s, const Eigen::Vector3d& gyro, const Eigen:
 // --- PDR --------------------------------------------------------------------------------------
 Pdr::Pdr(Params params, const PoseNetwork& net, const StepLengthModel& lengths)
     : params_(params),
-      lengths_(lengths),
+      step_length_(params.step_length, lengths),
       foot_steps_([] {
         AdaptiveStepParams p;
         return p;
@@ -540,8 +510,7 @@ void Pdr::on_step(double t_s, StepSource source) {
   }
   // Eq. (13) and eq. (11). The first step has no frequency yet: the person's usual walk.
   const double hz = out_.step_hz > 0.0 ? out_.step_hz : 1.8;
-  const double step_m = lengths_.length_m(pose_.pose(), params_.height_m, hz) *
-                        params_.step_scale[static_cast<std::size_t>(pose_.pose())];
+  const double step_m = step_length_.step_m(pose_.pose(), hz);
   double len = (per_event + missed) * step_m;
   out_.last_step_length_m = len;
   heading_.set_speed(step_m * hz);

@@ -29,7 +29,7 @@
 /// from its turns (SwingStepDetector, steps.hpp), whatever the pose; the swinging hand's
 /// pendulum acceleration taken out before the up direction follows the accelerometer
 /// (HeadingFilterParams::lever_arm); a personal step-length factor from one calibration walk of
-/// known length (PdrParams::step_scale).
+/// known length (StepLengthParams::scale).
 ///
 /// Frames: the phone's sensor axes are whatever the phone has; the walking frame is x forward, y
 /// left, z up with `v_walking = M_pose v_sensor` (M = I for hand-held and arm swing). Position is
@@ -48,30 +48,11 @@
 #include "telltale/fusion/hard_iron.hpp"
 #include "telltale/fusion/imu_sample.hpp"
 #include "telltale/fusion/pdr/pose_classifier.hpp"
+#include "telltale/fusion/pdr/step_length.hpp"
 #include "telltale/fusion/phone_pose.hpp"
 #include "telltale/fusion/steps.hpp"
 
 namespace telltale::fusion {
-
-/// Seed 003 eq. (13): step length L = a*h + b*f_step + c per pose (h in m, f_step in Hz).
-struct StepLengthModel {
-  std::array<Eigen::Vector3d, kPoseCount> abc{};  ///< per pose: a (m/m), b (m/Hz), c (m)
-  StepLengthModel();                              ///< generic walking coefficients
-  [[nodiscard]] double length_m(PhonePose pose, double height_m, double step_hz) const;
-};
-
-/// A walk of known length used to calibrate the step-length model.
-struct CalibrationWalk {
-  double height_m = 1.75;
-  std::vector<double> step_hz;  ///< estimated step frequency at each counted step
-  double distance_m = 0.0;      ///< the known length of the walk
-};
-/// Least squares for (a, b, c): each walk says sum_i (a h + b f_i + c) = distance. With fewer
-/// walks than unknowns (or walks that do not vary h and f) the solution stays as close as
-/// possible to `prior` (ridge weight `prior_weight` per coefficient, relative to one walk).
-[[nodiscard]] Eigen::Vector3d calibrate_step_length(const std::vector<CalibrationWalk>& walks,
-                                                    const Eigen::Vector3d& prior,
-                                                    double prior_weight = 1e-3);
 
 /// The model file (fusion_core/data/pose_bp.txt): network + step-length coefficients, text.
 [[nodiscard]] std::string format_pdr_model(const PoseNetwork& net, const StepLengthModel& len);
@@ -183,7 +164,6 @@ class HeadingFilter {
 // ---------------------------------------------------------------------------------------------
 struct PdrParams {
   StepMount mount = StepMount::kBody;  ///< kBody: phone (seed 003); kFoot: toe sensor (seed 004)
-  double height_m = 1.75;              ///< walker's height, m
   double switch_correlation = 0.5;     ///< step waveforms correlating less = pose switch...
   double switch_tilt_deg = 15.0;       ///< ...if gravity also moved this much in the sensor frame
                                        ///< (twice this much is a switch whatever the correlation)
@@ -242,10 +222,8 @@ struct PdrParams {
   double acc_bias_step_noise_uT = 0.5;      ///< noise of one step's mean vertical field
   double acc_bias_vertical_walk_uT = 0.05;  ///< drift of the vertical field, uT/sqrt(s)
   double acc_bias_max_turn_rad_s = 0.4;     ///< samples turning faster than this are left out
-  /// Personal factor on the model's step length, per pose (1 = the population model). Set it from
-  /// a calibration walk of known length: known distance / `output().distance_m` of that walk.
-  std::array<double, kPoseCount> step_scale{1.0, 1.0, 1.0, 1.0};
   PoseClassifierParams pose;
+  StepLengthParams step_length;
   HeadingFilterParams heading;
   bool calibrate_mag = true;  ///< online hard-iron calibration (hard_iron.hpp) before the heading
   HardIronParams hard_iron;
@@ -314,7 +292,7 @@ class Pdr {
   [[nodiscard]] Wave step_wave(double t0_s, double t1_s) const;
 
   Params params_;
-  StepLengthModel lengths_;
+  StepLength step_length_;
   PeakValleyStepDetector phone_steps_;
   SwingStepDetector swing_steps_;  ///< steps while the phone swings (its turns)
   bool last_step_by_swing_ = false;
