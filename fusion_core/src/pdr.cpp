@@ -283,7 +283,9 @@ Pdr::Pdr(Params params, const PoseNetwork& net, const StepLengthModel& lengths)
       }()),
       pose_(params.pose, net),
       heading_(params.heading),
-      mag_cal_(params.hard_iron) {
+      mag_cal_(params.hard_iron),
+      gyro_bias_(params.gyro_bias),
+      acc_bias_(params.acc_bias) {
   heading_bin_id_.fill(std::numeric_limits<std::int64_t>::min());
 }
 
@@ -359,7 +361,7 @@ void Pdr::on_step(double t_s, StepSource source) {
   const double f = out_.step_hz;
   out_.gait = f < 1.6 ? 0 : f < 1.95 ? 1 : f < 2.35 ? 2 : f < 2.75 ? 3 : 4;
 
-  if (!foot && tilt_n_ > 0) learn_acc_bias(t_s);
+  if (!foot) acc_bias_.at_step(t_s, mag_cal_.offset_uT());
   if (!foot) {
     // Pose switch (seed 003): cross-correlation of this step's waveform with the same foot's
     // previous one. A turn also changes the waveform, so we add a condition of our own: the
@@ -590,7 +592,7 @@ bool Pdr::quiet_between(double t0_s, double t1_s) const {
   const double window_s = params_.stand_still_s;
   if (!(window_s > 0.0)) return false;
   const double w2_limit = params_.stand_gyro_rad_s * params_.stand_gyro_rad_s;
-  const double limit = params_.still_acc_std_m_s2;
+  const double limit = params_.gyro_bias.acc_std_m_s2;
   const std::size_t first = raw_first_at(t0_s);
   double sum = 0.0, sum2 = 0.0, sum_w2 = 0.0;
   std::size_t lo = first;
@@ -726,76 +728,7 @@ void Pdr::swing_axis_direction() {
   step_left_ = walk.dot(left);
 }
 
-void Pdr::add_vertical_field(const Eigen::Vector3d& gyro, const Eigen::Vector3d& up,
-                             const Eigen::Vector3d& mag) {
-  // One sample of what the field's vertical component says about the up direction (sensor
-  // frame; learn_acc_bias). The caller leaves out arm swing (the pendulum's acceleration tilts
-  // up in step with the swing, which also turns the horizontal field in the phone) and the few
-  // up time constants after the phone moved. Turns are left out here: what is left of the
-  // centripetal acceleration tilts up with the turn, in step with the change of heading the
-  // estimate feeds on.
-  if (!(std::abs(gyro.dot(up)) < params_.acc_bias_max_turn_rad_s)) return;
-  const double vertical = mag.dot(up);
-  const Eigen::Vector3d r = (mag - vertical * up) / kStandardGravity_m_s2;
-  tilt_z_sum_ += vertical + r.dot(acc_bias_);
-  tilt_r_sum_ += r;
-  tilt_up_sum_ += up;
-  ++tilt_n_;
-}
-
-void Pdr::learn_acc_bias(double t_s) {
-  // The earth field's vertical component is the same wherever the walker faces. Up tilted by
-  // an angle d (a vector across up, rad) reads m.up + m_h.d, where m_h is the horizontal field
-  // in the sensor frame, which turns round as the walker turns: a tilt fixed in the phone shows
-  // as a vertical field that changes with the heading. An accelerometer bias b tilts up by
-  // b_h / g (its part across up), so, with the bias already removed (acc_bias_) and C the
-  // vertical field plus the hard-iron residual along up (constant while the phone sits the same
-  // way, free after a pose change):
-  //   m.up + m_h.acc_bias_ / g = C + m_h.b / g.
-  // One measurement per step (the step's means), a Kalman filter for [C, b].
-  const double n = tilt_n_;
-  const double z = tilt_z_sum_ / n;
-  const Eigen::Vector3d r = tilt_r_sum_ / n;
-  // A better hard-iron offset moves the corrected field, and C with it, by the change along up.
-  const Eigen::Vector3d offset = mag_cal_.offset_uT();
-  acc_x_[0] -= (offset - tilt_offset_uT_).dot(tilt_up_sum_ / n);
-  tilt_offset_uT_ = offset;
-  tilt_z_sum_ = 0.0;
-  tilt_r_sum_.setZero();
-  tilt_up_sum_.setZero();
-  tilt_n_ = 0;
-  if (tilt_t_s_ >= 0.0)
-    acc_p_(0, 0) += params_.acc_bias_vertical_walk_uT * params_.acc_bias_vertical_walk_uT *
-                    std::max(0.0, t_s - tilt_t_s_);
-  tilt_t_s_ = t_s;
-  Eigen::Vector4d h;
-  h << 1.0, r;
-  const double var = params_.acc_bias_step_noise_uT * params_.acc_bias_step_noise_uT;
-  const double innovation = z - h.dot(acc_x_);
-  const double s = h.dot(acc_p_ * h) + var;
-  if (!std::isfinite(innovation) || !(s > 0.0)) return;
-  // A magnetic disturbance (steel, a car) moves the vertical field by far more than a bias can.
-  if (innovation * innovation > 25.0 * s) return;
-  const Eigen::Vector4d k = acc_p_ * h / s;
-  acc_x_ += k * innovation;
-  acc_p_ -= k * h.transpose() * acc_p_;
-  acc_p_ = 0.5 * (acc_p_ + acc_p_.transpose()).eval();  // symmetric over hours of steps
-  // Past a few times the prior the estimate is no bias (a field that is not the earth's):
-  // the last plausible one stays.
-  if (acc_x_.tail<3>().norm() < 5.0 * params_.acc_bias_prior_m_s2) acc_bias_ = acc_x_.tail<3>();
-}
-
-void Pdr::forget_vertical_field() {
-  // The phone now sits another way: the hard-iron residual along up, hence C, is new.
-  acc_p_.row(0).setZero();
-  acc_p_.col(0).setZero();
-  acc_p_(0, 0) = 1e4;
-  tilt_settled_t_s_ = last_t_s_ + 3.0 * params_.heading.up_tau_s;
-  tilt_z_sum_ = 0.0;
-  tilt_r_sum_.setZero();
-  tilt_up_sum_.setZero();
-  tilt_n_ = 0;
-}
+void Pdr::forget_vertical_field() { acc_bias_.forget(last_t_s_ + 3.0 * params_.heading.up_tau_s); }
 
 void Pdr::reset_walking_direction() {
   step_swing_.setZero();
@@ -836,30 +769,6 @@ void Pdr::revise_mag_offset() {
   out_.x_m += corr.x() - mag_applied_.x();
   out_.y_m += corr.y() - mag_applied_.y();
   mag_applied_ = corr;
-}
-
-void Pdr::learn_gyro_bias(const ImuSample& s) {
-  if (still_n_ == 0) still_t0_ = s.t_s;
-  ++still_n_;
-  still_w_ += s.gyro_body_rad_s;
-  still_w2_ += s.gyro_body_rad_s.squaredNorm();
-  const double a = s.acc_body_m_s2.norm();
-  still_a_ += a;
-  still_a2_ += a * a;
-  if (s.t_s - still_t0_ < params_.still_window_s) return;
-  const double n = still_n_;
-  const Eigen::Vector3d mean_w = still_w_ / n;
-  const double var_w = still_w2_ / n - mean_w.squaredNorm();
-  const double mean_a = still_a_ / n, var_a = still_a2_ / n - mean_a * mean_a;
-  if (still_n_ >= 10 && var_w < params_.still_gyro_std_rad_s * params_.still_gyro_std_rad_s &&
-      var_a < params_.still_acc_std_m_s2 * params_.still_acc_std_m_s2 &&
-      mean_w.norm() < params_.still_max_bias_rad_s) {
-    ++diag_.still_windows;
-    gyro_bias_ += (mean_w - gyro_bias_) / std::min(diag_.still_windows, 10u);
-  }
-  still_n_ = 0;
-  still_w_.setZero();
-  still_w2_ = still_a_ = still_a2_ = 0.0;
 }
 
 void Pdr::relay_switch_steps(std::optional<double> heading_after, PhonePose pose) {
@@ -1002,8 +911,8 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
   }
   ImuSample s = raw;
   if (gyro_ok(s)) {
-    learn_gyro_bias(s);
-    s.gyro_body_rad_s -= gyro_bias_;
+    if (gyro_bias_.add(s)) ++diag_.still_windows;
+    s.gyro_body_rad_s -= gyro_bias_.bias_rad_s();
   }
   out_.t_s = s.t_s;
   const bool foot = params_.mount == StepMount::kFoot;
@@ -1028,10 +937,11 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
     mag_cal_.update(s.t_s, s.gyro_body_rad_s, mag);
     mag = mag_cal_.corrected(mag);
   }
-  heading_.update(s.t_s, m * s.gyro_body_rad_s, m * (s.acc_body_m_s2 - acc_bias_), m * mag);
-  if (!foot && !switching_ && params_.learn_acc_bias && mag.allFinite() && heading_.initialised() &&
-      gyro_ok(s) && pose_.pose() != PhonePose::kArmSwing && s.t_s > tilt_settled_t_s_)
-    add_vertical_field(s.gyro_body_rad_s, m.transpose() * heading_.state().up, mag);
+  heading_.update(s.t_s, m * s.gyro_body_rad_s, m * (s.acc_body_m_s2 - acc_bias_.bias_m_s2()),
+                  m * mag);
+  if (!foot && !switching_ && params_.acc_bias.learn && mag.allFinite() && heading_.initialised() &&
+      gyro_ok(s) && pose_.pose() != PhonePose::kArmSwing && acc_bias_.settled(s.t_s))
+    acc_bias_.add(s.gyro_body_rad_s, m.transpose() * heading_.state().up, mag);
   if (!foot && !switching_ && params_.walking_direction && gyro_ok(s) &&
       pose_.pose() != PhonePose::kArmSwing) {
     // Walking direction from the acceleration pattern of the step (our addition): the trunk

@@ -317,7 +317,7 @@ TEST(Pdr, LearntBiasesSurviveNaNAndAMagneticDisturbance) {
   Pdr pdr(p);
   for (const auto& s : run.samples) (void)pdr.update(s.imu, s.mag_uT);
   EXPECT_TRUE(pdr.acc_bias_m_s2().allFinite());
-  EXPECT_LT(pdr.acc_bias_m_s2().norm(), 5.0 * p.acc_bias_prior_m_s2);
+  EXPECT_LT(pdr.acc_bias_m_s2().norm(), 5.0 * p.acc_bias.prior_m_s2);
   EXPECT_TRUE(std::isfinite(pdr.output().x_m) && std::isfinite(pdr.output().y_m));
   EXPECT_GT(pdr.output().steps, run.step_times_s.size() * 9 / 10);
 }

@@ -25,7 +25,7 @@
 /// the hard-iron offset or the pose's yaw estimate improves (PdrParams::revise_track); the gyro
 /// bias learnt while standing still; in arm swing the walking direction from the arm's swing axis
 /// (PdrParams::swing_axis_ratio); the accelerometer bias learnt from the constancy of the field's
-/// vertical component (PdrParams::learn_acc_bias); while the phone swings, the steps counted
+/// vertical component (AccBiasParams); while the phone swings, the steps counted
 /// from its turns (SwingStepDetector, steps.hpp), whatever the pose; the swinging hand's
 /// pendulum acceleration taken out before the up direction follows the accelerometer
 /// (HeadingFilterParams::lever_arm); a personal step-length factor from one calibration walk of
@@ -47,6 +47,7 @@
 
 #include "telltale/fusion/hard_iron.hpp"
 #include "telltale/fusion/imu_sample.hpp"
+#include "telltale/fusion/pdr/bias_learners.hpp"
 #include "telltale/fusion/pdr/pose_classifier.hpp"
 #include "telltale/fusion/pdr/step_length.hpp"
 #include "telltale/fusion/phone_pose.hpp"
@@ -173,7 +174,7 @@ struct PdrParams {
   double fill_min_ratio = 1.6;     ///< a gap this many step intervals long has missed steps...
   double fill_max_gap_s = 4.0;     ///< ...if shorter than this...
   double fill_min_energy = 0.5;    ///< ...and the phone's acceleration energy says walking
-  /// ...and held no stand: the phone still (|f| within still_acc_std_m_s2, rotating at less
+  /// ...and held no stand: the phone still (|f| within gyro_bias.acc_std_m_s2, rotating at less
   /// than stand_gyro_rad_s rms) for stand_still_s.
   /// A walker who stops and then moves the phone (puts it away, lifts it to the ear) makes
   /// events after a gap that held no steps (2-3 steps too many on 10 of 400 loops). 0: off.
@@ -203,25 +204,8 @@ struct PdrParams {
   /// leg walked before the first corner calibrated the magnetometer is corrected too) and the
   /// pose's yaw from the walking direction (every step since the pose began turns with it).
   bool revise_track = true;
-  /// Gyro bias from standing still (our addition): a window of this length in which the rate
-  /// and |f| vary less than the limits below gives the bias as its mean rate (the average of the
-  /// last 10 such windows is subtracted from every sample). A mean rate above
-  /// still_max_bias_rad_s is a slow steady turn (a vehicle), not a bias.
-  double still_window_s = 1.0;
-  double still_gyro_std_rad_s = 0.03;
-  double still_acc_std_m_s2 = 0.15;
-  double still_max_bias_rad_s = 0.1;
-  /// Accelerometer bias from the field's vertical component (our addition): a bias b tilts the
-  /// up direction by its part across up over g, and the magnetic heading by tan(dip) times that
-  /// (0.05 m/s^2: 0.3 deg of tilt, 0.7 deg of heading at 65 deg dip), with a sign that turns
-  /// with the heading, so it does not cancel round a loop. Seen as a vertical field that
-  /// changes with the heading (Pdr::learn_acc_bias); the estimate is removed from the
-  /// accelerometer before the heading filter.
-  bool learn_acc_bias = true;
-  double acc_bias_prior_m_s2 = 0.1;         ///< prior std of each bias component
-  double acc_bias_step_noise_uT = 0.5;      ///< noise of one step's mean vertical field
-  double acc_bias_vertical_walk_uT = 0.05;  ///< drift of the vertical field, uT/sqrt(s)
-  double acc_bias_max_turn_rad_s = 0.4;     ///< samples turning faster than this are left out
+  GyroBiasParams gyro_bias;
+  AccBiasParams acc_bias;
   PoseClassifierParams pose;
   StepLengthParams step_length;
   HeadingFilterParams heading;
@@ -267,10 +251,10 @@ class Pdr {
   [[nodiscard]] const StepDiagnostics& step_diagnostics() const;
   [[nodiscard]] const HardIronCalibrator& mag_calibration() const { return mag_cal_; }
   /// Gyro bias learnt while still (sensor frame, rad/s; subtracted from every sample).
-  [[nodiscard]] const Eigen::Vector3d& gyro_bias_rad_s() const { return gyro_bias_; }
+  [[nodiscard]] const Eigen::Vector3d& gyro_bias_rad_s() const { return gyro_bias_.bias_rad_s(); }
   /// Accelerometer bias learnt from the vertical field (sensor frame, m/s^2; removed from the
   /// accelerometer before the heading filter).
-  [[nodiscard]] const Eigen::Vector3d& acc_bias_m_s2() const { return acc_bias_; }
+  [[nodiscard]] const Eigen::Vector3d& acc_bias_m_s2() const { return acc_bias_.bias_m_s2(); }
   /// Step frequencies seen at each step so far are not stored (no heap); for calibration, collect
   /// `output().step_hz` at every step in the caller.
 
@@ -308,6 +292,8 @@ class Pdr {
   PoseClassifier pose_;
   HeadingFilter heading_;
   HardIronCalibrator mag_cal_;
+  GyroBiasLearner gyro_bias_;
+  AccBiasLearner acc_bias_;
   Diagnostics diag_;
   PdrOutput out_;
   // Recent raw accelerations for the step waveforms.
@@ -348,16 +334,10 @@ class Pdr {
   /// heading of the step after them (none: the switch goes on).
   void relay_switch_steps(std::optional<double> heading_after, PhonePose pose);
   void reset_walking_direction();
-  /// Adds one sample (sensor frame) to the step's vertical-field sums.
-  void add_vertical_field(const Eigen::Vector3d& gyro, const Eigen::Vector3d& up,
-                          const Eigen::Vector3d& mag);
-  /// Accelerometer bias from the vertical field's constancy (one Kalman update per step).
-  void learn_acc_bias(double t_s);
-  /// The phone changed how it sits: the vertical field plus hard-iron residual is unknown again.
+  /// The phone changed how it sits: the accelerometer bias's vertical field is unknown again.
   void forget_vertical_field();
   /// Arm swing: the step's walking direction from its principal rotation axis (step_fwd_/left_).
   void swing_axis_direction();
-  void learn_gyro_bias(const ImuSample& s);
   /// Turns the steps laid in this pose so far with a new yaw correction `corr` (rad).
   void revise_pose_yaw(double corr);
   /// Moves the track by what the current hard-iron offset changes in every step laid so far.
@@ -386,25 +366,6 @@ class Pdr {
   Eigen::Vector2d mag_c_ = Eigen::Vector2d::Zero(), mag_applied_ = Eigen::Vector2d::Zero();
   Eigen::Vector3d mag_grad_sum_ = Eigen::Vector3d::Zero();
   int mag_grad_n_ = 0;
-  // Still windows for the gyro bias.
-  double still_t0_ = 0.0, still_w2_ = 0.0, still_a_ = 0.0, still_a2_ = 0.0;
-  Eigen::Vector3d still_w_ = Eigen::Vector3d::Zero(), gyro_bias_ = Eigen::Vector3d::Zero();
-  // Accelerometer bias from the vertical field: state [C (uT), b (m/s^2, sensor frame)], its
-  // covariance, the bias removed before the heading filter, and the step's sums.
-  Eigen::Vector4d acc_x_ = Eigen::Vector4d::Zero();
-  Eigen::Matrix4d acc_p_ = initial_acc_covariance();
-  Eigen::Vector3d acc_bias_ = Eigen::Vector3d::Zero();
-  double tilt_z_sum_ = 0.0, tilt_t_s_ = -1.0, tilt_settled_t_s_ = 0.0;
-  Eigen::Vector3d tilt_r_sum_ = Eigen::Vector3d::Zero(), tilt_up_sum_ = Eigen::Vector3d::Zero();
-  Eigen::Vector3d tilt_offset_uT_ = Eigen::Vector3d::Zero();  ///< hard-iron offset C is for
-  int tilt_n_ = 0;
-  [[nodiscard]] Eigen::Matrix4d initial_acc_covariance() const {
-    Eigen::Matrix4d p =
-        Eigen::Matrix4d::Identity() * params_.acc_bias_prior_m_s2 * params_.acc_bias_prior_m_s2;
-    p(0, 0) = 1e4;
-    return p;
-  }
-  int still_n_ = 0;
   double last_av_ = 0.0, last_av_t_ = 0.0;
   bool have_av_ = false;
   std::array<SwitchStep, kMaxSwitchSteps> switch_{};
