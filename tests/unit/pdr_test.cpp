@@ -337,7 +337,7 @@ TEST(Pdr, ArmSwingWalkingDirectionFromTheSwingAxis) {
       const auto run = sim::simulate_gait(sc, person, 1);
       PdrParams p;
       p.step_length.height_m = person.height_m;
-      if (!axis) p.swing_axis_ratio = std::numeric_limits<double>::infinity();
+      if (!axis) p.walking_direction.swing_axis_ratio = std::numeric_limits<double>::infinity();
       Pdr pdr(p);
       const double last_s = run.samples.back().imu.t_s - 25.0;
       double sn = 0.0, cs = 0.0;
