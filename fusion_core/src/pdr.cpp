@@ -121,7 +121,8 @@ Pdr::Pdr(Params params, const PoseNetwork& net, const StepLengthModel& lengths)
       walking_(params.walking_direction),
       mag_cal_(params.hard_iron),
       gyro_bias_(params.gyro_bias),
-      acc_bias_(params.acc_bias) {
+      acc_bias_(params.acc_bias),
+      track_(params.track, params.calibrate_mag) {
   heading_bin_id_.fill(std::numeric_limits<std::int64_t>::min());
 }
 
@@ -146,12 +147,7 @@ Pdr::Wave Pdr::step_wave(double t0, double t1) const {
 
 void Pdr::on_step(double t_s, StepSource source) {
   const bool foot = params_.mount == StepMount::kFoot;
-  // How this step's heading depends on the hard-iron offset (mean over the step).
-  const bool have_mag_grad = mag_grad_n_ > 0;
-  const Eigen::Vector3d mag_grad =
-      have_mag_grad ? Eigen::Vector3d(mag_grad_sum_ / mag_grad_n_) : Eigen::Vector3d::Zero();
-  mag_grad_sum_.setZero();
-  mag_grad_n_ = 0;
+  track_.begin_step();
   const std::array<Eigen::Vector3d, 2> ups_before = ups_;
   const double per_event = foot ? 2.0 : 1.0;  // a foot sensor sees one event per two steps
   // Steps the detector missed (our addition): its thresholds follow the last steps' peaks and
@@ -304,7 +300,7 @@ void Pdr::on_step(double t_s, StepSource source) {
   sum_sin_ = sum_cos_ = 0.0;
   const double yaw_corr =
       walking_.at_step(heading, pose_.pose() == PhonePose::kArmSwing, heading_.state().up);
-  if (params_.revise_track && !switching_) revise_pose_yaw(yaw_corr);
+  if (params_.track.revise && !switching_) revise_pose_yaw(yaw_corr);
   heading = wrap_2pi(heading - yaw_corr);
   const double step_heading = heading;
   const Eigen::Vector2d step_axis_x = axis_sum_[0], step_axis_z = axis_sum_[1];
@@ -337,25 +333,10 @@ void Pdr::on_step(double t_s, StepSource source) {
   if (!foot && (!pose_.known() || !heading_.initialised())) {
     // At the start the pose (hence the walking frame and the heading) is not known yet: the
     // first steps are laid along the first heading we get (a straight start).
-    pending_m_ += len;
+    track_.hold(len);
     return;
   }
-  const double laid_m = len + pending_m_;
-  out_.x_m += laid_m * std::sin(heading);
-  out_.y_m += laid_m * std::cos(heading);
-  pending_m_ = 0.0;
-  if (!switching_) {
-    pose_disp_ += laid_m * Eigen::Vector2d(std::sin(heading), std::cos(heading));
-    ++pose_steps_;
-    if (params_.revise_track && params_.calibrate_mag && have_mag_grad) {
-      // d(east, north)/dheading times dheading/doffset: how this step moves per uT of offset.
-      const Eigen::Matrix<double, 2, 3> a =
-          laid_m * Eigen::Vector2d(std::cos(heading), -std::sin(heading)) * mag_grad.transpose();
-      mag_a_ += a;
-      mag_c_ += a * mag_cal_.offset_uT();
-    }
-  }
-  if (params_.revise_track) revise_mag_offset();
+  track_.lay(len, heading, !switching_, mag_cal_.offset_uT());
   SwitchStep laid;  // what a later re-laying of this step needs
   laid.length_m = len;
   laid.laid_rad = heading;
@@ -517,37 +498,16 @@ void Pdr::forget_vertical_field() { acc_bias_.forget(last_t_s_ + 3.0 * params_.h
 
 void Pdr::reset_walking_direction() {
   walking_.reset();
-  // The steps of the pose that ends keep the correction they have.
-  pose_disp_.setZero();
-  pose_corr_rad_ = 0.0;
-  pose_steps_ = 0;
+  track_.new_pose();
 }
 
 void Pdr::revise_pose_yaw(double corr) {
-  // The pose's steps were laid with heading - pose_corr_rad_; with the better estimate they turn
-  // about the point where the pose began (headings clockwise, so east/north turn the other way).
-  const double d = corr - pose_corr_rad_;
+  const double d = track_.turn_pose(corr);
   if (d == 0.0) return;
-  const double c = std::cos(d), sn = std::sin(d);
-  const Eigen::Vector2d turned(pose_disp_.x() * c - pose_disp_.y() * sn,
-                               pose_disp_.y() * c + pose_disp_.x() * sn);
-  out_.x_m += turned.x() - pose_disp_.x();
-  out_.y_m += turned.y() - pose_disp_.y();
-  pose_disp_ = turned;
-  pose_corr_rad_ = corr;
   // Steps a later switch may re-lay must know the heading they now have.
-  const std::size_t n = std::min(last_count_, pose_steps_);
+  const std::size_t n = std::min(last_count_, track_.pose_steps());
   for (std::size_t i = kLookback - n; i < kLookback; ++i)
     last_steps_[i].laid_rad = wrap_2pi(last_steps_[i].laid_rad - d);
-}
-
-void Pdr::revise_mag_offset() {
-  // First order in the heading change (a few degrees at most: a 1 uT offset in a 20 uT
-  // horizontal field is 3 deg).
-  const Eigen::Vector2d corr = mag_a_ * mag_cal_.offset_uT() - mag_c_;
-  out_.x_m += corr.x() - mag_applied_.x();
-  out_.y_m += corr.y() - mag_applied_.y();
-  mag_applied_ = corr;
 }
 
 void Pdr::relay_switch_steps(std::optional<double> heading_after, PhonePose pose) {
@@ -608,13 +568,13 @@ void Pdr::relay_switch_steps(std::optional<double> heading_after, PhonePose pose
   }
   for (std::size_t k = 0; k < n; ++k) {
     SwitchStep& r = switch_[k];
-    out_.x_m += r.length_m * (std::sin(h[k]) - std::sin(r.laid_rad));
-    out_.y_m += r.length_m * (std::cos(h[k]) - std::cos(r.laid_rad));
+    track_.shift(r.length_m * (std::sin(h[k]) - std::sin(r.laid_rad)),
+                 r.length_m * (std::cos(h[k]) - std::cos(r.laid_rad)));
     r.laid_rad = h[k];  // a later re-laying moves it from here
     // Steps walked in the new pose turn with its walking-direction correction once that is
     // learnt (revise_pose_yaw), like the pose's later steps: they were laid with its raw axis.
     if (heading_after && in_new[k])
-      pose_disp_ += r.length_m * Eigen::Vector2d(std::sin(h[k]), std::cos(h[k]));
+      track_.add_to_pose(r.length_m * Eigen::Vector2d(std::sin(h[k]), std::cos(h[k])));
   }
 }
 
@@ -741,8 +701,7 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
     // horizontal field; |east| = |north| = H here), so every heading grows by east.db / H^2.
     const double h2 = north.squaredNorm();
     if (h2 > 1.0) {
-      mag_grad_sum_ += east / h2;
-      ++mag_grad_n_;
+      track_.add_offset_sensitivity(east / h2);
     }
     if (hx.norm() > 1e-9) axis_sum_[0] += hx.normalized();
     if (hz.norm() > 1e-9) axis_sum_[1] += hz.normalized();
@@ -762,6 +721,8 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
   const bool step = foot ? foot_steps_.update(s, ev) : phone_step(s, m, ev, source);
   if (step) {
     on_step(ev.t_s, source);
+    out_.x_m = track_.x_m();
+    out_.y_m = track_.y_m();
     out_.step = true;
   }
   out_.pose = pose_.pose();

@@ -516,7 +516,7 @@ TEST(Pdr, RevisingTheTrackWithTheLearntHardIronClosesLoops) {
       PdrParams p;
       p.step_length.height_m = person.height_m;
       p.step_length.scale.fill(sim::personal_step_scale(person, seed + 1000003));
-      p.revise_track = revise;
+      p.track.revise = revise;
       Pdr pdr(p);
       for (const auto& s : run.samples) (void)pdr.update(s.imu, s.mag_uT);
       const auto& last = run.samples.back();

@@ -22,7 +22,7 @@
 /// from the walking direction removed using the step's acceleration pattern (shrunk toward 0
 /// while the pose is young, from straight steps only); the centripetal acceleration of turns
 /// taken out before the up direction follows the accelerometer; steps already walked re-laid when
-/// the hard-iron offset or the pose's yaw estimate improves (PdrParams::revise_track); the gyro
+/// the hard-iron offset or the pose's yaw estimate improves (TrackParams::revise); the gyro
 /// bias learnt while standing still; in arm swing the walking direction from the arm's swing axis
 /// (WalkingDirectionParams::swing_axis_ratio); the accelerometer bias learnt from the constancy of
 /// the field's vertical component (AccBiasParams); while the phone swings, the steps counted from
@@ -50,6 +50,7 @@
 #include "telltale/fusion/pdr/bias_learners.hpp"
 #include "telltale/fusion/pdr/pose_classifier.hpp"
 #include "telltale/fusion/pdr/step_length.hpp"
+#include "telltale/fusion/pdr/track.hpp"
 #include "telltale/fusion/pdr/walking_heading.hpp"
 #include "telltale/fusion/phone_pose.hpp"
 #include "telltale/fusion/steps.hpp"
@@ -87,15 +88,11 @@ struct PdrParams {
   double stand_gyro_rad_s = 0.2;
   double min_step_interval_s = 0.2;  ///< 5 steps/s, a sprinter's: shorter is no cadence
   double walk_pause_s = 2.0;         ///< no step for this long: the next is a new walk
-  /// Re-lay steps already walked when an estimate they were laid with improves (our addition):
-  /// the hard-iron offset (each step's heading moves by its sensitivity to the offset, so the
-  /// leg walked before the first corner calibrated the magnetometer is corrected too) and the
-  /// pose's yaw from the walking direction (every step since the pose began turns with it).
-  bool revise_track = true;
   GyroBiasParams gyro_bias;
   AccBiasParams acc_bias;
   PoseClassifierParams pose;
   StepLengthParams step_length;
+  TrackParams track;
   HeadingFilterParams heading;
   WalkingDirectionParams walking_direction;
   bool calibrate_mag = true;  ///< online hard-iron calibration (hard_iron.hpp) before the heading
@@ -184,6 +181,7 @@ class Pdr {
   HardIronCalibrator mag_cal_;
   GyroBiasLearner gyro_bias_;
   AccBiasLearner acc_bias_;
+  Track track_;
   Diagnostics diag_;
   PdrOutput out_;
   // Recent raw accelerations for the step waveforms.
@@ -203,7 +201,6 @@ class Pdr {
   std::array<Eigen::Vector3d, 2> ups_{};
   bool settling_ = false;  ///< switch over, waiting for the new pose to be confirmed
   int settling_steps_ = 0;
-  double pending_m_ = 0.0;  ///< distance walked before the first heading
   /// A step walked during a pose switch, re-laid when the switch is over.
   struct SwitchStep {
     double length_m = 0.0;
@@ -228,20 +225,6 @@ class Pdr {
   void forget_vertical_field();
   /// Turns the steps laid in this pose so far with a new yaw correction `corr` (rad).
   void revise_pose_yaw(double corr);
-  /// Moves the track by what the current hard-iron offset changes in every step laid so far.
-  void revise_mag_offset();
-  // Track revision for the pose's yaw: displacement of the steps laid in this pose (as laid),
-  // the correction they carry, and how many there are.
-  Eigen::Vector2d pose_disp_ = Eigen::Vector2d::Zero();
-  double pose_corr_rad_ = 0.0;
-  std::size_t pose_steps_ = 0;
-  // Track revision for the hard-iron offset: over all laid steps, sum of L dpos/dheading
-  // (dheading/doffset)^T (east, north per uT) and of the same times the offset each was laid
-  // with; the correction already applied. Over the current step: sum of dheading/doffset.
-  Eigen::Matrix<double, 2, 3> mag_a_ = Eigen::Matrix<double, 2, 3>::Zero();
-  Eigen::Vector2d mag_c_ = Eigen::Vector2d::Zero(), mag_applied_ = Eigen::Vector2d::Zero();
-  Eigen::Vector3d mag_grad_sum_ = Eigen::Vector3d::Zero();
-  int mag_grad_n_ = 0;
   std::array<SwitchStep, kMaxSwitchSteps> switch_{};
   int switch_steps_ = 0;
   std::array<Eigen::Vector3d, 2> pre_switch_ups_{
