@@ -145,11 +145,7 @@ Pdr::Wave Pdr::step_wave(double t0, double t1) const {
   return w;
 }
 
-void Pdr::on_step(double t_s, StepSource source) {
-  const bool foot = params_.mount == StepMount::kFoot;
-  track_.begin_step();
-  const std::array<Eigen::Vector3d, 2> ups_before = ups_;
-  const double per_event = foot ? 2.0 : 1.0;  // a foot sensor sees one event per two steps
+int Pdr::count_steps(double t_s, const StepSource& source, double per_event) {
   // Steps the detector missed (our addition): its thresholds follow the last steps' peaks and
   // valleys, so after an arm swing the smaller steps of the next pose go unseen until its
   // memory resets (4-9 steps lost per arm-swing exit, measured; not always while a switch is
@@ -157,7 +153,7 @@ void Pdr::on_step(double t_s, StepSource source) {
   // (acceleration energy over the last window) counts n - 1 more steps; a stop does not.
   int missed = 0;
   const double gap = t_s - last_step_t_s_;
-  if (!foot && last_step_t_s_ >= 0.0 && interval_s_ > 0.0) {
+  if (params_.mount != StepMount::kFoot && last_step_t_s_ >= 0.0 && interval_s_ > 0.0) {
     const double ratio = gap / interval_s_;
     if (ratio > params_.fill_min_ratio && gap < params_.fill_max_gap_s &&
         pose_.window().features().acc_energy > params_.fill_min_energy && !source.after_stand)
@@ -183,7 +179,6 @@ void Pdr::on_step(double t_s, StepSource source) {
   missed += source.backfill;  // the start of a swinging walk (phone_step)
   diag_.filled_steps += static_cast<unsigned>(missed);
   out_.steps += static_cast<std::size_t>(missed);
-  const double t_prev = last_step_t_s_;
   last_step_t_s_ = t_s;
   out_.steps += static_cast<std::size_t>(per_event);
   if (interval_s_ > 0.0) {
@@ -192,120 +187,145 @@ void Pdr::on_step(double t_s, StepSource source) {
   }
   const double f = out_.step_hz;
   out_.gait = f < 1.6 ? 0 : f < 1.95 ? 1 : f < 2.35 ? 2 : f < 2.75 ? 3 : 4;
+  return missed;
+}
 
-  if (!foot) acc_bias_.at_step(t_s, mag_cal_.offset_uT());
-  if (!foot) {
-    // Pose switch (seed 003): cross-correlation of this step's waveform with the same foot's
-    // previous one. A turn also changes the waveform, so we add a condition of our own: the
-    // gravity direction in the sensor frame must have moved (the phone was re-oriented).
-    if (t_prev >= 0.0) {
-      const Wave w = step_wave(t_prev, t_s);
-      Eigen::Vector3d tilt(w.segment<kWave>(0).mean(), w.segment<kWave>(kWave).mean(),
-                           w.segment<kWave>(2 * kWave).mean());
-      tilt.normalize();
-      const auto slot = static_cast<std::size_t>(wave_count_ % 2);
-      if (wave_count_ >= 2) {
-        const Wave a = w.array() - w.mean();
-        const Wave b = waves_[slot].array() - waves_[slot].mean();
-        const double den = a.norm() * b.norm();
-        const double r = den > 1e-9 ? a.dot(b) / den : 0.0;
-        const double tilt_deg =
-            std::acos(std::clamp(tilt.dot(tilts_[slot]), -1.0, 1.0)) * 180.0 / M_PI;
-        const bool changed =
-            (r < params_.switch_correlation && tilt_deg > params_.switch_tilt_deg) ||
-            tilt_deg > 2.0 * params_.switch_tilt_deg;
-        if (!switching_ && changed) {
-          switching_ = true;
-          settling_ = false;
-          correlated_steps_ = 0;
-          switch_steps_ = 0;
-          // The phone may have begun to move a step or two before the waveforms said so: those
-          // steps join the switch (re-laid at its end) and the up direction before them is the
-          // old pose's.
-          const std::size_t back = last_count_;
-          pre_switch_ups_ = back > 0 ? last_ups_before_[kLookback - back] : ups_;
-          for (std::size_t i = kLookback - back; i < kLookback; ++i)
-            switch_[static_cast<std::size_t>(switch_steps_++)] = last_steps_[i];
-          last_count_ = 0;
-          reset_walking_direction();
-          ++diag_.switches;
-          forget_vertical_field();
-          // If the 3 steps before the switch were straight, their mean heading stands in for
-          // the heading during the switch. The comparison spans two steps, so the switch may
-          // have begun during the latest step: the 3 steps before the re-laid ones (at least
-          // the latest) are the ones known to be clean.
-          have_replacement_ = false;
-          const std::size_t skip = std::max<std::size_t>(1, back);
-          const std::size_t n_recent = recent_heading_rad_.size();
-          if (static_cast<std::size_t>(recent_count_) >= 3 + skip) {
-            const std::size_t i0 = n_recent - skip - 3;
-            double s = 0, c = 0;
-            for (std::size_t i = i0; i < i0 + 3; ++i) {
-              s += std::sin(recent_heading_rad_[i]);
-              c += std::cos(recent_heading_rad_[i]);
-            }
-            const double mean = std::atan2(s, c);
-            bool straight = true;
-            for (std::size_t i = i0; i < i0 + 3; ++i)
-              straight =
-                  straight && std::abs(std::remainder(recent_heading_rad_[i] - mean, kTwoPi)) <
-                                  params_.walking_direction.straight_deg * M_PI / 180.0;
-            if (straight) {
-              replacement_heading_rad_ = wrap_2pi(mean);
-              have_replacement_ = true;
-            }
-          }
-        } else if (switching_) {
-          correlated_steps_ =
-              (r >= params_.switch_correlation && tilt_deg < params_.switch_tilt_deg)
-                  ? correlated_steps_ + 1
-                  : 0;
-          if (!settling_ && correlated_steps_ >= params_.switch_exit_steps) {
-            // The phone is steady again: wait for fresh classifications of the new pose.
-            settling_ = true;
-            settling_steps_ = 0;
-            pose_.restart_vote();
-          }
-        }
-      }
-      waves_[slot] = w;
-      tilts_[slot] = tilt;
-      if (step_up_.norm() > 0.0) ups_[slot] = step_up_.normalized();
-      last_slot_ = slot;
-      ++wave_count_;
-    }
-    step_up_.setZero();
-    // Pose: classified at every step (PoseClassifier); a switch that saw no confirmed pose
-    // within pose_window_steps keeps the previous one.
-    if (settling_ && ++settling_steps_ > params_.pose_window_steps) settling_ = switching_ = false;
-    if (const auto change = pose_.at_step(settling_, out_.steps)) {
-      settling_ = switching_ = false;
-      const Eigen::Matrix3d r = pose_rotation(change->to) * pose_rotation(change->from).transpose();
-      if (!r.isIdentity(1e-9)) {
-        heading_.change_frame(r);  // new walking frame: heading again from the magnetometer
-        sum_sin_ = sum_cos_ = 0.0;
-        heading_bins_from_t_s_ = t_s;
-      }
-      if (change->to != change->from) {
-        if (!change->first) ++diag_.pose_changes;
-        reset_walking_direction();
-        forget_vertical_field();
+void Pdr::detect_switch(double t_prev, double t_s) {
+  // Pose switch (seed 003): cross-correlation of this step's waveform with the same foot's
+  // previous one. A turn also changes the waveform, so we add a condition of our own: the
+  // gravity direction in the sensor frame must have moved (the phone was re-oriented).
+  const Wave w = step_wave(t_prev, t_s);
+  Eigen::Vector3d tilt(w.segment<kWave>(0).mean(), w.segment<kWave>(kWave).mean(),
+                       w.segment<kWave>(2 * kWave).mean());
+  tilt.normalize();
+  const auto slot = static_cast<std::size_t>(wave_count_ % 2);
+  if (wave_count_ >= 2) {
+    const Wave a = w.array() - w.mean();
+    const Wave b = waves_[slot].array() - waves_[slot].mean();
+    const double den = a.norm() * b.norm();
+    const double r = den > 1e-9 ? a.dot(b) / den : 0.0;
+    const double tilt_deg = std::acos(std::clamp(tilt.dot(tilts_[slot]), -1.0, 1.0)) * 180.0 / M_PI;
+    const bool changed = (r < params_.switch_correlation && tilt_deg > params_.switch_tilt_deg) ||
+                         tilt_deg > 2.0 * params_.switch_tilt_deg;
+    if (!switching_ && changed) {
+      begin_switch();
+    } else if (switching_) {
+      correlated_steps_ = (r >= params_.switch_correlation && tilt_deg < params_.switch_tilt_deg)
+                              ? correlated_steps_ + 1
+                              : 0;
+      if (!settling_ && correlated_steps_ >= params_.switch_exit_steps) {
+        // The phone is steady again: wait for fresh classifications of the new pose.
+        settling_ = true;
+        settling_steps_ = 0;
+        pose_.restart_vote();
       }
     }
   }
+  waves_[slot] = w;
+  tilts_[slot] = tilt;
+  if (step_up_.norm() > 0.0) ups_[slot] = step_up_.normalized();
+  last_slot_ = slot;
+  ++wave_count_;
+}
 
-  // Heading of this step: circular mean over the step, or the replacement during a switch.
+void Pdr::begin_switch() {
+  switching_ = true;
+  settling_ = false;
+  correlated_steps_ = 0;
+  switch_steps_ = 0;
+  // The phone may have begun to move a step or two before the waveforms said so: those
+  // steps join the switch (re-laid at its end) and the up direction before them is the
+  // old pose's.
+  const std::size_t back = last_count_;
+  pre_switch_ups_ = back > 0 ? last_ups_before_[kLookback - back] : ups_;
+  for (std::size_t i = kLookback - back; i < kLookback; ++i)
+    switch_[static_cast<std::size_t>(switch_steps_++)] = last_steps_[i];
+  last_count_ = 0;
+  reset_walking_direction();
+  ++diag_.switches;
+  forget_vertical_field();
+  // If the 3 steps before the switch were straight, their mean heading stands in for
+  // the heading during the switch. The comparison spans two steps, so the switch may
+  // have begun during the latest step: the 3 steps before the re-laid ones (at least
+  // the latest) are the ones known to be clean.
+  have_replacement_ = false;
+  const std::size_t skip = std::max<std::size_t>(1, back);
+  const std::size_t n_recent = recent_heading_rad_.size();
+  if (static_cast<std::size_t>(recent_count_) >= 3 + skip) {
+    const std::size_t i0 = n_recent - skip - 3;
+    double s = 0, c = 0;
+    for (std::size_t i = i0; i < i0 + 3; ++i) {
+      s += std::sin(recent_heading_rad_[i]);
+      c += std::cos(recent_heading_rad_[i]);
+    }
+    const double mean = std::atan2(s, c);
+    bool straight = true;
+    for (std::size_t i = i0; i < i0 + 3; ++i)
+      straight = straight && std::abs(std::remainder(recent_heading_rad_[i] - mean, kTwoPi)) <
+                                 params_.walking_direction.straight_deg * M_PI / 180.0;
+    if (straight) {
+      replacement_heading_rad_ = wrap_2pi(mean);
+      have_replacement_ = true;
+    }
+  }
+}
+
+void Pdr::classify_pose(double t_s) {
+  // Pose: classified at every step (PoseClassifier); a switch that saw no confirmed pose
+  // within pose_window_steps keeps the previous one.
+  if (settling_ && ++settling_steps_ > params_.pose_window_steps) settling_ = switching_ = false;
+  if (const auto change = pose_.at_step(settling_, out_.steps)) {
+    settling_ = switching_ = false;
+    const Eigen::Matrix3d r = pose_rotation(change->to) * pose_rotation(change->from).transpose();
+    if (!r.isIdentity(1e-9)) {
+      heading_.change_frame(r);  // new walking frame: heading again from the magnetometer
+      sum_sin_ = sum_cos_ = 0.0;
+      heading_bins_from_t_s_ = t_s;
+    }
+    if (change->to != change->from) {
+      if (!change->first) ++diag_.pose_changes;
+      reset_walking_direction();
+      forget_vertical_field();
+    }
+  }
+}
+
+double Pdr::walked_heading() {
+  // The heading filter's circular mean over the step (its heading if it had none).
   double heading = heading_.heading_rad();
   if (sum_sin_ != 0.0 || sum_cos_ != 0.0) heading = wrap_2pi(std::atan2(sum_sin_, sum_cos_));
   sum_sin_ = sum_cos_ = 0.0;
   const double yaw_corr =
       walking_.at_step(heading, pose_.pose() == PhonePose::kArmSwing, heading_.state().up);
   if (params_.track.revise && !switching_) revise_pose_yaw(yaw_corr);
-  heading = wrap_2pi(heading - yaw_corr);
-  const double step_heading = heading;
+  return wrap_2pi(heading - yaw_corr);
+}
+
+void Pdr::on_step(double t_s, StepSource source) {
+  const bool foot = params_.mount == StepMount::kFoot;
+  track_.begin_step();
+  const std::array<Eigen::Vector3d, 2> ups_before = ups_;
+  const double per_event = foot ? 2.0 : 1.0;  // a foot sensor sees one event per two steps
+  const double t_prev = last_step_t_s_;
+  const int missed = count_steps(t_s, source, per_event);
+  if (!foot) {
+    acc_bias_.at_step(t_s, mag_cal_.offset_uT());
+    if (t_prev >= 0.0) detect_switch(t_prev, t_s);
+    step_up_.setZero();
+    classify_pose(t_s);
+  }
+  const double walked_rad = walked_heading();
+  lay_step(t_s, t_prev, per_event, missed, walked_rad, ups_before);
+}
+
+void Pdr::lay_step(double t_s, double t_prev, double per_event, int missed, double walked_rad,
+                   const std::array<Eigen::Vector3d, 2>& ups_before) {
+  const bool foot = params_.mount == StepMount::kFoot;
+  double heading = walked_rad;
   const Eigen::Vector2d step_axis_x = axis_sum_[0], step_axis_z = axis_sum_[1];
   axis_sum_[0].setZero();
   axis_sum_[1].setZero();
+  // During a switch the straight heading from before it stands in (begin_switch).
   const bool replaced = switching_ && have_replacement_;
   if (replaced) {
     heading = replacement_heading_rad_;
@@ -340,10 +360,16 @@ void Pdr::on_step(double t_s, StepSource source) {
   SwitchStep laid;  // what a later re-laying of this step needs
   laid.length_m = len;
   laid.laid_rad = heading;
-  laid.old_frame_rad = step_heading;
+  laid.old_frame_rad = walked_rad;
   laid.slot = last_slot_;
   laid.up = ups_[last_slot_];
   laid.axis_sum = {step_axis_x, step_axis_z};
+  book_laid_step(laid, heading, ups_before);
+  out_.heading_deg = heading * 180.0 / M_PI;
+}
+
+void Pdr::book_laid_step(const SwitchStep& laid, double heading,
+                         const std::array<Eigen::Vector3d, 2>& ups_before) {
   if (switching_ && switch_steps_ < static_cast<int>(switch_.size()))
     switch_[static_cast<std::size_t>(switch_steps_++)] = laid;
   if (!switching_ && switch_steps_ > 0) {
@@ -356,7 +382,7 @@ void Pdr::on_step(double t_s, StepSource source) {
     // where they went, not along the heading from before the switch.
     relay_switch_steps(std::nullopt, *candidate);
   }
-  if (!switching_ && !foot) {
+  if (!switching_ && params_.mount != StepMount::kFoot) {
     for (std::size_t i = 0; i + 1 < kLookback; ++i) {
       last_steps_[i] = last_steps_[i + 1];
       last_ups_before_[i] = last_ups_before_[i + 1];
@@ -365,7 +391,6 @@ void Pdr::on_step(double t_s, StepSource source) {
     last_ups_before_.back() = ups_before;
     last_count_ = std::min(last_count_ + 1, kLookback);
   }
-  out_.heading_deg = heading * 180.0 / M_PI;
 }
 
 std::size_t Pdr::raw_first_at(double t_s) const {

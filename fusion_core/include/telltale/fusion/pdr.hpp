@@ -156,6 +156,21 @@ class Pdr {
     bool after_stand = false;  ///< the phone stood still since the last step (quiet_between)
   };
   void on_step(double t_s, StepSource source);
+  /// Counts the step (and the steps a gap held, the cadence learnt from it); returns how many
+  /// more than `per_event` this event stands for.
+  int count_steps(double t_s, const StepSource& source, double per_event);
+  /// Compares the step [t_prev, t_s]'s waveform with the same foot's last: a pose switch
+  /// begins or settles.
+  void detect_switch(double t_prev, double t_s);
+  void begin_switch();
+  /// The pose classifier's vote at this step, and a new walking frame if it confirms one.
+  void classify_pose(double t_s);
+  /// The step's walking direction (rad): the heading over the step, yaw-corrected.
+  double walked_heading();
+  /// Lays the step (`missed` more with it) walked along `walked_rad`: its length, the heading a
+  /// switch or a gap gives it, the track, and what a later re-laying needs.
+  void lay_step(double t_s, double t_prev, double per_event, int missed, double walked_rad,
+                const std::array<Eigen::Vector3d, 2>& ups_before);
   /// Phone-mounted step detection: the acceleration's peaks and valleys, the arm's turns while
   /// the phone swings.
   bool phone_step(const ImuSample& s, const Eigen::Matrix3d& m, StepEvent& ev, StepSource& source);
@@ -220,6 +235,10 @@ class Pdr {
   /// Re-lays the switch's steps (switch_) for the phone now in `pose`; `heading_after` is the
   /// heading of the step after them (none: the switch goes on).
   void relay_switch_steps(std::optional<double> heading_after, PhonePose pose);
+  /// Keeps a laid step for a switch's re-laying (in the switch, or among the last steps before
+  /// one) and re-lays the switch's steps when it ends or the classifier sees a pose.
+  void book_laid_step(const SwitchStep& laid, double heading,
+                      const std::array<Eigen::Vector3d, 2>& ups_before);
   void reset_walking_direction();
   /// The phone changed how it sits: the accelerometer bias's vertical field is unknown again.
   void forget_vertical_field();
