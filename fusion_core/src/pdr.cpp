@@ -117,6 +117,8 @@ Pdr::Pdr(Params params, const PoseNetwork& net, const StepLengthModel& lengths)
         return p;
       }()),
       pose_(params.pose, net),
+      recent_(StandLimits{params.stand_still_s, params.stand_gyro_rad_s,
+                          params.gyro_bias.acc_std_m_s2}),
       heading_(params.heading),
       walking_(params.walking_direction),
       mag_cal_(params.hard_iron),
@@ -128,21 +130,6 @@ Pdr::Pdr(Params params, const PoseNetwork& net, const StepLengthModel& lengths)
 
 const StepDiagnostics& Pdr::step_diagnostics() const {
   return params_.mount == StepMount::kFoot ? foot_steps_.diagnostics() : phone_steps_.diagnostics();
-}
-
-Pdr::Wave Pdr::step_wave(double t0, double t1) const {
-  Wave w = Wave::Zero();
-  if (raw_size_ == 0) return w;
-  // Index into the ring from the oldest: the last sample before t0 (the ring holds 10 s).
-  std::size_t j = raw_first_at(t0);
-  j = j > 0 ? j - 1 : 0;
-  for (int i = 0; i < kWave; ++i) {
-    const double t = t0 + (t1 - t0) * (i + 0.5) / kWave;
-    while (j + 1 < raw_size_ && raw_t_[(raw_head_ + j + 1) % kRaw] <= t) ++j;
-    const Eigen::Vector3d& f = raw_f_[(raw_head_ + j) % kRaw];
-    for (int a = 0; a < 3; ++a) w[a * kWave + i] = f[a];
-  }
-  return w;
 }
 
 int Pdr::count_steps(double t_s, const StepSource& source, double per_event) {
@@ -166,7 +153,7 @@ int Pdr::count_steps(double t_s, const StepSource& source, double per_event) {
   // them kept any wrong cadence for ever: 2 or 8 steps counted for every one.)
   constexpr int kMaxFilledRow = 10;
   filled_row_ = missed > 0 ? filled_row_ + 1 : 0;
-  if (filled_row_ > kMaxFilledRow && !walking_period(interval_s_)) {
+  if (filled_row_ > kMaxFilledRow && !recent_.walking_period(interval_s_)) {
     missed = 0;
     filled_row_ = 0;
     interval_s_ = 0.0;
@@ -194,7 +181,7 @@ void Pdr::detect_switch(double t_prev, double t_s) {
   // Pose switch (seed 003): cross-correlation of this step's waveform with the same foot's
   // previous one. A turn also changes the waveform, so we add a condition of our own: the
   // gravity direction in the sensor frame must have moved (the phone was re-oriented).
-  const Wave w = step_wave(t_prev, t_s);
+  const Wave w = recent_.step_wave(t_prev, t_s);
   Eigen::Vector3d tilt(w.segment<kWave>(0).mean(), w.segment<kWave>(kWave).mean(),
                        w.segment<kWave>(2 * kWave).mean());
   tilt.normalize();
@@ -393,71 +380,6 @@ void Pdr::book_laid_step(const SwitchStep& laid, double heading,
   }
 }
 
-std::size_t Pdr::raw_first_at(double t_s) const {
-  // From the newest back: a step's worth of samples, not the whole ring.
-  std::size_t i = raw_size_;
-  while (i > 0 && raw_t_[(raw_head_ + i - 1) % kRaw] >= t_s) --i;
-  return i;
-}
-
-bool Pdr::quiet_between(double t0_s, double t1_s) const {
-  // A walker who stopped holds the phone still for a moment: |f| steady and little rotation
-  // (|f| alone is steady in a slow arm swing, whose pendulum acceleration is mostly across
-  // gravity). A walking trunk never is, for any stretch of a step. Without a gyroscope the
-  // rotation is unknown and no stretch counts as still.
-  const double window_s = params_.stand_still_s;
-  if (!(window_s > 0.0)) return false;
-  const double w2_limit = params_.stand_gyro_rad_s * params_.stand_gyro_rad_s;
-  const double limit = params_.gyro_bias.acc_std_m_s2;
-  const std::size_t first = raw_first_at(t0_s);
-  double sum = 0.0, sum2 = 0.0, sum_w2 = 0.0;
-  std::size_t lo = first;
-  for (std::size_t i = first; i < raw_size_; ++i) {
-    const std::size_t k = (raw_head_ + i) % kRaw;
-    if (raw_t_[k] > t1_s) break;
-    const double m = raw_f_[k].norm();
-    sum += m;
-    sum2 += m * m;
-    sum_w2 += raw_w2_[k];
-    while (raw_t_[(raw_head_ + lo) % kRaw] < raw_t_[k] - window_s) {
-      const std::size_t kl = (raw_head_ + lo) % kRaw;
-      const double ml = raw_f_[kl].norm();
-      sum -= ml;
-      sum2 -= ml * ml;
-      sum_w2 -= raw_w2_[kl];
-      ++lo;
-    }
-    const auto n = static_cast<double>(i - lo + 1);
-    if (raw_t_[k] - raw_t_[(raw_head_ + lo) % kRaw] >= window_s * 0.9 && n >= 5) {
-      const double var = sum2 / n - (sum / n) * (sum / n);
-      if (var < limit * limit && sum_w2 / n < w2_limit) return true;
-    }
-  }
-  return false;
-}
-
-bool Pdr::walking_period(double lag_s) const {
-  constexpr double kSpanS = 4.0;
-  // Autocorrelation of |f| over the last few seconds at that lag: a step interval repeats the
-  // step (r ~ 0.5-0.9 even in a pocket, where the stride is the waveform's period); half of one
-  // puts a valley on a peak (r < 0).
-  if (raw_size_ < 8 || !(lag_s > 0.0)) return false;
-  const double t_end = raw_t_[(raw_head_ + raw_size_ - 1) % kRaw];
-  const std::size_t first = raw_first_at(t_end - kSpanS);
-  const std::size_t n = raw_size_ - first;
-  const double dt = (t_end - raw_t_[(raw_head_ + first) % kRaw]) / static_cast<double>(n - 1);
-  const auto lag = static_cast<std::size_t>(std::lround(lag_s / dt));
-  if (!(dt > 0.0) || lag == 0 || 2 * lag >= n) return false;
-  const auto mag = [&](std::size_t i) { return raw_f_[(raw_head_ + first + i) % kRaw].norm(); };
-  double mean = 0.0;
-  for (std::size_t i = 0; i < n; ++i) mean += mag(i);
-  mean /= static_cast<double>(n);
-  double num = 0.0, den = 0.0;
-  for (std::size_t i = 0; i + lag < n; ++i) num += (mag(i) - mean) * (mag(i + lag) - mean);
-  for (std::size_t i = 0; i < n; ++i) den += (mag(i) - mean) * (mag(i) - mean);
-  return den > 0.0 && num / den * static_cast<double>(n) / static_cast<double>(n - lag) > 0.3;
-}
-
 void Pdr::learn_interval(double interval_s) {
   // A median, not a running mean: a hand moving the phone makes events at any moment, and two
   // of them 0.3 s apart made the filler count 5 steps for a gap that held 3.
@@ -635,7 +557,7 @@ bool Pdr::phone_step(const ImuSample& s, const Eigen::Matrix3d& m, StepEvent& ev
   // confirmed 0.0-0.4 s after the strike, the arm's turn ~0.05 s): the interval across a handoff
   // is no cadence.
   source.handoff = swing != last_step_by_swing_;
-  source.after_stand = last_step_t_s_ >= 0.0 && quiet_between(last_step_t_s_, s.t_s);
+  source.after_stand = last_step_t_s_ >= 0.0 && recent_.quiet_between(last_step_t_s_, s.t_s);
   // A walk after a stand (the phone still since the last step) begins with its first event
   // held until a second follows within walk_start_intervals with no stand between: a hand
   // moving the phone (putting it away, lifting it to the ear) makes one event, or two far apart.
@@ -643,7 +565,7 @@ bool Pdr::phone_step(const ImuSample& s, const Eigen::Matrix3d& m, StepEvent& ev
     const bool confirmed =
         start_pending_t_s_ >= 0.0 &&
         s.t_s - start_pending_t_s_ < params_.walk_start_intervals * interval_s_ &&
-        !quiet_between(start_pending_t_s_, s.t_s);
+        !recent_.quiet_between(start_pending_t_s_, s.t_s);
     if (!confirmed) {
       start_pending_t_s_ = s.t_s;
       return false;
@@ -682,15 +604,7 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
   const bool foot = params_.mount == StepMount::kFoot;
   if (!foot) {
     pose_.push(s);
-    if (raw_size_ == kRaw) {
-      raw_head_ = (raw_head_ + 1) % kRaw;
-      --raw_size_;
-    }
-    raw_t_[(raw_head_ + raw_size_) % kRaw] = s.t_s;
-    raw_f_[(raw_head_ + raw_size_) % kRaw] = s.acc_body_m_s2;
-    raw_w2_[(raw_head_ + raw_size_) % kRaw] =
-        gyro_ok(s) ? s.gyro_body_rad_s.squaredNorm() : kNoGyroW2;
-    ++raw_size_;
+    recent_.push(s);
   }
   // Into the walking frame of the pose in force (eqs. (14)-(15)).
   const Eigen::Matrix3d m = foot ? Eigen::Matrix3d::Identity() : pose_rotation(pose_.pose());

@@ -49,6 +49,7 @@
 #include "telltale/fusion/imu_sample.hpp"
 #include "telltale/fusion/pdr/bias_learners.hpp"
 #include "telltale/fusion/pdr/pose_classifier.hpp"
+#include "telltale/fusion/pdr/recent_samples.hpp"
 #include "telltale/fusion/pdr/step_length.hpp"
 #include "telltale/fusion/pdr/track.hpp"
 #include "telltale/fusion/pdr/walking_heading.hpp"
@@ -145,8 +146,8 @@ class Pdr {
   /// `output().step_hz` at every step in the caller.
 
  private:
-  static constexpr int kWave = 16;  ///< points per axis in a step waveform
-  using Wave = Eigen::Matrix<double, 3 * kWave, 1>;
+  static constexpr int kWave = RecentSamples::kWave;
+  using Wave = RecentSamples::Wave;
   /// How a phone step was found (phone_step): steps to count with it that the acceleration
   /// missed at a walk's swinging start, whether its detector took over from the other one, and
   /// whether the walker stood still since the last step.
@@ -174,7 +175,6 @@ class Pdr {
   /// Phone-mounted step detection: the acceleration's peaks and valleys, the arm's turns while
   /// the phone swings.
   bool phone_step(const ImuSample& s, const Eigen::Matrix3d& m, StepEvent& ev, StepSource& source);
-  [[nodiscard]] Wave step_wave(double t0_s, double t1_s) const;
 
   Params params_;
   StepLength step_length_;
@@ -191,6 +191,7 @@ class Pdr {
   double start_pending_t_s_ = -1.0;  ///< a walk's first event after a stand, held (phone_step)
   AdaptiveStepDetector foot_steps_;
   PoseClassifier pose_;
+  RecentSamples recent_;  ///< phone pipeline only
   HeadingFilter heading_;
   WalkingDirection walking_;
   HardIronCalibrator mag_cal_;
@@ -199,13 +200,6 @@ class Pdr {
   Track track_;
   Diagnostics diag_;
   PdrOutput out_;
-  // Recent raw accelerations for the step waveforms.
-  static constexpr std::size_t kRaw = 512;
-  std::array<double, kRaw> raw_t_{};
-  std::array<Eigen::Vector3d, kRaw> raw_f_{};
-  std::array<double, kRaw> raw_w2_{};       ///< |w|^2 (kNoGyroW2 without a gyroscope)
-  static constexpr double kNoGyroW2 = 1e6;  ///< far above any stand's
-  std::size_t raw_head_ = 0, raw_size_ = 0;
   std::array<Wave, 2> waves_{};             ///< the last two step waveforms
   std::array<Eigen::Vector3d, 2> tilts_{};  ///< their mean gravity directions (sensor frame)
   /// The up direction tracked by the heading filter (gyro, pulled toward the accelerometer with
@@ -260,13 +254,6 @@ class Pdr {
   std::array<double, kIntervals> intervals_{};
   std::size_t interval_count_ = 0;
   void learn_interval(double interval_s);
-  /// Whether the phone's acceleration repeats itself after `lag_s` (a step interval does).
-  [[nodiscard]] bool walking_period(double lag_s) const;
-  /// Index, from the oldest, of the first raw sample at or after t_s (raw_size_ if none).
-  [[nodiscard]] std::size_t raw_first_at(double t_s) const;
-  /// Whether the phone was still (|f| steady, little rotation) for stand_still_s somewhere in
-  /// [t0, t1]: a stand.
-  [[nodiscard]] bool quiet_between(double t0_s, double t1_s) const;
   // Heading over the current step (circular mean) and of the last three steps.
   double sum_sin_ = 0.0, sum_cos_ = 0.0;
   /// The heading over the last seconds, in 0.1 s bins (sums of unit vectors, since the walking
