@@ -48,6 +48,7 @@
 #include "telltale/fusion/hard_iron.hpp"
 #include "telltale/fusion/imu_sample.hpp"
 #include "telltale/fusion/pdr/bias_learners.hpp"
+#include "telltale/fusion/pdr/phone_steps.hpp"
 #include "telltale/fusion/pdr/pose_classifier.hpp"
 #include "telltale/fusion/pdr/recent_samples.hpp"
 #include "telltale/fusion/pdr/step_length.hpp"
@@ -82,13 +83,10 @@ struct PdrParams {
   /// A walker who stops and then moves the phone (puts it away, lifts it to the ear) makes
   /// events after a gap that held no steps (2-3 steps too many on 10 of 400 loops). 0: off.
   double stand_still_s = 0.6;
-  /// After a stand a walk's first event counts only if a second follows within this many step
-  /// intervals, without a stand between (the hand's movement made 1-2 lone events). 0: off.
-  double walk_start_intervals = 2.0;
   /// A stand's rotation rate, rms: a still hand (0.05 rad/s), not a swinging arm (1-3 rad/s).
   double stand_gyro_rad_s = 0.2;
   double min_step_interval_s = 0.2;  ///< 5 steps/s, a sprinter's: shorter is no cadence
-  double walk_pause_s = 2.0;         ///< no step for this long: the next is a new walk
+  PhoneStepParams phone_steps;
   GyroBiasParams gyro_bias;
   AccBiasParams acc_bias;
   PoseClassifierParams pose;
@@ -148,14 +146,6 @@ class Pdr {
  private:
   static constexpr int kWave = RecentSamples::kWave;
   using Wave = RecentSamples::Wave;
-  /// How a phone step was found (phone_step): steps to count with it that the acceleration
-  /// missed at a walk's swinging start, whether its detector took over from the other one, and
-  /// whether the walker stood still since the last step.
-  struct StepSource {
-    int backfill = 0;
-    bool handoff = false;
-    bool after_stand = false;  ///< the phone stood still since the last step (quiet_between)
-  };
   void on_step(double t_s, StepSource source);
   /// Counts the step (and the steps a gap held, the cadence learnt from it); returns how many
   /// more than `per_event` this event stands for.
@@ -172,23 +162,11 @@ class Pdr {
   /// switch or a gap gives it, the track, and what a later re-laying needs.
   void lay_step(double t_s, double t_prev, double per_event, int missed, double walked_rad,
                 const std::array<Eigen::Vector3d, 2>& ups_before);
-  /// Phone-mounted step detection: the acceleration's peaks and valleys, the arm's turns while
-  /// the phone swings.
-  bool phone_step(const ImuSample& s, const Eigen::Matrix3d& m, StepEvent& ev, StepSource& source);
 
   Params params_;
   StepLength step_length_;
-  PeakValleyStepDetector phone_steps_;
-  SwingStepDetector swing_steps_;  ///< steps while the phone swings (its turns)
-  bool last_step_by_swing_ = false;
-  struct Walk {  ///< since the last pause (phone_step)
-    double last_event_t_s = -1e9;
-    int swing_events = 0;  ///< the arm's turns
-    int steps = 0;         ///< steps counted (either detector)
-    bool backfilled = false;
-  } walk_;
-  int filled_row_ = 0;               ///< steps in a row that filled a gap
-  double start_pending_t_s_ = -1.0;  ///< a walk's first event after a stand, held (phone_step)
+  PhoneSteps phone_steps_;
+  int filled_row_ = 0;  ///< steps in a row that filled a gap
   AdaptiveStepDetector foot_steps_;
   PoseClassifier pose_;
   RecentSamples recent_;  ///< phone pipeline only
