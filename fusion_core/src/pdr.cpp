@@ -3,7 +3,6 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <sstream>
 
 #include "pose_bp_data.hpp"
@@ -15,11 +14,6 @@ constexpr double kTwoPi = 2.0 * M_PI;
 
 bool gyro_ok(const ImuSample& s) { return s.gyro_body_rad_s.allFinite(); }
 
-/// Slot of a (possibly negative) running index in a ring of n.
-std::size_t ring_slot(std::int64_t id, std::size_t n) {
-  const auto m = static_cast<std::int64_t>(n);
-  return static_cast<std::size_t>(((id % m) + m) % m);
-}
 }  // namespace
 
 // --- model file -------------------------------------------------------------------------------
@@ -120,57 +114,27 @@ Pdr::Pdr(Params params, const PoseNetwork& net, const StepLengthModel& lengths)
       pose_(params.pose, net),
       recent_(StandLimits{params.stand_still_s, params.stand_gyro_rad_s,
                           params.gyro_bias.acc_std_m_s2}),
+      gaps_(params.gaps),
       heading_(params.heading),
       walking_(params.walking_direction),
       mag_cal_(params.hard_iron),
       gyro_bias_(params.gyro_bias),
       acc_bias_(params.acc_bias),
-      track_(params.track, params.calibrate_mag) {
-  heading_bin_id_.fill(std::numeric_limits<std::int64_t>::min());
-}
+      track_(params.track, params.calibrate_mag) {}
 
 const StepDiagnostics& Pdr::step_diagnostics() const {
   return params_.mount == StepMount::kFoot ? foot_steps_.diagnostics() : phone_steps_.diagnostics();
 }
 
 int Pdr::count_steps(double t_s, const StepSource& source, double per_event) {
-  // Steps the detector missed (our addition): its thresholds follow the last steps' peaks and
-  // valleys, so after an arm swing the smaller steps of the next pose go unseen until its
-  // memory resets (4-9 steps lost per arm-swing exit, measured; not always while a switch is
-  // detected). A gap of about n step intervals while the phone kept moving like a walk
-  // (acceleration energy over the last window) counts n - 1 more steps; a stop does not.
-  int missed = 0;
-  const double gap = t_s - last_step_t_s_;
-  if (params_.mount != StepMount::kFoot && last_step_t_s_ >= 0.0 && interval_s_ > 0.0) {
-    const double ratio = gap / interval_s_;
-    if (ratio > params_.fill_min_ratio && gap < params_.fill_max_gap_s &&
-        pose_.window().features().acc_energy > params_.fill_min_energy && !source.after_stand)
-      missed = static_cast<int>(std::lround(ratio)) - 1;
-  }
-  // Filling in needs a cadence that was measured. A gap after every step is no missed step but a
-  // cadence that is wrong (learnt from two detections of one step, or from a detector that has
-  // since locked onto the stride): after kMaxFilledRow filled steps in a row the cadence is
-  // learnt again from the gaps. (Learning it from the gaps divided by the steps filled into
-  // them kept any wrong cadence for ever: 2 or 8 steps counted for every one.)
-  constexpr int kMaxFilledRow = 10;
-  filled_row_ = missed > 0 ? filled_row_ + 1 : 0;
-  if (filled_row_ > kMaxFilledRow && !recent_.walking_period(interval_s_)) {
-    missed = 0;
-    filled_row_ = 0;
-    interval_s_ = 0.0;
-    interval_count_ = 0;
-  }
-  if (last_step_t_s_ >= 0.0 && missed == 0 && !source.handoff) {
-    const double interval = gap / per_event;
-    if (interval >= params_.min_step_interval_s && interval < 2.0) learn_interval(interval);
-  }
+  int missed = gaps_.at_step(t_s, source, per_event, params_.mount != StepMount::kFoot,
+                             pose_.window().features().acc_energy, recent_);
   missed += source.backfill;  // the start of a swinging walk (PhoneSteps)
   diag_.filled_steps += static_cast<unsigned>(missed);
   out_.steps += static_cast<std::size_t>(missed);
-  last_step_t_s_ = t_s;
   out_.steps += static_cast<std::size_t>(per_event);
-  if (interval_s_ > 0.0) {
-    out_.step_hz = 1.0 / interval_s_;
+  if (gaps_.interval_s() > 0.0) {
+    out_.step_hz = 1.0 / gaps_.interval_s();
     out_.cadence_spm = 60.0 * out_.step_hz;
   }
   const double f = out_.step_hz;
@@ -268,7 +232,7 @@ void Pdr::classify_pose(double t_s) {
     if (!r.isIdentity(1e-9)) {
       heading_.change_frame(r);  // new walking frame: heading again from the magnetometer
       sum_sin_ = sum_cos_ = 0.0;
-      heading_bins_from_t_s_ = t_s;
+      gaps_.new_frame(t_s);
     }
     if (change->to != change->from) {
       if (!change->first) ++diag_.pose_changes;
@@ -294,7 +258,7 @@ void Pdr::on_step(double t_s, StepSource source) {
   track_.begin_step();
   const std::array<Eigen::Vector3d, 2> ups_before = ups_;
   const double per_event = foot ? 2.0 : 1.0;  // a foot sensor sees one event per two steps
-  const double t_prev = last_step_t_s_;
+  const double t_prev = gaps_.last_step_t_s();
   const int missed = count_steps(t_s, source, per_event);
   if (!foot) {
     acc_bias_.at_step(t_s, mag_cal_.offset_uT());
@@ -334,7 +298,7 @@ void Pdr::lay_step(double t_s, double t_prev, double per_event, int missed, doub
   if (missed > 0 && !replaced) {
     // The steps a gap held are laid along the heading the gap had part by part (a corner walked
     // while the detector was blind is a corner, not a diagonal): one displacement, the chord.
-    const Eigen::Vector2d turn = gap_turn(t_prev, t_s, static_cast<int>(per_event) + missed);
+    const Eigen::Vector2d turn = gaps_.gap_turn(t_prev, t_s, static_cast<int>(per_event) + missed);
     heading = wrap_2pi(heading + std::atan2(turn.y(), turn.x()));
     len *= turn.norm();
   }
@@ -379,67 +343,6 @@ void Pdr::book_laid_step(const SwitchStep& laid, double heading,
     last_ups_before_.back() = ups_before;
     last_count_ = std::min(last_count_ + 1, kLookback);
   }
-}
-
-void Pdr::learn_interval(double interval_s) {
-  // A median, not a running mean: a hand moving the phone makes events at any moment, and two
-  // of them 0.3 s apart made the filler count 5 steps for a gap that held 3.
-  for (std::size_t i = 0; i + 1 < kIntervals; ++i) intervals_[i] = intervals_[i + 1];
-  intervals_.back() = interval_s;
-  interval_count_ = std::min(interval_count_ + 1, kIntervals);
-  // The newest interval_count_ of them, sorted by insertion (at most 5).
-  std::array<double, kIntervals> sorted{};
-  const std::size_t n = interval_count_;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double v = intervals_[kIntervals - n + i];
-    std::size_t j = i;
-    for (; j > 0 && sorted[j - 1] > v; --j) sorted[j] = sorted[j - 1];
-    sorted[j] = v;
-  }
-  const std::size_t mid = n / 2;
-  interval_s_ = n % 2 ? sorted[mid] : 0.5 * (sorted[mid - 1] + sorted[mid]);
-}
-
-void Pdr::add_heading_bin(double t_s, const Eigen::Vector2d& unit) {
-  const auto id = static_cast<std::int64_t>(std::floor(t_s / kHeadingBinS));
-  const std::size_t slot = ring_slot(id, kHeadingBins);
-  if (heading_bin_id_[slot] != id) {
-    heading_bin_id_[slot] = id;
-    heading_bins_[slot].setZero();
-  }
-  heading_bins_[slot] += unit;
-}
-
-Eigen::Vector2d Pdr::gap_turn(double t0_s, double t1_s, int parts) const {
-  const Eigen::Vector2d none(1.0, 0.0);
-  if (parts < 2 || !(t1_s > t0_s) || t0_s < heading_bins_from_t_s_ ||
-      t1_s - t0_s > kHeadingBinS * static_cast<double>(kHeadingBins - 2))
-    return none;
-  // Each part's heading: the circular mean of the bins its interval covers.
-  std::array<Eigen::Vector2d, kHeadingBins> part{};
-  Eigen::Vector2d all = Eigen::Vector2d::Zero();
-  const double span = (t1_s - t0_s) / parts;
-  for (int j = 0; j < parts; ++j) {
-    const double a = t0_s + j * span, b = a + span;
-    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
-    for (auto id = static_cast<std::int64_t>(std::floor(a / kHeadingBinS));
-         static_cast<double>(id) * kHeadingBinS < b; ++id) {
-      const std::size_t slot = ring_slot(id, kHeadingBins);
-      if (heading_bin_id_[slot] == id) sum += heading_bins_[slot];
-    }
-    if (!(sum.norm() > 1e-9)) return none;  // a part with no heading: no better than one
-    part[static_cast<std::size_t>(j)] = sum.normalized();
-    all += sum;
-  }
-  // Relative to the whole gap's mean: rotate each part's unit vector back by the mean's angle.
-  const double mean = std::atan2(all.y(), all.x());
-  Eigen::Vector2d turn = Eigen::Vector2d::Zero();
-  for (int j = 0; j < parts; ++j) {
-    const Eigen::Vector2d& u = part[static_cast<std::size_t>(j)];
-    const double h = std::atan2(u.y(), u.x()) - mean;
-    turn += Eigen::Vector2d(std::cos(h), std::sin(h));
-  }
-  return turn / parts;
 }
 
 void Pdr::forget_vertical_field() { acc_bias_.forget(last_t_s_ + 3.0 * params_.heading.up_tau_s); }
@@ -586,7 +489,7 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
     const Eigen::Vector2d unit(std::cos(heading_.heading_rad()), std::sin(heading_.heading_rad()));
     sum_sin_ += unit.y();
     sum_cos_ += unit.x();
-    add_heading_bin(s.t_s, unit);
+    gaps_.add_heading(s.t_s, unit);
     step_up_ += m.transpose() * heading_.state().up;
     if (!out_.step)
       out_.heading_deg = switching_ && have_replacement_ ? replacement_heading_rad_ * 180.0 / M_PI
@@ -594,9 +497,10 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
   }
   StepEvent ev;
   StepSource source;
-  const bool step = foot ? foot_steps_.update(s, ev)
-                         : phone_steps_.update(s, m.transpose() * heading_.state().up,
-                                               last_step_t_s_, interval_s_, recent_, ev, source);
+  const bool step =
+      foot ? foot_steps_.update(s, ev)
+           : phone_steps_.update(s, m.transpose() * heading_.state().up, gaps_.last_step_t_s(),
+                                 gaps_.interval_s(), recent_, ev, source);
   if (step) {
     on_step(ev.t_s, source);
     out_.x_m = track_.x_m();

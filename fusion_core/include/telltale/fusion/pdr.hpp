@@ -51,6 +51,7 @@
 #include "telltale/fusion/pdr/phone_steps.hpp"
 #include "telltale/fusion/pdr/pose_classifier.hpp"
 #include "telltale/fusion/pdr/recent_samples.hpp"
+#include "telltale/fusion/pdr/step_gaps.hpp"
 #include "telltale/fusion/pdr/step_length.hpp"
 #include "telltale/fusion/pdr/track.hpp"
 #include "telltale/fusion/pdr/walking_heading.hpp"
@@ -75,17 +76,15 @@ struct PdrParams {
                                        ///< (twice this much is a switch whatever the correlation)
   int switch_exit_steps = 2;           ///< correlated steps needed to leave a switch
   int pose_window_steps = 10;          ///< steps after a switch to confirm the new pose
-  double fill_min_ratio = 1.6;     ///< a gap this many step intervals long has missed steps...
-  double fill_max_gap_s = 4.0;     ///< ...if shorter than this...
-  double fill_min_energy = 0.5;    ///< ...and the phone's acceleration energy says walking
-  /// ...and held no stand: the phone still (|f| within gyro_bias.acc_std_m_s2, rotating at less
-  /// than stand_gyro_rad_s rms) for stand_still_s.
+  /// A stand: the phone still (|f| within gyro_bias.acc_std_m_s2, rotating at less than
+  /// stand_gyro_rad_s rms) for stand_still_s. A gap that held one has no missed steps
+  /// (StepGaps), and a walk after one must confirm its start (PhoneSteps).
   /// A walker who stops and then moves the phone (puts it away, lifts it to the ear) makes
   /// events after a gap that held no steps (2-3 steps too many on 10 of 400 loops). 0: off.
   double stand_still_s = 0.6;
   /// A stand's rotation rate, rms: a still hand (0.05 rad/s), not a swinging arm (1-3 rad/s).
   double stand_gyro_rad_s = 0.2;
-  double min_step_interval_s = 0.2;  ///< 5 steps/s, a sprinter's: shorter is no cadence
+  StepGapParams gaps;
   PhoneStepParams phone_steps;
   GyroBiasParams gyro_bias;
   AccBiasParams acc_bias;
@@ -166,10 +165,10 @@ class Pdr {
   Params params_;
   StepLength step_length_;
   PhoneSteps phone_steps_;
-  int filled_row_ = 0;  ///< steps in a row that filled a gap
   AdaptiveStepDetector foot_steps_;
   PoseClassifier pose_;
   RecentSamples recent_;  ///< phone pipeline only
+  StepGaps gaps_;
   HeadingFilter heading_;
   WalkingDirection walking_;
   HardIronCalibrator mag_cal_;
@@ -225,28 +224,8 @@ class Pdr {
   /// -z axes: the walking direction if the pose's forward axis is that one.
   std::array<Eigen::Vector2d, 2> axis_sum_{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
   int wave_count_ = 0;
-  double last_step_t_s_ = -1.0;
-  /// The step interval: the median of the last kIntervals measured ones (0 until one is).
-  double interval_s_ = 0.0;
-  static constexpr std::size_t kIntervals = 5;
-  std::array<double, kIntervals> intervals_{};
-  std::size_t interval_count_ = 0;
-  void learn_interval(double interval_s);
   // Heading over the current step (circular mean) and of the last three steps.
   double sum_sin_ = 0.0, sum_cos_ = 0.0;
-  /// The heading over the last seconds, in 0.1 s bins (sums of unit vectors, since the walking
-  /// frame last changed): a step that fills a gap lays the steps it adds along the heading each
-  /// part of the gap had (gap_turn).
-  static constexpr std::size_t kHeadingBins = 64;
-  static constexpr double kHeadingBinS = 0.1;
-  std::array<Eigen::Vector2d, kHeadingBins> heading_bins_{};
-  std::array<std::int64_t, kHeadingBins> heading_bin_id_{};
-  double heading_bins_from_t_s_ = 0.0;
-  void add_heading_bin(double t_s, const Eigen::Vector2d& unit);  ///< (cos, sin) of the heading
-  /// For a gap [t0, t1] walked in `parts` equal steps: the mean of the unit vectors of each
-  /// part's heading relative to the whole gap's (x along, y clockwise); (1, 0) when the bins do
-  /// not cover the gap.
-  [[nodiscard]] Eigen::Vector2d gap_turn(double t0_s, double t1_s, int parts) const;
   std::array<double, 5> recent_heading_rad_{};  ///< oldest first
   int recent_count_ = 0;
   bool switching_ = false;
