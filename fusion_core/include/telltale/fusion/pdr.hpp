@@ -35,6 +35,11 @@
 /// left, z up with `v_walking = M_pose v_sensor` (M = I for hand-held and arm swing). Position is
 /// x east, y north (m) from the start; heading clockwise from north.
 ///
+/// Structure: Pdr orders the work of a sample and of a step, and detects and re-lays pose
+/// switches; each stage it calls owns its state and its Params (a member of PdrParams), one
+/// file pair each in pdr/ (docs/pdr.md lists them): phone_steps, recent_samples, step_gaps,
+/// pose_classifier, step_length, walking_heading, bias_learners, track.
+///
 /// Memory: fixed-size buffers and Eigen fixed-size types, no heap in update().
 
 #include <array>
