@@ -184,15 +184,10 @@ void Pdr::begin_switch() {
   switching_ = true;
   settling_ = false;
   correlated_steps_ = 0;
-  switch_steps_ = 0;
   // The phone may have begun to move a step or two before the waveforms said so: those
   // steps join the switch (re-laid at its end) and the up direction before them is the
   // old pose's.
-  const std::size_t back = last_count_;
-  pre_switch_ups_ = back > 0 ? last_ups_before_[kLookback - back] : ups_;
-  for (std::size_t i = kLookback - back; i < kLookback; ++i)
-    switch_[static_cast<std::size_t>(switch_steps_++)] = last_steps_[i];
-  last_count_ = 0;
+  const std::size_t back = relay_.begin(ups_);
   reset_walking_direction();
   ++diag_.switches;
   forget_vertical_field();
@@ -322,11 +317,10 @@ void Pdr::lay_step(double t_s, double t_prev, double per_event, int missed, doub
 
 void Pdr::book_laid_step(const SwitchStep& laid, double heading,
                          const std::array<Eigen::Vector3d, 2>& ups_before) {
-  if (switching_ && switch_steps_ < static_cast<int>(switch_.size()))
-    switch_[static_cast<std::size_t>(switch_steps_++)] = laid;
-  if (!switching_ && switch_steps_ > 0) {
+  if (switching_) relay_.add(laid);
+  if (!switching_ && !relay_.empty()) {
     relay_switch_steps(heading, pose_.pose());
-    switch_steps_ = 0;
+    relay_.clear();
   } else if (const auto candidate = pose_.candidate(); switching_ && candidate) {
     // Meanwhile the switch's steps are laid as the pose the classifier now sees would lay them
     // (again at every step, each time from the latest up direction): a walk may end before the
@@ -334,15 +328,7 @@ void Pdr::book_laid_step(const SwitchStep& laid, double heading,
     // where they went, not along the heading from before the switch.
     relay_switch_steps(std::nullopt, *candidate);
   }
-  if (!switching_ && params_.mount != StepMount::kFoot) {
-    for (std::size_t i = 0; i + 1 < kLookback; ++i) {
-      last_steps_[i] = last_steps_[i + 1];
-      last_ups_before_[i] = last_ups_before_[i + 1];
-    }
-    last_steps_.back() = laid;
-    last_ups_before_.back() = ups_before;
-    last_count_ = std::min(last_count_ + 1, kLookback);
-  }
+  if (!switching_ && params_.mount != StepMount::kFoot) relay_.keep_last(laid, ups_before);
 }
 
 void Pdr::forget_vertical_field() { acc_bias_.forget(last_t_s_ + 3.0 * params_.heading.up_tau_s); }
@@ -355,78 +341,13 @@ void Pdr::reset_walking_direction() {
 void Pdr::revise_pose_yaw(double corr) {
   const double d = track_.turn_pose(corr);
   if (d == 0.0) return;
-  // Steps a later switch may re-lay must know the heading they now have.
-  const std::size_t n = std::min(last_count_, track_.pose_steps());
-  for (std::size_t i = kLookback - n; i < kLookback; ++i)
-    last_steps_[i].laid_rad = wrap_2pi(last_steps_[i].laid_rad - d);
+  relay_.turn_last(d, track_.pose_steps());
 }
 
 void Pdr::relay_switch_steps(std::optional<double> heading_after, PhonePose pose) {
-  // At each step of a pose switch and at the first after it (our addition to seed 003). While
-  // the phone was moved, the steps were laid with the heading from before the switch; with the
-  // pose the classifier sees (at the end, the confirmed one), each switch step is given the
-  // heading it really had:
-  //  - steps whose up direction (sensor frame, gyro-tracked: a corner's centripetal
-  //    acceleration does not tilt it) already matches the new steady one (same foot: an arm
-  //    swing alternates): the phone was in its new place, so the walking
-  //    direction is the new pose's forward axis, from that step's field and gyro-tracked up
-  //    (a turn during the settling steps is then measured, not interpolated);
-  //  - steps still in the old orientation: the heading filter's heading in the old frame;
-  //  - the steps of the movement itself: interpolated between those.
-  const double tol = std::cos(params_.switch_tilt_deg * M_PI / 180.0);
-  const std::size_t axis = pose_rotation(pose)(0, 0) > 0.5 ? 0 : 1;
-  const auto n = static_cast<std::size_t>(switch_steps_);
-  std::array<double, kMaxSwitchSteps> h{};
-  std::array<bool, kMaxSwitchSteps> known{}, in_new{};
-  bool moved = false;
-  for (std::size_t k = 0; k < n; ++k) {
-    const SwitchStep& r = switch_[k];
-    known[k] = false;
-    if (r.up.dot(ups_[r.slot]) > tol) {
-      const Eigen::Vector2d& v = r.axis_sum[axis];
-      if (v.norm() > 1e-9) {
-        h[k] = wrap_2pi(std::atan2(v.x(), v.y()));
-        known[k] = in_new[k] = true;
-      }
-      moved = true;
-    } else if (!moved && r.up.dot(pre_switch_ups_[r.slot]) > tol) {
-      h[k] = r.old_frame_rad;
-      known[k] = true;
-    } else {
-      moved = true;
-    }
-  }
-  // Interpolate the unknown ones between the nearest known headings (the replacement heading
-  // before the first, the heading after the switch after the last).
-  double before = have_replacement_ ? replacement_heading_rad_ : switch_[0].laid_rad;
-  std::size_t before_k = 0;
-  bool have_before_k = false;
-  for (std::size_t k = 0; k < n; ++k) {
-    if (known[k]) {
-      before = h[k];
-      before_k = k;
-      have_before_k = true;
-      continue;
-    }
-    std::size_t next = k;
-    while (next < n && !known[next]) ++next;
-    const double after = next < n ? h[next] : heading_after ? *heading_after : before;
-    const double span =
-        static_cast<double>(next) - (have_before_k ? static_cast<double>(before_k) : -1.0);
-    const double pos =
-        static_cast<double>(k) - (have_before_k ? static_cast<double>(before_k) : -1.0);
-    h[k] = before + std::remainder(after - before, kTwoPi) * pos / span;
-  }
-  for (std::size_t k = 0; k < n; ++k) {
-    SwitchStep& r = switch_[k];
-    track_.shift(r.length_m * (std::sin(h[k]) - std::sin(r.laid_rad)),
-                 r.length_m * (std::cos(h[k]) - std::cos(r.laid_rad)));
-    r.laid_rad = h[k];  // a later re-laying moves it from here
-    // Steps walked in the new pose turn with its walking-direction correction once that is
-    // learnt (revise_pose_yaw), like the pose's later steps: they were laid with its raw axis.
-    if (heading_after && in_new[k])
-      track_.add_to_pose(r.length_m * Eigen::Vector2d(std::sin(h[k]), std::cos(h[k])));
-  }
+  relay_.relay(track_, ups_,
+               have_replacement_ ? std::optional<double>(replacement_heading_rad_) : std::nullopt,
+               heading_after, pose, params_.switch_tilt_deg);
 }
 
 const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT) {

@@ -1,8 +1,17 @@
 #include "telltale/fusion/pdr/track.hpp"
 
+#include <algorithm>
 #include <cmath>
 
+#include "telltale/fusion/pdr/pose_classifier.hpp"
+#include "telltale/fusion/pdr/walking_heading.hpp"
+
 namespace telltale::fusion {
+namespace {
+
+constexpr double kTwoPi = 2.0 * M_PI;
+
+}  // namespace
 
 void Track::begin_step() {
   have_step_sens_ = sens_n_ > 0;
@@ -60,6 +69,104 @@ void Track::new_pose() {
   pose_disp_.setZero();
   pose_corr_rad_ = 0.0;
   pose_steps_ = 0;
+}
+
+// --- pose switches ------------------------------------------------------------------------------
+std::size_t SwitchRelay::begin(const std::array<Eigen::Vector3d, 2>& ups) {
+  count_ = 0;
+  const std::size_t back = last_count_;
+  ups_before_switch_ = back > 0 ? last_ups_before_[kLookback - back] : ups;
+  for (std::size_t i = kLookback - back; i < kLookback; ++i) steps_[count_++] = last_[i];
+  last_count_ = 0;
+  return back;
+}
+
+void SwitchRelay::keep_last(const SwitchStep& laid,
+                            const std::array<Eigen::Vector3d, 2>& ups_before) {
+  for (std::size_t i = 0; i + 1 < kLookback; ++i) {
+    last_[i] = last_[i + 1];
+    last_ups_before_[i] = last_ups_before_[i + 1];
+  }
+  last_.back() = laid;
+  last_ups_before_.back() = ups_before;
+  last_count_ = std::min(last_count_ + 1, kLookback);
+}
+
+void SwitchRelay::turn_last(double d_rad, std::size_t pose_steps) {
+  // Steps a later switch may re-lay must know the heading they now have.
+  const std::size_t n = std::min(last_count_, pose_steps);
+  for (std::size_t i = kLookback - n; i < kLookback; ++i)
+    last_[i].laid_rad = wrap_2pi(last_[i].laid_rad - d_rad);
+}
+
+void SwitchRelay::relay(Track& track, const std::array<Eigen::Vector3d, 2>& ups,
+                        std::optional<double> stand_in_rad, std::optional<double> heading_after,
+                        PhonePose pose, double tilt_deg) {
+  // At each step of a pose switch and at the first after it (our addition to seed 003). While
+  // the phone was moved, the steps were laid with the heading from before the switch; with the
+  // pose the classifier sees (at the end, the confirmed one), each switch step is given the
+  // heading it really had:
+  //  - steps whose up direction (sensor frame, gyro-tracked: a corner's centripetal
+  //    acceleration does not tilt it) already matches the new steady one (same foot: an arm
+  //    swing alternates): the phone was in its new place, so the walking
+  //    direction is the new pose's forward axis, from that step's field and gyro-tracked up
+  //    (a turn during the settling steps is then measured, not interpolated);
+  //  - steps still in the old orientation: the heading filter's heading in the old frame;
+  //  - the steps of the movement itself: interpolated between those.
+  const double tol = std::cos(tilt_deg * M_PI / 180.0);
+  const std::size_t axis = pose_rotation(pose)(0, 0) > 0.5 ? 0 : 1;
+  const std::size_t n = count_;
+  std::array<double, kMaxSteps> h{};
+  std::array<bool, kMaxSteps> known{}, in_new{};
+  bool moved = false;
+  for (std::size_t k = 0; k < n; ++k) {
+    const SwitchStep& r = steps_[k];
+    known[k] = false;
+    if (r.up.dot(ups[r.slot]) > tol) {
+      const Eigen::Vector2d& v = r.axis_sum[axis];
+      if (v.norm() > 1e-9) {
+        h[k] = wrap_2pi(std::atan2(v.x(), v.y()));
+        known[k] = in_new[k] = true;
+      }
+      moved = true;
+    } else if (!moved && r.up.dot(ups_before_switch_[r.slot]) > tol) {
+      h[k] = r.old_frame_rad;
+      known[k] = true;
+    } else {
+      moved = true;
+    }
+  }
+  // Interpolate the unknown ones between the nearest known headings (the replacement heading
+  // before the first, the heading after the switch after the last).
+  double before = stand_in_rad ? *stand_in_rad : steps_[0].laid_rad;
+  std::size_t before_k = 0;
+  bool have_before_k = false;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (known[k]) {
+      before = h[k];
+      before_k = k;
+      have_before_k = true;
+      continue;
+    }
+    std::size_t next = k;
+    while (next < n && !known[next]) ++next;
+    const double after = next < n ? h[next] : heading_after ? *heading_after : before;
+    const double span =
+        static_cast<double>(next) - (have_before_k ? static_cast<double>(before_k) : -1.0);
+    const double pos =
+        static_cast<double>(k) - (have_before_k ? static_cast<double>(before_k) : -1.0);
+    h[k] = before + std::remainder(after - before, kTwoPi) * pos / span;
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    SwitchStep& r = steps_[k];
+    track.shift(r.length_m * (std::sin(h[k]) - std::sin(r.laid_rad)),
+                r.length_m * (std::cos(h[k]) - std::cos(r.laid_rad)));
+    r.laid_rad = h[k];  // a later re-laying moves it from here
+    // Steps walked in the new pose turn with its walking-direction correction once that is
+    // learnt (revise_pose_yaw), like the pose's later steps: they were laid with its raw axis.
+    if (heading_after && in_new[k])
+      track.add_to_pose(r.length_m * Eigen::Vector2d(std::sin(h[k]), std::cos(h[k])));
+  }
 }
 
 }  // namespace telltale::fusion

@@ -35,10 +35,10 @@
 /// left, z up with `v_walking = M_pose v_sensor` (M = I for hand-held and arm swing). Position is
 /// x east, y north (m) from the start; heading clockwise from north.
 ///
-/// Structure: Pdr orders the work of a sample and of a step, and detects and re-lays pose
-/// switches; each stage it calls owns its state and its Params (a member of PdrParams), one
-/// file pair each in pdr/ (docs/pdr.md lists them): phone_steps, recent_samples, step_gaps,
-/// pose_classifier, step_length, walking_heading, bias_learners, track.
+/// Structure: Pdr orders the work of a sample and of a step, and detects pose switches; each stage
+/// it calls owns its state and its Params (a member of PdrParams), one file pair each in pdr/
+/// (docs/pdr.md lists them): phone_steps, recent_samples, step_gaps, pose_classifier, step_length,
+/// walking_heading, bias_learners, track.
 ///
 /// Memory: fixed-size buffers and Eigen fixed-size types, no heap in update().
 
@@ -192,24 +192,9 @@ class Pdr {
   std::array<Eigen::Vector3d, 2> ups_{};
   bool settling_ = false;  ///< switch over, waiting for the new pose to be confirmed
   int settling_steps_ = 0;
-  /// A step walked during a pose switch, re-laid when the switch is over.
-  struct SwitchStep {
-    double length_m = 0.0;
-    double laid_rad = 0.0;       ///< heading it was laid with
-    double old_frame_rad = 0.0;  ///< heading filter's heading (pose before the switch)
-    Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  ///< mean tracked up, sensor frame
-    std::size_t slot = 0;                           ///< which foot (waves_/ups_ slot)
-    std::array<Eigen::Vector2d, 2> axis_sum{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
-  };
-  static constexpr std::size_t kMaxSwitchSteps = 32;
-  /// The last steps laid outside a switch, newest last: a switch is seen one or two steps after
-  /// the phone began to move, so those are re-laid with the switch.
-  static constexpr std::size_t kLookback = 2;
-  std::array<SwitchStep, kLookback> last_steps_{};
-  std::array<std::array<Eigen::Vector3d, 2>, kLookback> last_ups_before_{};
-  std::size_t last_count_ = 0;
-  /// Re-lays the switch's steps (switch_) for the phone now in `pose`; `heading_after` is the
-  /// heading of the step after them (none: the switch goes on).
+  SwitchRelay relay_;  ///< the steps of a pose switch, and the last ones before one
+  /// Re-lays the switch's steps for the phone now in `pose`; `heading_after` is the heading of
+  /// the step after them (none: the switch goes on).
   void relay_switch_steps(std::optional<double> heading_after, PhonePose pose);
   /// Keeps a laid step for a switch's re-laying (in the switch, or among the last steps before
   /// one) and re-lays the switch's steps when it ends or the classifier sees a pose.
@@ -220,10 +205,6 @@ class Pdr {
   void forget_vertical_field();
   /// Turns the steps laid in this pose so far with a new yaw correction `corr` (rad).
   void revise_pose_yaw(double corr);
-  std::array<SwitchStep, kMaxSwitchSteps> switch_{};
-  int switch_steps_ = 0;
-  std::array<Eigen::Vector3d, 2> pre_switch_ups_{
-      Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitZ()};  ///< both feet's up before the switch
   std::size_t last_slot_ = 0;
   /// Over the current step, sums of unit (east, north) vectors of the horizontal sensor x and
   /// -z axes: the walking direction if the pose's forward axis is that one.

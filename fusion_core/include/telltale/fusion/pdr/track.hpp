@@ -2,15 +2,19 @@
 /// \file
 /// PDR stage: the track (seed 003 eq. (11), with our revisions). Owns the position and what is
 /// needed to move steps already laid when an estimate they were laid with improves: the
-/// displacement of the pose's steps (turned with a better yaw correction) and each step's
-/// sensitivity to the hard-iron offset (moved with a better offset). Position is x east, y north
+/// displacement of the pose's steps (turned with a better yaw correction), each step's
+/// sensitivity to the hard-iron offset (moved with a better offset), and the steps of a pose
+/// switch (re-laid with the heading each really had, SwitchRelay). Position is x east, y north
 /// (m) from the start; headings clockwise from north.
 ///
 /// Memory: fixed-size Eigen types, no heap.
 
+#include <array>
 #include <cstddef>
+#include <optional>
 
 #include "telltale/fusion/imu_sample.hpp"
+#include "telltale/fusion/phone_pose.hpp"
 
 namespace telltale::fusion {
 
@@ -78,6 +82,55 @@ class Track {
   Eigen::Vector3d sens_sum_ = Eigen::Vector3d::Zero(), step_sens_ = Eigen::Vector3d::Zero();
   int sens_n_ = 0;
   bool have_step_sens_ = false;
+};
+
+/// A laid step, as a pose switch's re-laying needs it.
+struct SwitchStep {
+  double length_m = 0.0;
+  double laid_rad = 0.0;       ///< heading it was laid with
+  double old_frame_rad = 0.0;  ///< heading filter's heading (pose before the switch)
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  ///< mean tracked up, sensor frame
+  std::size_t slot = 0;                           ///< which foot (the waveform slot)
+  /// Over the step, sums of unit (east, north) vectors of the horizontal sensor x and -z axes:
+  /// the walking direction if the pose's forward axis is that one.
+  std::array<Eigen::Vector2d, 2> axis_sum{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
+};
+
+/// The steps of a pose switch, and the last steps laid before one (a switch is seen one or two
+/// steps after the phone began to move, so those are re-laid with it).
+class SwitchRelay {
+ public:
+  static constexpr std::size_t kMaxSteps = 32;
+  static constexpr std::size_t kLookback = 2;
+  /// A switch was detected (`ups`: each foot's up now): the last steps join it, and the up
+  /// direction before them is the old pose's. Returns how many joined.
+  std::size_t begin(const std::array<Eigen::Vector3d, 2>& ups);
+  /// A step laid during the switch (dropped past kMaxSteps).
+  void add(const SwitchStep& laid) {
+    if (count_ < kMaxSteps) steps_[count_++] = laid;
+  }
+  /// A step laid outside a switch; `ups_before`: each foot's up before it.
+  void keep_last(const SwitchStep& laid, const std::array<Eigen::Vector3d, 2>& ups_before);
+  [[nodiscard]] bool empty() const { return count_ == 0; }
+  void clear() { count_ = 0; }
+  /// Re-lays the switch's steps on `track` for the phone now in `pose` (`ups`: each foot's
+  /// steady up now; `tilt_deg`: how far from it an up is another orientation); `stand_in_rad`
+  /// the heading that stood in during the switch, `heading_after` the heading of the step
+  /// after it (none: the switch goes on).
+  void relay(Track& track, const std::array<Eigen::Vector3d, 2>& ups,
+             std::optional<double> stand_in_rad, std::optional<double> heading_after,
+             PhonePose pose, double tilt_deg);
+  /// The last steps of the pose (`pose_steps` of them at most) were turned by `d_rad`.
+  void turn_last(double d_rad, std::size_t pose_steps);
+
+ private:
+  std::array<SwitchStep, kMaxSteps> steps_{};
+  std::size_t count_ = 0;
+  std::array<Eigen::Vector3d, 2> ups_before_switch_{Eigen::Vector3d::UnitZ(),
+                                                    Eigen::Vector3d::UnitZ()};
+  std::array<SwitchStep, kLookback> last_{};  ///< newest last
+  std::array<std::array<Eigen::Vector3d, 2>, kLookback> last_ups_before_{};
+  std::size_t last_count_ = 0;
 };
 
 }  // namespace telltale::fusion
