@@ -1,7 +1,6 @@
 #include "telltale/fusion/pdr.hpp"
 
 #include <Eigen/Dense>
-#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -9,8 +8,6 @@
 
 namespace telltale::fusion {
 namespace {
-
-constexpr double kTwoPi = 2.0 * M_PI;
 
 bool gyro_ok(const ImuSample& s) { return s.gyro_body_rad_s.allFinite(); }
 
@@ -120,7 +117,8 @@ Pdr::Pdr(Params params, const PoseNetwork& net, const StepLengthModel& lengths)
       mag_cal_(params.hard_iron),
       gyro_bias_(params.gyro_bias),
       acc_bias_(params.acc_bias),
-      track_(params.track, params.calibrate_mag) {}
+      track_(params.track, params.calibrate_mag),
+      switch_(params.pose_switch) {}
 
 const StepDiagnostics& Pdr::step_diagnostics() const {
   return params_.mount == StepMount::kFoot ? foot_steps_.diagnostics() : phone_steps_.diagnostics();
@@ -142,87 +140,34 @@ int Pdr::count_steps(double t_s, const StepSource& source, double per_event) {
   return missed;
 }
 
-void Pdr::detect_switch(double t_prev, double t_s) {
-  // Pose switch (seed 003): cross-correlation of this step's waveform with the same foot's
-  // previous one. A turn also changes the waveform, so we add a condition of our own: the
-  // gravity direction in the sensor frame must have moved (the phone was re-oriented).
-  const Wave w = recent_.step_wave(t_prev, t_s);
-  Eigen::Vector3d tilt(w.segment<kWave>(0).mean(), w.segment<kWave>(kWave).mean(),
-                       w.segment<kWave>(2 * kWave).mean());
-  tilt.normalize();
-  const auto slot = static_cast<std::size_t>(wave_count_ % 2);
-  if (wave_count_ >= 2) {
-    const Wave a = w.array() - w.mean();
-    const Wave b = waves_[slot].array() - waves_[slot].mean();
-    const double den = a.norm() * b.norm();
-    const double r = den > 1e-9 ? a.dot(b) / den : 0.0;
-    const double tilt_deg = std::acos(std::clamp(tilt.dot(tilts_[slot]), -1.0, 1.0)) * 180.0 / M_PI;
-    const bool changed = (r < params_.switch_correlation && tilt_deg > params_.switch_tilt_deg) ||
-                         tilt_deg > 2.0 * params_.switch_tilt_deg;
-    if (!switching_ && changed) {
-      begin_switch();
-    } else if (switching_) {
-      correlated_steps_ = (r >= params_.switch_correlation && tilt_deg < params_.switch_tilt_deg)
-                              ? correlated_steps_ + 1
-                              : 0;
-      if (!settling_ && correlated_steps_ >= params_.switch_exit_steps) {
-        // The phone is steady again: wait for fresh classifications of the new pose.
-        settling_ = true;
-        settling_steps_ = 0;
-        pose_.restart_vote();
-      }
+void Pdr::detect_switch(double t_prev, double t_s,
+                        const std::array<Eigen::Vector3d, 2>& ups_before) {
+  switch (switch_.at_step(recent_.step_wave(t_prev, t_s))) {
+    case PoseSwitch::Event::kBegan: {
+      // The phone may have begun to move a step or two before the waveforms said so: those
+      // steps join the switch (re-laid at its end) and the up direction before them is the
+      // old pose's.
+      const std::size_t back = relay_.begin(ups_before);
+      reset_walking_direction();
+      ++diag_.switches;
+      forget_vertical_field();
+      switch_.choose_stand_in(back, params_.walking_direction.straight_deg);
+      break;
     }
-  }
-  waves_[slot] = w;
-  tilts_[slot] = tilt;
-  if (step_up_.norm() > 0.0) ups_[slot] = step_up_.normalized();
-  last_slot_ = slot;
-  ++wave_count_;
-}
-
-void Pdr::begin_switch() {
-  switching_ = true;
-  settling_ = false;
-  correlated_steps_ = 0;
-  // The phone may have begun to move a step or two before the waveforms said so: those
-  // steps join the switch (re-laid at its end) and the up direction before them is the
-  // old pose's.
-  const std::size_t back = relay_.begin(ups_);
-  reset_walking_direction();
-  ++diag_.switches;
-  forget_vertical_field();
-  // If the 3 steps before the switch were straight, their mean heading stands in for
-  // the heading during the switch. The comparison spans two steps, so the switch may
-  // have begun during the latest step: the 3 steps before the re-laid ones (at least
-  // the latest) are the ones known to be clean.
-  have_replacement_ = false;
-  const std::size_t skip = std::max<std::size_t>(1, back);
-  const std::size_t n_recent = recent_heading_rad_.size();
-  if (static_cast<std::size_t>(recent_count_) >= 3 + skip) {
-    const std::size_t i0 = n_recent - skip - 3;
-    double s = 0, c = 0;
-    for (std::size_t i = i0; i < i0 + 3; ++i) {
-      s += std::sin(recent_heading_rad_[i]);
-      c += std::cos(recent_heading_rad_[i]);
-    }
-    const double mean = std::atan2(s, c);
-    bool straight = true;
-    for (std::size_t i = i0; i < i0 + 3; ++i)
-      straight = straight && std::abs(std::remainder(recent_heading_rad_[i] - mean, kTwoPi)) <
-                                 params_.walking_direction.straight_deg * M_PI / 180.0;
-    if (straight) {
-      replacement_heading_rad_ = wrap_2pi(mean);
-      have_replacement_ = true;
-    }
+    case PoseSwitch::Event::kSettling:
+      pose_.restart_vote();  // the phone is steady again: fresh answers for the new pose
+      break;
+    case PoseSwitch::Event::kNone:
+      break;
   }
 }
 
 void Pdr::classify_pose(double t_s) {
   // Pose: classified at every step (PoseClassifier); a switch that saw no confirmed pose
   // within pose_window_steps keeps the previous one.
-  if (settling_ && ++settling_steps_ > params_.pose_window_steps) settling_ = switching_ = false;
-  if (const auto change = pose_.at_step(settling_, out_.steps)) {
-    settling_ = switching_ = false;
+  switch_.count_settling_step();
+  if (const auto change = pose_.at_step(switch_.settling(), out_.steps)) {
+    switch_.end();
     const Eigen::Matrix3d r = pose_rotation(change->to) * pose_rotation(change->from).transpose();
     if (!r.isIdentity(1e-9)) {
       heading_.change_frame(r);  // new walking frame: heading again from the magnetometer
@@ -244,21 +189,21 @@ double Pdr::walked_heading() {
   sum_sin_ = sum_cos_ = 0.0;
   const double yaw_corr =
       walking_.at_step(heading, pose_.pose() == PhonePose::kArmSwing, heading_.state().up);
-  if (params_.track.revise && !switching_) revise_pose_yaw(yaw_corr);
+  if (params_.track.revise && !switch_.switching()) revise_pose_yaw(yaw_corr);
   return wrap_2pi(heading - yaw_corr);
 }
 
 void Pdr::on_step(double t_s, StepSource source) {
   const bool foot = params_.mount == StepMount::kFoot;
   track_.begin_step();
-  const std::array<Eigen::Vector3d, 2> ups_before = ups_;
+  const std::array<Eigen::Vector3d, 2> ups_before = switch_.ups();
   const double per_event = foot ? 2.0 : 1.0;  // a foot sensor sees one event per two steps
   const double t_prev = gaps_.last_step_t_s();
   const int missed = count_steps(t_s, source, per_event);
   if (!foot) {
     acc_bias_.at_step(t_s, mag_cal_.offset_uT());
-    if (t_prev >= 0.0) detect_switch(t_prev, t_s);
-    step_up_.setZero();
+    if (t_prev >= 0.0) detect_switch(t_prev, t_s, ups_before);
+    switch_.end_step();
     classify_pose(t_s);
   }
   const double walked_rad = walked_heading();
@@ -273,15 +218,12 @@ void Pdr::lay_step(double t_s, double t_prev, double per_event, int missed, doub
   axis_sum_[0].setZero();
   axis_sum_[1].setZero();
   // During a switch the straight heading from before it stands in (begin_switch).
-  const bool replaced = switching_ && have_replacement_;
+  const bool replaced = switch_.switching() && switch_.stand_in_rad();
   if (replaced) {
-    heading = replacement_heading_rad_;
+    heading = *switch_.stand_in_rad();
     ++diag_.replaced_headings;
-  } else if (!switching_) {
-    for (std::size_t i = 0; i + 1 < recent_heading_rad_.size(); ++i)
-      recent_heading_rad_[i] = recent_heading_rad_[i + 1];
-    recent_heading_rad_.back() = heading;
-    recent_count_ = std::min(recent_count_ + 1, static_cast<int>(recent_heading_rad_.size()));
+  } else if (!switch_.switching()) {
+    switch_.note_heading(heading);
   }
   // Eq. (13) and eq. (11). The first step has no frequency yet: the person's usual walk.
   const double hz = out_.step_hz > 0.0 ? out_.step_hz : 1.8;
@@ -303,13 +245,13 @@ void Pdr::lay_step(double t_s, double t_prev, double per_event, int missed, doub
     track_.hold(len);
     return;
   }
-  track_.lay(len, heading, !switching_, mag_cal_.offset_uT());
+  track_.lay(len, heading, !switch_.switching(), mag_cal_.offset_uT());
   SwitchStep laid;  // what a later re-laying of this step needs
   laid.length_m = len;
   laid.laid_rad = heading;
   laid.old_frame_rad = walked_rad;
-  laid.slot = last_slot_;
-  laid.up = ups_[last_slot_];
+  laid.slot = switch_.slot();
+  laid.up = switch_.ups()[switch_.slot()];
   laid.axis_sum = {step_axis_x, step_axis_z};
   book_laid_step(laid, heading, ups_before);
   out_.heading_deg = heading * 180.0 / M_PI;
@@ -317,18 +259,19 @@ void Pdr::lay_step(double t_s, double t_prev, double per_event, int missed, doub
 
 void Pdr::book_laid_step(const SwitchStep& laid, double heading,
                          const std::array<Eigen::Vector3d, 2>& ups_before) {
-  if (switching_) relay_.add(laid);
-  if (!switching_ && !relay_.empty()) {
+  const bool switching = switch_.switching();
+  if (switching) relay_.add(laid);
+  if (!switching && !relay_.empty()) {
     relay_switch_steps(heading, pose_.pose());
     relay_.clear();
-  } else if (const auto candidate = pose_.candidate(); switching_ && candidate) {
+  } else if (const auto candidate = pose_.candidate(); switching && candidate) {
     // Meanwhile the switch's steps are laid as the pose the classifier now sees would lay them
     // (again at every step, each time from the latest up direction): a walk may end before the
     // new pose is confirmed (a phone put away on arrival), and its last metres then point
     // where they went, not along the heading from before the switch.
     relay_switch_steps(std::nullopt, *candidate);
   }
-  if (!switching_ && params_.mount != StepMount::kFoot) relay_.keep_last(laid, ups_before);
+  if (!switching && params_.mount != StepMount::kFoot) relay_.keep_last(laid, ups_before);
 }
 
 void Pdr::forget_vertical_field() { acc_bias_.forget(last_t_s_ + 3.0 * params_.heading.up_tau_s); }
@@ -345,9 +288,8 @@ void Pdr::revise_pose_yaw(double corr) {
 }
 
 void Pdr::relay_switch_steps(std::optional<double> heading_after, PhonePose pose) {
-  relay_.relay(track_, ups_,
-               have_replacement_ ? std::optional<double>(replacement_heading_rad_) : std::nullopt,
-               heading_after, pose, params_.switch_tilt_deg);
+  relay_.relay(track_, switch_.ups(), switch_.stand_in_rad(), heading_after, pose,
+               params_.pose_switch.tilt_deg);
 }
 
 const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT) {
@@ -378,10 +320,11 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
   }
   heading_.update(s.t_s, m * s.gyro_body_rad_s, m * (s.acc_body_m_s2 - acc_bias_.bias_m_s2()),
                   m * mag);
-  if (!foot && !switching_ && params_.acc_bias.learn && mag.allFinite() && heading_.initialised() &&
-      gyro_ok(s) && pose_.pose() != PhonePose::kArmSwing && acc_bias_.settled(s.t_s))
+  if (!foot && !switch_.switching() && params_.acc_bias.learn && mag.allFinite() &&
+      heading_.initialised() && gyro_ok(s) && pose_.pose() != PhonePose::kArmSwing &&
+      acc_bias_.settled(s.t_s))
     acc_bias_.add(s.gyro_body_rad_s, m.transpose() * heading_.state().up, mag);
-  if (!foot && !switching_ && params_.walking_direction.correct && gyro_ok(s)) {
+  if (!foot && !switch_.switching() && params_.walking_direction.correct && gyro_ok(s)) {
     walking_.add(s.t_s, m * s.acc_body_m_s2, m * s.gyro_body_rad_s, heading_.state().up,
                  pose_.pose() == PhonePose::kArmSwing);
   } else {
@@ -411,10 +354,11 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
     sum_sin_ += unit.y();
     sum_cos_ += unit.x();
     gaps_.add_heading(s.t_s, unit);
-    step_up_ += m.transpose() * heading_.state().up;
+    switch_.add_up(m.transpose() * heading_.state().up);
     if (!out_.step)
-      out_.heading_deg = switching_ && have_replacement_ ? replacement_heading_rad_ * 180.0 / M_PI
-                                                         : heading_.heading_rad() * 180.0 / M_PI;
+      out_.heading_deg = switch_.switching() && switch_.stand_in_rad()
+                             ? *switch_.stand_in_rad() * 180.0 / M_PI
+                             : heading_.heading_rad() * 180.0 / M_PI;
   }
   StepEvent ev;
   StepSource source;
@@ -429,7 +373,7 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
     out_.step = true;
   }
   out_.pose = pose_.pose();
-  out_.switching = switching_;
+  out_.switching = switch_.switching();
   return out_;
 }
 

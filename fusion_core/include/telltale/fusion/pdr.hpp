@@ -35,9 +35,9 @@
 /// left, z up with `v_walking = M_pose v_sensor` (M = I for hand-held and arm swing). Position is
 /// x east, y north (m) from the start; heading clockwise from north.
 ///
-/// Structure: Pdr orders the work of a sample and of a step, and detects pose switches; each stage
-/// it calls owns its state and its Params (a member of PdrParams), one file pair each in pdr/
-/// (docs/pdr.md lists them): phone_steps, recent_samples, step_gaps, pose_classifier, step_length,
+/// Structure: Pdr orders the work of a sample and of a step; each stage it calls owns its state
+/// and its Params (a member of PdrParams), one file pair each in pdr/ (docs/pdr.md lists them):
+/// phone_steps, recent_samples, step_gaps, pose_classifier, pose_switch, step_length,
 /// walking_heading, bias_learners, track.
 ///
 /// Memory: fixed-size buffers and Eigen fixed-size types, no heap in update().
@@ -55,6 +55,7 @@
 #include "telltale/fusion/pdr/bias_learners.hpp"
 #include "telltale/fusion/pdr/phone_steps.hpp"
 #include "telltale/fusion/pdr/pose_classifier.hpp"
+#include "telltale/fusion/pdr/pose_switch.hpp"
 #include "telltale/fusion/pdr/recent_samples.hpp"
 #include "telltale/fusion/pdr/step_gaps.hpp"
 #include "telltale/fusion/pdr/step_length.hpp"
@@ -76,11 +77,6 @@ namespace telltale::fusion {
 // ---------------------------------------------------------------------------------------------
 struct PdrParams {
   StepMount mount = StepMount::kBody;  ///< kBody: phone (seed 003); kFoot: toe sensor (seed 004)
-  double switch_correlation = 0.5;     ///< step waveforms correlating less = pose switch...
-  double switch_tilt_deg = 15.0;       ///< ...if gravity also moved this much in the sensor frame
-                                       ///< (twice this much is a switch whatever the correlation)
-  int switch_exit_steps = 2;           ///< correlated steps needed to leave a switch
-  int pose_window_steps = 10;          ///< steps after a switch to confirm the new pose
   /// A stand: the phone still (|f| within gyro_bias.acc_std_m_s2, rotating at less than
   /// stand_gyro_rad_s rms) for stand_still_s. A gap that held one has no missed steps
   /// (StepGaps), and a walk after one must confirm its start (PhoneSteps).
@@ -94,6 +90,7 @@ struct PdrParams {
   GyroBiasParams gyro_bias;
   AccBiasParams acc_bias;
   PoseClassifierParams pose;
+  PoseSwitchParams pose_switch;
   StepLengthParams step_length;
   TrackParams track;
   HeadingFilterParams heading;
@@ -148,16 +145,13 @@ class Pdr {
   /// `output().step_hz` at every step in the caller.
 
  private:
-  static constexpr int kWave = RecentSamples::kWave;
-  using Wave = RecentSamples::Wave;
   void on_step(double t_s, StepSource source);
   /// Counts the step (and the steps a gap held, the cadence learnt from it); returns how many
   /// more than `per_event` this event stands for.
   int count_steps(double t_s, const StepSource& source, double per_event);
   /// Compares the step [t_prev, t_s]'s waveform with the same foot's last: a pose switch
-  /// begins or settles.
-  void detect_switch(double t_prev, double t_s);
-  void begin_switch();
+  /// begins (its steps gathered; `ups_before` each foot's up before this step) or settles.
+  void detect_switch(double t_prev, double t_s, const std::array<Eigen::Vector3d, 2>& ups_before);
   /// The pose classifier's vote at this step, and a new walking frame if it confirms one.
   void classify_pose(double t_s);
   /// The step's walking direction (rad): the heading over the step, yaw-corrected.
@@ -166,6 +160,19 @@ class Pdr {
   /// switch or a gap gives it, the track, and what a later re-laying needs.
   void lay_step(double t_s, double t_prev, double per_event, int missed, double walked_rad,
                 const std::array<Eigen::Vector3d, 2>& ups_before);
+  /// Re-lays the switch's steps for the phone now in `pose`; `heading_after` is the heading of
+  /// the step after them (none: the switch goes on).
+  void relay_switch_steps(std::optional<double> heading_after, PhonePose pose);
+  /// Keeps a laid step for a switch's re-laying (in the switch, or among the last steps before
+  /// one) and re-lays the switch's steps when it ends or the classifier sees a pose.
+  void book_laid_step(const SwitchStep& laid, double heading,
+                      const std::array<Eigen::Vector3d, 2>& ups_before);
+  /// A new pose or a switch: the walking direction and the pose's track revision start again.
+  void reset_walking_direction();
+  /// The phone changed how it sits: the accelerometer bias's vertical field is unknown again.
+  void forget_vertical_field();
+  /// Turns the steps laid in this pose so far with a new yaw correction `corr` (rad).
+  void revise_pose_yaw(double corr);
 
   Params params_;
   StepLength step_length_;
@@ -182,42 +189,12 @@ class Pdr {
   Track track_;
   Diagnostics diag_;
   PdrOutput out_;
-  std::array<Wave, 2> waves_{};             ///< the last two step waveforms
-  std::array<Eigen::Vector3d, 2> tilts_{};  ///< their mean gravity directions (sensor frame)
-  /// The up direction tracked by the heading filter (gyro, pulled toward the accelerometer with
-  /// the turn's centripetal acceleration taken out), sensor frame: summed over the step in
-  /// progress, and its mean over the last two steps. Unlike the waveform's mean acceleration it
-  /// does not tilt in a corner: the switch's re-laying tells by it where the phone sat.
-  Eigen::Vector3d step_up_ = Eigen::Vector3d::Zero();
-  std::array<Eigen::Vector3d, 2> ups_{};
-  bool settling_ = false;  ///< switch over, waiting for the new pose to be confirmed
-  int settling_steps_ = 0;
+  PoseSwitch switch_;  ///< phone pipeline only
   SwitchRelay relay_;  ///< the steps of a pose switch, and the last ones before one
-  /// Re-lays the switch's steps for the phone now in `pose`; `heading_after` is the heading of
-  /// the step after them (none: the switch goes on).
-  void relay_switch_steps(std::optional<double> heading_after, PhonePose pose);
-  /// Keeps a laid step for a switch's re-laying (in the switch, or among the last steps before
-  /// one) and re-lays the switch's steps when it ends or the classifier sees a pose.
-  void book_laid_step(const SwitchStep& laid, double heading,
-                      const std::array<Eigen::Vector3d, 2>& ups_before);
-  void reset_walking_direction();
-  /// The phone changed how it sits: the accelerometer bias's vertical field is unknown again.
-  void forget_vertical_field();
-  /// Turns the steps laid in this pose so far with a new yaw correction `corr` (rad).
-  void revise_pose_yaw(double corr);
-  std::size_t last_slot_ = 0;
   /// Over the current step, sums of unit (east, north) vectors of the horizontal sensor x and
   /// -z axes: the walking direction if the pose's forward axis is that one.
   std::array<Eigen::Vector2d, 2> axis_sum_{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
-  int wave_count_ = 0;
-  // Heading over the current step (circular mean) and of the last three steps.
-  double sum_sin_ = 0.0, sum_cos_ = 0.0;
-  std::array<double, 5> recent_heading_rad_{};  ///< oldest first
-  int recent_count_ = 0;
-  bool switching_ = false;
-  int correlated_steps_ = 0;
-  double replacement_heading_rad_ = 0.0;
-  bool have_replacement_ = false;
+  double sum_sin_ = 0.0, sum_cos_ = 0.0;  ///< heading over the current step (circular mean)
   bool have_t_ = false;
   double last_t_s_ = 0.0;
 };
