@@ -217,7 +217,7 @@ void Pdr::lay_step(double t_s, double t_prev, double per_event, int missed, doub
   const Eigen::Vector2d step_axis_x = axis_sum_[0], step_axis_z = axis_sum_[1];
   axis_sum_[0].setZero();
   axis_sum_[1].setZero();
-  // During a switch the straight heading from before it stands in (begin_switch).
+  // During a switch the straight heading from before it stands in (PoseSwitch::choose_stand_in).
   const bool replaced = switch_.switching() && switch_.stand_in_rad();
   if (replaced) {
     heading = *switch_.stand_in_rad();

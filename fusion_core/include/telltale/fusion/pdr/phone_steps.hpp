@@ -27,7 +27,8 @@ struct PhoneStepParams {
 struct StepSource {
   int backfill = 0;
   bool handoff = false;
-  bool after_stand = false;  ///< the phone stood still since the last step (quiet_between)
+  /// The phone stood still since the last step (RecentSamples::quiet_between).
+  bool after_stand = false;
 };
 
 class PhoneSteps {
