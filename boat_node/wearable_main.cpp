@@ -167,8 +167,8 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   // held in front), body -> the seed-003 Pdr with its four poses, foot -> the foot Pdr.
   fusion::PdrParams params;
   params.mount = foot ? fusion::StepMount::kFoot : fusion::StepMount::kBody;
-  params.height_m = o.height_m;
-  params.step_scale.fill(o.step_scale);
+  params.step_length.height_m = o.height_m;
+  params.step_length.scale.fill(o.step_scale);
   std::unique_ptr<fusion::Pdr> pdr;                 // 110 kB: not on the stack
   std::unique_ptr<fusion::HandheldPdr> phone_pdr;
   if (handheld) {

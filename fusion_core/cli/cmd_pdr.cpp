@@ -74,8 +74,8 @@ void run_pdr(const PdrOptions& o) {
     return;
   }
   fusion::PdrParams params;
-  params.height_m = o.height_m;
-  params.step_scale.fill(o.step_scale);
+  params.step_length.height_m = o.height_m;
+  params.step_length.scale.fill(o.step_scale);
   params.mount = o.mount == "foot" ? fusion::StepMount::kFoot : fusion::StepMount::kBody;
   fusion::Pdr pdr(params);
   io::CsvWriter track(o.out, {"t_s", "x_m", "y_m", "heading_deg", "pose", "steps", "distance_m",

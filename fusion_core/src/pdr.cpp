@@ -1,218 +1,17 @@
 #include "telltale/fusion/pdr.hpp"
 
 #include <Eigen/Dense>
-#include <algorithm>
-#include <charconv>
 #include <cmath>
-#include <limits>
-#include <numeric>
-#include <random>
 #include <sstream>
 
 #include "pose_bp_data.hpp"
-#include "telltale/fusion/attitude.hpp"
 
 namespace telltale::fusion {
 namespace {
 
-constexpr double kTwoPi = 2.0 * M_PI;
-
-double wrap_2pi(double a) {
-  a = std::fmod(a, kTwoPi);
-  return a < 0.0 ? a + kTwoPi : a;
-}
-
-double sigmoid(double x) { return 1.0 / (1.0 + std::exp(-x)); }
-
 bool gyro_ok(const ImuSample& s) { return s.gyro_body_rad_s.allFinite(); }
 
-/// Slot of a (possibly negative) running index in a ring of n.
-std::size_t ring_slot(std::int64_t id, std::size_t n) {
-  const auto m = static_cast<std::int64_t>(n);
-  return static_cast<std::size_t>(((id % m) + m) % m);
-}
-
-/// [v]x: the matrix of the cross product v x.
-Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return m;
-}
-
-/// The walking frame's forward (its x axis made horizontal) and left, for an up direction in
-/// that frame; false when x is within ~17 deg of vertical (no forward direction).
-bool horizontal_axes(const Eigen::Vector3d& up, Eigen::Vector3d& fwd, Eigen::Vector3d& left) {
-  fwd = Eigen::Vector3d::UnitX() - up.x() * up;
-  if (!(fwd.norm() > 0.3)) return false;
-  fwd.normalize();
-  left = up.cross(fwd);
-  return true;
-}
-
 }  // namespace
-
-// --- features ---------------------------------------------------------------------------------
-void PoseFeatureWindow::pop() {
-  const ImuSample& s = buf_[head_];
-  const double m = s.acc_body_m_s2.norm();
-  sum_f_ -= s.acc_body_m_s2;
-  sum_f2_ -= s.acc_body_m_s2.cwiseAbs2();
-  sum_m_ -= m;
-  sum_m2_ -= m * m;
-  if (s.gyro_body_rad_s.allFinite()) {
-    sum_w_ -= s.gyro_body_rad_s;
-    sum_w2_ -= s.gyro_body_rad_s.cwiseAbs2();
-    --gyro_count_;
-  }
-  head_ = (head_ + 1) % kCapacity;
-  --size_;
-}
-
-void PoseFeatureWindow::push(const ImuSample& s) {
-  while (size_ > 0 && (size_ == kCapacity || buf_[head_].t_s < s.t_s - window_s_)) pop();
-  buf_[(head_ + size_) % kCapacity] = s;
-  ++size_;
-  const double m = s.acc_body_m_s2.norm();
-  sum_f_ += s.acc_body_m_s2;
-  sum_f2_ += s.acc_body_m_s2.cwiseAbs2();
-  sum_m_ += m;
-  sum_m2_ += m * m;
-  if (s.gyro_body_rad_s.allFinite()) {
-    sum_w_ += s.gyro_body_rad_s;
-    sum_w2_ += s.gyro_body_rad_s.cwiseAbs2();
-    ++gyro_count_;
-  }
-}
-
-double PoseFeatureWindow::span_s() const {
-  if (size_ < 2) return 0.0;
-  return buf_[(head_ + size_ - 1) % kCapacity].t_s - buf_[head_].t_s;
-}
-
-Eigen::Vector3d PoseFeatureWindow::mean_acc() const {
-  return size_ ? Eigen::Vector3d(sum_f_ / static_cast<double>(size_)) : Eigen::Vector3d::Zero();
-}
-
-PoseFeatures PoseFeatureWindow::features() const {
-  PoseFeatures f;
-  if (size_ == 0) return f;
-  const double n = static_cast<double>(size_);
-  const Eigen::Vector3d mean_f = sum_f_ / n;
-  f.acc_energy = std::max(0.0, (sum_f2_ / n - mean_f.cwiseAbs2()).sum());
-  const double mean_m = sum_m_ / n;
-  f.acc_variance = std::max(0.0, sum_m2_ / n - mean_m * mean_m);
-  if (gyro_count_ == 0) {
-    f.gyro_variance = std::nan("");
-  } else {
-    const double ng = static_cast<double>(gyro_count_);
-    const Eigen::Vector3d mean_w = sum_w_ / ng;
-    f.gyro_variance = std::max(0.0, (sum_w2_ / ng - mean_w.cwiseAbs2()).sum());
-  }
-  return f;
-}
-
-// --- BP network -------------------------------------------------------------------------------
-PoseNetwork::Input PoseNetwork::input(const PoseFeatures& f) const {
-  // Log features: the variances span three decades between a phone at the ear and a swinging
-  // arm, and their ratios (not differences) separate the poses.
-  const Input raw(std::log(f.acc_energy + 1e-4), std::log(f.acc_variance + 1e-4),
-                  std::log(f.gyro_variance + 1e-6));
-  return (raw - in_mean).cwiseQuotient(in_scale);
-}
-
-PoseNetwork::Output PoseNetwork::forward(const Input& x) const {
-  // Eq. (4): H_j = f(sum_i w_ij x_i - a_j) with a sigmoid f; eq. (5): O_k = sum_j H_j w_jk - b_k.
-  const Eigen::Matrix<double, kHidden, 1> h = (w_ih * x + b_h).unaryExpr(&sigmoid);
-  return w_ho * h + b_o;
-}
-
-std::optional<PhonePose> PoseNetwork::classify(const PoseFeatures& f) const {
-  if (!trained) return std::nullopt;
-  const Input x = input(f);
-  if (!x.allFinite()) return std::nullopt;
-  Eigen::Index k = 0;
-  forward(x).maxCoeff(&k);
-  return static_cast<PhonePose>(k);
-}
-
-PoseNetwork train_pose_network(const std::vector<PoseFeatures>& features,
-                               const std::vector<PhonePose>& labels, PoseTrainingParams params) {
-  PoseNetwork net;
-  const std::size_t n = std::min(features.size(), labels.size());
-  if (n == 0) return net;
-  // Standardisation from the data (log features).
-  std::vector<PoseNetwork::Input> raw(n);
-  for (std::size_t i = 0; i < n; ++i) raw[i] = net.input(features[i]);
-  PoseNetwork::Input mean = PoseNetwork::Input::Zero(), sq = PoseNetwork::Input::Zero();
-  for (const auto& r : raw) mean += r;
-  mean /= static_cast<double>(n);
-  for (const auto& r : raw) sq += (r - mean).cwiseAbs2();
-  net.in_mean = mean;
-  net.in_scale = (sq / static_cast<double>(n)).cwiseSqrt().cwiseMax(1e-6);
-  std::vector<PoseNetwork::Input> x(n);
-  for (std::size_t i = 0; i < n; ++i) x[i] = (raw[i] - mean).cwiseQuotient(net.in_scale);
-
-  // Step 1: small random initial weights (seeded; uniform +-0.5 from our own transform).
-  std::mt19937_64 rng(params.seed);
-  auto uni = [&rng] { return static_cast<double>(rng() >> 11) * 0x1.0p-53 - 0.5; };
-  for (int i = 0; i < net.w_ih.size(); ++i) net.w_ih.data()[i] = uni();
-  for (int i = 0; i < net.b_h.size(); ++i) net.b_h.data()[i] = uni();
-  for (int i = 0; i < net.w_ho.size(); ++i) net.w_ho.data()[i] = uni();
-  for (int i = 0; i < net.b_o.size(); ++i) net.b_o.data()[i] = uni();
-  std::vector<std::size_t> order(n);
-  std::iota(order.begin(), order.end(), 0);
-  for (int epoch = 0; epoch < params.epochs; ++epoch) {
-    for (std::size_t i = n - 1; i > 0; --i) std::swap(order[i], order[rng() % (i + 1)]);
-    for (const std::size_t i : order) {
-      // Steps 2-3: forward pass.
-      const Eigen::Matrix<double, PoseNetwork::kHidden, 1> h =
-          (net.w_ih * x[i] + net.b_h).unaryExpr(&sigmoid);
-      const PoseNetwork::Output o = net.w_ho * h + net.b_o;
-      // Step 4: error e_k = Y_k - O_k against the one-hot target.
-      PoseNetwork::Output e = -o;
-      e[static_cast<Eigen::Index>(labels[i])] += 1.0;
-      // Steps 5-6 (eqs. (7)-(10)): weights and thresholds along the error gradient.
-      const Eigen::Matrix<double, PoseNetwork::kHidden, 1> back =
-          (net.w_ho.transpose() * e)
-              .cwiseProduct(
-                  h.cwiseProduct(Eigen::Matrix<double, PoseNetwork::kHidden, 1>::Ones() - h));
-      net.w_ho += params.eta * e * h.transpose();
-      net.b_o += params.eta * e;
-      net.w_ih += params.eta * back * x[i].transpose();
-      net.b_h += params.eta * back;
-    }
-  }
-  net.trained = true;
-  return net;
-}
-
-// --- step length ------------------------------------------------------------------------------
-StepLengthModel::StepLengthModel() {
-  // Generic walking coefficients (overridden by the shipped calibration in pose_bp.txt).
-  for (auto& c : abc) c = Eigen::Vector3d(0.3, 0.4, -0.51);
-}
-
-double StepLengthModel::length_m(PhonePose pose, double height_m, double step_hz) const {
-  const Eigen::Vector3d& c = abc[static_cast<std::size_t>(pose)];
-  return std::max(0.0, c[0] * height_m + c[1] * step_hz + c[2]);
-}
-
-Eigen::Vector3d calibrate_step_length(const std::vector<CalibrationWalk>& walks,
-                                      const Eigen::Vector3d& prior, double prior_weight) {
-  // Each walk: a (N h) + b (sum f) + c N = D. Rows are divided by N so every walk weighs the
-  // same whatever its length; ridge toward the prior keeps the unobservable combinations.
-  Eigen::Matrix3d ata = prior_weight * Eigen::Matrix3d::Identity();
-  Eigen::Vector3d atb = prior_weight * prior;
-  for (const auto& w : walks) {
-    if (w.step_hz.empty()) continue;
-    const double n = static_cast<double>(w.step_hz.size());
-    const double mean_f = std::accumulate(w.step_hz.begin(), w.step_hz.end(), 0.0) / n;
-    const Eigen::Vector3d row(w.height_m, mean_f, 1.0);
-    ata += row * row.transpose();
-    atb += row * (w.distance_m / n);
-  }
-  return ata.ldlt().solve(atb);
-}
 
 // --- model file -------------------------------------------------------------------------------
 std::string format_pdr_model(const PoseNetwork& net, const StepLengthModel& len) {
@@ -300,441 +99,135 @@ const Builtin& builtin() {
 const PoseNetwork& builtin_pose_network() { return builtin().net; }
 const StepLengthModel& builtin_step_length_model() { return builtin().len; }
 
-Eigen::Matrix3d pose_rotation(PhonePose pose) {
-  Eigen::Matrix3d m = Eigen::Matrix3d::Identity();
-  if (pose == PhonePose::kCall) m << 0, 0, -1, 0, -1, 0, -1, 0, 0;  // eq. (14)
-  if (pose == PhonePose::kPocket) m << 0, 0, -1, 0, 1, 0, 1, 0, 0;  // eq. (15)
-  return m;
-}
-
-// --- heading ----------------------------------------------------------------------------------
-double HeadingFilter::magnetic_heading_rad(const Eigen::Vector3d& mag, const Eigen::Vector3d& up) {
-  return magnetic_heading_rad(mag, up, Eigen::Vector3d::UnitX());
-}
-
-double HeadingFilter::magnetic_heading_rad(const Eigen::Vector3d& mag, const Eigen::Vector3d& up,
-                                           const Eigen::Vector3d& axis) {
-  const Eigen::Vector3d north = mag - mag.dot(up) * up;
-  const double nn = north.norm();
-  if (!(nn > 1e-6)) return std::nan("");
-  const Eigen::Vector3d n = north / nn;
-  const Eigen::Vector3d e = n.cross(up);
-  const Eigen::Vector3d x = axis - axis.dot(up) * up;
-  if (x.norm() < 0.3) return std::nan("");  // x within ~17 deg of vertical: no heading
-  return wrap_2pi(std::atan2(x.dot(e), x.dot(n)));
-}
-
-void HeadingFilter::pull_up(double dt, const Eigen::Vector3d& gyro, bool gyro_ok, double t_s) {
-  Eigen::Vector3d f = last_acc_;
-  Eigen::Vector3d& up = state_.up;
-  // Walking round a corner (0.6 m radius at 1.4 m/s: 3 m/s^2, 17 deg of tilt) the
-  // accelerometer also reads the centripetal acceleration v w (toward the centre, left for a
-  // left turn); left in, it tilts the up direction, and the magnetic heading by about
-  // tan(dip) times as much, for seconds after every corner.
-  const double w_up = last_gyro_ok_ ? last_gyro_.dot(up) : 0.0;
-  Eigen::Vector3d fwd, left;
-  if (speed_m_s_ > 0.0 && horizontal_axes(up, fwd, left)) f -= speed_m_s_ * w_up * left;
-  // A swinging arm: the hand's pendulum acceleration (+-10 m/s^2 along the walking direction)
-  // swung the up direction +-8 deg round the vertical every stride, and the magnetic heading
-  // turned that into a bias of 2-3 deg that depends on the heading. Rotation about the
-  // horizontal axes only: turning the body is the corner's business (above).
-  const double span = t_s - before_t_s_;
-  if (params_.lever_arm && gyro_ok && last_gyro_ok_ && before_gyro_ok_ && span > 0.0) {
-    const auto horizontal = [&up](const Eigen::Vector3d& v) { return v - v.dot(up) * up; };
-    const Eigen::Vector3d w = horizontal(last_gyro_);
-    const Eigen::Vector3d w_dot = horizontal((gyro - before_gyro_) / span);
-    const Eigen::Matrix3d a = cross_matrix(w_dot) + cross_matrix(w) * cross_matrix(w);
-    const double keep = std::exp(-dt / params_.lever_arm_tau_s);
-    lever_info_ = keep * lever_info_ + a.transpose() * a * dt;
-    lever_sum_ = keep * lever_sum_ + a.transpose() * (f - kStandardGravity_m_s2 * up) * dt;
-    // p changes over the forgetting time (10 s): solved again every 0.1 s, not every sample.
-    if (t_s - lever_solved_t_s_ >= 0.1 || t_s < lever_solved_t_s_) {
-      const double prior = std::pow(params_.lever_arm_noise_m_s2 / params_.lever_arm_prior_m, 2);
-      lever_m_ = (lever_info_ + prior * Eigen::Matrix3d::Identity()).ldlt().solve(lever_sum_);
-      lever_solved_t_s_ = t_s;
-    }
-    f -= a * lever_m_;
-  }
-  if (!(f.norm() > 1e-3)) return;
-  up += dt / (params_.up_tau_s + dt) * (f.normalized() - up);
-  up.normalize();
-}
-
-void HeadingFilter::update(double t_s, const Eigen::Vector3d& gyro, const Eigen::Vector3d& acc,
-                           const Eigen::Vector3d& mag) {
-  if (!std::isfinite(t_s) || !acc.allFinite() || !(acc.norm() > 1e-3)) {
-    ++diag_.rejected_non_finite;
-    return;
-  }
-  const bool gyro_ok = gyro.allFinite();
-  const double dt = up_init_ ? t_s - state_.last_t_s : 0.0;
-  if (up_init_ && !(dt > 0.0)) {
-    ++diag_.rejected_non_finite;
-    return;
-  }
-  const double t_prev = state_.last_t_s;
-  state_.last_t_s = t_s;
-  // Up direction in the walking frame: gyro-propagated (du/dt = u x w for a world-fixed vector),
-  // pulled toward the accelerometer's direction with time constant up_tau_s.
-  if (!up_init_) {
-    state_.up = acc.normalized();
-    up_init_ = true;
-  } else {
-    pull_up(dt, gyro, gyro_ok, t_s);
-    if (gyro_ok) {
-      // A world-fixed vector turns back by the body's rotation: trapezoidal rate, exact
-      // rotation. A swinging arm turns the phone +-30 deg and back every stride, and the
-      // first-order step (u += u x w dt with the end-of-interval rate) drifted the up direction
-      // steadily, held only by the accelerometer's pull.
-      state_.up =
-          interval_rotation(last_gyro_ok_ ? last_gyro_ : gyro, gyro, dt).conjugate() * state_.up;
-    }
-  }
-  before_gyro_ = last_gyro_;
-  before_gyro_ok_ = last_gyro_ok_;
-  before_t_s_ = t_prev;
-  last_gyro_ = gyro;
-  last_gyro_ok_ = gyro_ok;
-  last_acc_ = acc;
-  // Prediction: heading rate = -(yaw rate about up) (heading is clockwise).
-  if (state_.initialised) {
-    const double rate = gyro_ok ? -gyro.dot(state_.up) : 0.0;
-    state_.heading_rad = wrap_2pi(state_.heading_rad + (rate - state_.bias_rad_s) * dt);
-    Eigen::Matrix2d f;
-    f << 1.0, -dt, 0.0, 1.0;
-    const double q_h = gyro_ok ? params_.gyro_noise_rad_s * params_.gyro_noise_rad_s : 1.0;
-    Eigen::Matrix2d q = Eigen::Matrix2d::Zero();
-    q(0, 0) = q_h * dt;
-    q(1, 1) = params_.bias_walk_rad_s2 * params_.bias_walk_rad_s2 * dt;
-    state_.p = f * state_.p * f.transpose() + q;
-  }
-  if (!mag.allFinite()) {
-    if (!state_.initialised) {  // no magnetometer: gyro heading relative to the start
-      state_.heading_rad = 0.0;
-      state_.p = Eigen::Matrix2d::Identity() * 1e-4;
-      state_.initialised = true;
-    }
-    return;
-  }
-  const double z = magnetic_heading_rad(mag, state_.up);
-  if (!std::isfinite(z)) return;
-  const double r = std::pow(params_.mag_noise_deg * M_PI / 180.0, 2);
-  if (!state_.initialised) {
-    state_.heading_rad = z;
-    state_.p << r, 0.0, 0.0, 1e-4;
-    state_.initialised = true;
-    state_.rejected_since_s = -1.0;
-    return;
-  }
-  const double y = std::remainder(z - state_.heading_rad, kTwoPi);
-  if (std::abs(y) > params_.gate_deg * M_PI / 180.0) {
-    ++diag_.rejected_mag;
-    if (state_.rejected_since_s < 0.0) state_.rejected_since_s = t_s;
-    if (t_s - state_.rejected_since_s > params_.reset_after_s) {
-      state_.heading_rad = z;
-      state_.p << r, 0.0, 0.0, 1e-4;
-      state_.rejected_since_s = -1.0;
-      ++diag_.resets;
-    }
-    return;
-  }
-  state_.rejected_since_s = -1.0;
-  const double s = state_.p(0, 0) + r;
-  const Eigen::Vector2d k = state_.p.col(0) / s;
-  state_.heading_rad = wrap_2pi(state_.heading_rad + k[0] * y);
-  state_.bias_rad_s += k[1] * y;
-  const Eigen::Matrix2d ikh = Eigen::Matrix2d::Identity() - k * Eigen::RowVector2d(1.0, 0.0);
-  state_.p = ikh * state_.p;
-}
-
 // --- PDR --------------------------------------------------------------------------------------
 Pdr::Pdr(Params params, const PoseNetwork& net, const StepLengthModel& lengths)
     : params_(params),
-      net_(net),
-      lengths_(lengths),
+      step_length_(params.step_length, lengths),
+      phone_steps_(params.phone_steps),
       foot_steps_([] {
         AdaptiveStepParams p;
         return p;
       }()),
-      features_(params.feature_window_s),
+      pose_(params.pose, net),
+      recent_(StandLimits{params.stand_still_s, params.stand_gyro_rad_s,
+                          params.gyro_bias.acc_std_m_s2}),
+      gaps_(params.gaps),
       heading_(params.heading),
-      mag_cal_(params.hard_iron) {
-  heading_bin_id_.fill(std::numeric_limits<std::int64_t>::min());
-}
+      walking_(params.walking_direction),
+      mag_cal_(params.hard_iron),
+      gyro_bias_(params.gyro_bias),
+      acc_bias_(params.acc_bias),
+      track_(params.track, params.calibrate_mag),
+      switch_(params.pose_switch) {}
 
 const StepDiagnostics& Pdr::step_diagnostics() const {
   return params_.mount == StepMount::kFoot ? foot_steps_.diagnostics() : phone_steps_.diagnostics();
 }
 
-Pdr::Wave Pdr::step_wave(double t0, double t1) const {
-  Wave w = Wave::Zero();
-  if (raw_size_ == 0) return w;
-  // Index into the ring from the oldest: the last sample before t0 (the ring holds 10 s).
-  std::size_t j = raw_first_at(t0);
-  j = j > 0 ? j - 1 : 0;
-  for (int i = 0; i < kWave; ++i) {
-    const double t = t0 + (t1 - t0) * (i + 0.5) / kWave;
-    while (j + 1 < raw_size_ && raw_t_[(raw_head_ + j + 1) % kRaw] <= t) ++j;
-    const Eigen::Vector3d& f = raw_f_[(raw_head_ + j) % kRaw];
-    for (int a = 0; a < 3; ++a) w[a * kWave + i] = f[a];
-  }
-  return w;
-}
-
-void Pdr::on_step(double t_s, StepSource source) {
-  const bool foot = params_.mount == StepMount::kFoot;
-  // How this step's heading depends on the hard-iron offset (mean over the step).
-  const bool have_mag_grad = mag_grad_n_ > 0;
-  const Eigen::Vector3d mag_grad =
-      have_mag_grad ? Eigen::Vector3d(mag_grad_sum_ / mag_grad_n_) : Eigen::Vector3d::Zero();
-  mag_grad_sum_.setZero();
-  mag_grad_n_ = 0;
-  const std::array<Eigen::Vector3d, 2> ups_before = ups_;
-  const double per_event = foot ? 2.0 : 1.0;  // a foot sensor sees one event per two steps
-  // Steps the detector missed (our addition): its thresholds follow the last steps' peaks and
-  // valleys, so after an arm swing the smaller steps of the next pose go unseen until its
-  // memory resets (4-9 steps lost per arm-swing exit, measured; not always while a switch is
-  // detected). A gap of about n step intervals while the phone kept moving like a walk
-  // (acceleration energy over the last window) counts n - 1 more steps; a stop does not.
-  int missed = 0;
-  const double gap = t_s - last_step_t_s_;
-  if (!foot && last_step_t_s_ >= 0.0 && interval_s_ > 0.0) {
-    const double ratio = gap / interval_s_;
-    if (ratio > params_.fill_min_ratio && gap < params_.fill_max_gap_s &&
-        features_.features().acc_energy > params_.fill_min_energy && !source.after_stand)
-      missed = static_cast<int>(std::lround(ratio)) - 1;
-  }
-  // Filling in needs a cadence that was measured. A gap after every step is no missed step but a
-  // cadence that is wrong (learnt from two detections of one step, or from a detector that has
-  // since locked onto the stride): after kMaxFilledRow filled steps in a row the cadence is
-  // learnt again from the gaps. (Learning it from the gaps divided by the steps filled into
-  // them kept any wrong cadence for ever: 2 or 8 steps counted for every one.)
-  constexpr int kMaxFilledRow = 10;
-  filled_row_ = missed > 0 ? filled_row_ + 1 : 0;
-  if (filled_row_ > kMaxFilledRow && !walking_period(interval_s_)) {
-    missed = 0;
-    filled_row_ = 0;
-    interval_s_ = 0.0;
-    interval_count_ = 0;
-  }
-  if (last_step_t_s_ >= 0.0 && missed == 0 && !source.handoff) {
-    const double interval = gap / per_event;
-    if (interval >= params_.min_step_interval_s && interval < 2.0) learn_interval(interval);
-  }
-  missed += source.backfill;  // the start of a swinging walk (phone_step)
+int Pdr::count_steps(double t_s, const StepSource& source, double per_event) {
+  int missed = gaps_.at_step(t_s, source, per_event, params_.mount != StepMount::kFoot,
+                             pose_.window().features().acc_energy, recent_);
+  missed += source.backfill;  // the start of a swinging walk (PhoneSteps)
   diag_.filled_steps += static_cast<unsigned>(missed);
   out_.steps += static_cast<std::size_t>(missed);
-  const double t_prev = last_step_t_s_;
-  last_step_t_s_ = t_s;
   out_.steps += static_cast<std::size_t>(per_event);
-  if (interval_s_ > 0.0) {
-    out_.step_hz = 1.0 / interval_s_;
+  if (gaps_.interval_s() > 0.0) {
+    out_.step_hz = 1.0 / gaps_.interval_s();
     out_.cadence_spm = 60.0 * out_.step_hz;
   }
   const double f = out_.step_hz;
   out_.gait = f < 1.6 ? 0 : f < 1.95 ? 1 : f < 2.35 ? 2 : f < 2.75 ? 3 : 4;
+  return missed;
+}
 
-  if (!foot && tilt_n_ > 0) learn_acc_bias(t_s);
-  if (!foot) {
-    // Pose switch (seed 003): cross-correlation of this step's waveform with the same foot's
-    // previous one. A turn also changes the waveform, so we add a condition of our own: the
-    // gravity direction in the sensor frame must have moved (the phone was re-oriented).
-    if (t_prev >= 0.0) {
-      const Wave w = step_wave(t_prev, t_s);
-      Eigen::Vector3d tilt(w.segment<kWave>(0).mean(), w.segment<kWave>(kWave).mean(),
-                           w.segment<kWave>(2 * kWave).mean());
-      tilt.normalize();
-      const auto slot = static_cast<std::size_t>(wave_count_ % 2);
-      if (wave_count_ >= 2) {
-        const Wave a = w.array() - w.mean();
-        const Wave b = waves_[slot].array() - waves_[slot].mean();
-        const double den = a.norm() * b.norm();
-        const double r = den > 1e-9 ? a.dot(b) / den : 0.0;
-        const double tilt_deg =
-            std::acos(std::clamp(tilt.dot(tilts_[slot]), -1.0, 1.0)) * 180.0 / M_PI;
-        const bool changed =
-            (r < params_.switch_correlation && tilt_deg > params_.switch_tilt_deg) ||
-            tilt_deg > 2.0 * params_.switch_tilt_deg;
-        if (!switching_ && changed) {
-          switching_ = true;
-          settling_ = false;
-          correlated_steps_ = 0;
-          switch_steps_ = 0;
-          // The phone may have begun to move a step or two before the waveforms said so: those
-          // steps join the switch (re-laid at its end) and the up direction before them is the
-          // old pose's.
-          const std::size_t back = last_count_;
-          pre_switch_ups_ = back > 0 ? last_ups_before_[kLookback - back] : ups_;
-          for (std::size_t i = kLookback - back; i < kLookback; ++i)
-            switch_[static_cast<std::size_t>(switch_steps_++)] = last_steps_[i];
-          last_count_ = 0;
-          reset_walking_direction();
-          ++diag_.switches;
-          forget_vertical_field();
-          // If the 3 steps before the switch were straight, their mean heading stands in for
-          // the heading during the switch. The comparison spans two steps, so the switch may
-          // have begun during the latest step: the 3 steps before the re-laid ones (at least
-          // the latest) are the ones known to be clean.
-          have_replacement_ = false;
-          const std::size_t skip = std::max<std::size_t>(1, back);
-          const std::size_t n_recent = recent_heading_rad_.size();
-          if (static_cast<std::size_t>(recent_count_) >= 3 + skip) {
-            const std::size_t i0 = n_recent - skip - 3;
-            double s = 0, c = 0;
-            for (std::size_t i = i0; i < i0 + 3; ++i) {
-              s += std::sin(recent_heading_rad_[i]);
-              c += std::cos(recent_heading_rad_[i]);
-            }
-            const double mean = std::atan2(s, c);
-            bool straight = true;
-            for (std::size_t i = i0; i < i0 + 3; ++i)
-              straight =
-                  straight && std::abs(std::remainder(recent_heading_rad_[i] - mean, kTwoPi)) <
-                                  params_.straight_deg * M_PI / 180.0;
-            if (straight) {
-              replacement_heading_rad_ = wrap_2pi(mean);
-              have_replacement_ = true;
-            }
-          }
-        } else if (switching_) {
-          correlated_steps_ =
-              (r >= params_.switch_correlation && tilt_deg < params_.switch_tilt_deg)
-                  ? correlated_steps_ + 1
-                  : 0;
-          if (!settling_ && correlated_steps_ >= params_.switch_exit_steps) {
-            // The phone is steady again: wait for fresh classifications of the new pose.
-            settling_ = true;
-            settling_steps_ = 0;
-            candidate_count_ = 0;
-          }
-        }
-      }
-      waves_[slot] = w;
-      tilts_[slot] = tilt;
-      if (step_up_.norm() > 0.0) ups_[slot] = step_up_.normalized();
-      last_slot_ = slot;
-      ++wave_count_;
+void Pdr::detect_switch(double t_prev, double t_s,
+                        const std::array<Eigen::Vector3d, 2>& ups_before) {
+  switch (switch_.at_step(recent_.step_wave(t_prev, t_s))) {
+    case PoseSwitch::Event::kBegan: {
+      // The phone may have begun to move a step or two before the waveforms said so: those
+      // steps join the switch (re-laid at its end) and the up direction before them is the
+      // old pose's.
+      const std::size_t back = relay_.begin(ups_before);
+      reset_walking_direction();
+      ++diag_.switches;
+      forget_vertical_field();
+      switch_.choose_stand_in(back, params_.walking_direction.straight_deg);
+      break;
     }
-    step_up_.setZero();
-    // Pose: classify the feature window at every step. A pose can only change around a detected
-    // switch (turns fool the gyro-variance feature), or when one answer persists for
-    // pose_fallback_steps; the first pose is the first confirmed answer.
-    if (settling_ && ++settling_steps_ > params_.pose_window_steps) {
-      settling_ = switching_ = false;  // no confirmed pose: keep the previous one
+    case PoseSwitch::Event::kSettling:
+      pose_.restart_vote();  // the phone is steady again: fresh answers for the new pose
+      break;
+    case PoseSwitch::Event::kNone:
+      break;
+  }
+}
+
+void Pdr::classify_pose(double t_s) {
+  // Pose: classified at every step (PoseClassifier); a switch that saw no confirmed pose
+  // within pose_window_steps keeps the previous one.
+  switch_.count_settling_step();
+  if (const auto change = pose_.at_step(switch_.settling(), out_.steps)) {
+    switch_.end();
+    const Eigen::Matrix3d r = pose_rotation(change->to) * pose_rotation(change->from).transpose();
+    if (!r.isIdentity(1e-9)) {
+      heading_.change_frame(r);  // new walking frame: heading again from the magnetometer
+      sum_sin_ = sum_cos_ = 0.0;
+      gaps_.new_frame(t_s);
     }
-    // The classifier sees only the three features of seed 003; the rotation matrices of eqs.
-    // (14)-(15) also assume how the phone sits in each pose. We keep the best-scoring pose whose
-    // matrix brings the window's mean gravity near the walking frame's up (our addition: without
-    // it a pocket taken for a phone call turns the heading upside down).
-    std::optional<PhonePose> pose;
-    if (net_.trained) {
-      const PoseNetwork::Input x = net_.input(features_.features());
-      const Eigen::Vector3d g = features_.mean_acc();
-      if (x.allFinite() && g.norm() > 1.0) {
-        PoseNetwork::Output score = net_.forward(x);
-        const double cos_max = std::cos(params_.pose_gravity_deg * M_PI / 180.0);
-        for (int k = 0; k < kPoseCount; ++k) {
-          Eigen::Index best = 0;
-          score.maxCoeff(&best);
-          const auto p = static_cast<PhonePose>(best);
-          if ((pose_rotation(p) * g).normalized().z() > cos_max) {
-            pose = p;
-            break;
-          }
-          score[best] = -std::numeric_limits<double>::infinity();
-        }
-      }
-    }
-    if (pose) {
-      if (*pose == candidate_pose_) {
-        ++candidate_count_;
-      } else {
-        candidate_pose_ = *pose;
-        candidate_count_ = 1;
-      }
-      // (The fallback is for a pose that changes: the old pose's long run of answers must not
-      // end a switch the moment it is detected.)
-      const bool same_frame = pose_rotation(candidate_pose_).isApprox(pose_rotation(applied_pose_));
-      const int fallback =
-          same_frame ? params_.pose_fallback_same_frame_steps : params_.pose_fallback_steps;
-      const bool may_change = !pose_known_ || settling_ ||
-                              (candidate_pose_ != applied_pose_ && candidate_count_ >= fallback);
-      if (candidate_count_ >= params_.pose_confirm_steps && may_change) {
-        settling_ = switching_ = false;
-        const Eigen::Matrix3d r =
-            pose_rotation(candidate_pose_) * pose_rotation(applied_pose_).transpose();
-        if (!r.isIdentity(1e-9)) {
-          heading_.change_frame(r);  // new walking frame: heading again from the magnetometer
-          sum_sin_ = sum_cos_ = 0.0;
-          heading_bins_from_t_s_ = t_s;
-        }
-        if (pose_known_ && candidate_pose_ != applied_pose_) ++diag_.pose_changes;
-        if (candidate_pose_ != applied_pose_) {
-          reset_walking_direction();
-          forget_vertical_field();
-        }
-        applied_pose_ = candidate_pose_;
-        pose_known_ = true;
-      }
-    } else if (!pose_known_ && out_.steps >= static_cast<std::size_t>(params_.pose_confirm_steps)) {
-      // No classification possible (no gyroscope, or no model): keep the hand-held frame
-      // (M = I) rather than holding the track back for ever.
-      pose_known_ = true;
+    if (change->to != change->from) {
+      if (!change->first) ++diag_.pose_changes;
+      reset_walking_direction();
+      forget_vertical_field();
     }
   }
+}
 
-  // Heading of this step: circular mean over the step, or the replacement during a switch.
+double Pdr::walked_heading() {
+  // The heading filter's circular mean over the step (its heading if it had none).
   double heading = heading_.heading_rad();
   if (sum_sin_ != 0.0 || sum_cos_ != 0.0) heading = wrap_2pi(std::atan2(sum_sin_, sum_cos_));
   sum_sin_ = sum_cos_ = 0.0;
-  // The walking-direction sums of the last step count once this step shows that both were
-  // straight (a corner's centripetal acceleration would bias them).
-  const bool straight =
-      have_last_raw_ && std::abs(std::remainder(heading - last_raw_heading_rad_, kTwoPi)) <
-                            params_.straight_deg * M_PI / 180.0;
-  if (straight && last_straight_ && last_fwd_ > 0.0) {
-    yaw_fwd_ += last_fwd_;
-    yaw_left_ += last_left_;
-    const double a = std::atan2(last_left_, last_fwd_);
-    step_yaw_sum_ += a;
-    step_yaw_sq_ += a * a;
-    ++straight_steps_;
+  const double yaw_corr =
+      walking_.at_step(heading, pose_.pose() == PhonePose::kArmSwing, heading_.state().up);
+  if (params_.track.revise && !switch_.switching()) revise_pose_yaw(yaw_corr);
+  return wrap_2pi(heading - yaw_corr);
+}
+
+void Pdr::on_step(double t_s, StepSource source) {
+  const bool foot = params_.mount == StepMount::kFoot;
+  track_.begin_step();
+  const std::array<Eigen::Vector3d, 2> ups_before = switch_.ups();
+  const double per_event = foot ? 2.0 : 1.0;  // a foot sensor sees one event per two steps
+  const double t_prev = gaps_.last_step_t_s();
+  const int missed = count_steps(t_s, source, per_event);
+  if (!foot) {
+    acc_bias_.at_step(t_s, mag_cal_.offset_uT());
+    if (t_prev >= 0.0) detect_switch(t_prev, t_s, ups_before);
+    switch_.end_step();
+    classify_pose(t_s);
   }
-  if (applied_pose_ == PhonePose::kArmSwing) swing_axis_direction();
-  last_fwd_ = step_fwd_;
-  last_left_ = step_left_;
-  step_fwd_ = step_left_ = 0.0;
-  last_straight_ = straight;
-  last_raw_heading_rad_ = heading;
-  have_last_raw_ = true;
-  double yaw_corr = 0.0;
-  if (!foot && params_.walking_direction &&
-      straight_steps_ >= std::max(2, params_.walking_direction_steps) && yaw_fwd_ > 0.0) {
-    const double n = straight_steps_, mean = step_yaw_sum_ / n;
-    const double se2 = std::max(0.0, step_yaw_sq_ / n - mean * mean) / (n - 1.0);
-    const double prior2 = std::pow(params_.walking_direction_prior_deg * M_PI / 180.0, 2);
-    yaw_corr = prior2 / (prior2 + se2) * std::atan2(yaw_left_, yaw_fwd_);
-  }
-  if (params_.revise_track && !switching_) revise_pose_yaw(yaw_corr);
-  heading = wrap_2pi(heading - yaw_corr);
-  const double step_heading = heading;
+  const double walked_rad = walked_heading();
+  lay_step(t_s, t_prev, per_event, missed, walked_rad, ups_before);
+}
+
+void Pdr::lay_step(double t_s, double t_prev, double per_event, int missed, double walked_rad,
+                   const std::array<Eigen::Vector3d, 2>& ups_before) {
+  const bool foot = params_.mount == StepMount::kFoot;
+  double heading = walked_rad;
   const Eigen::Vector2d step_axis_x = axis_sum_[0], step_axis_z = axis_sum_[1];
   axis_sum_[0].setZero();
   axis_sum_[1].setZero();
-  const bool replaced = switching_ && have_replacement_;
+  // During a switch the straight heading from before it stands in (PoseSwitch::choose_stand_in).
+  const bool replaced = switch_.switching() && switch_.stand_in_rad();
   if (replaced) {
-    heading = replacement_heading_rad_;
+    heading = *switch_.stand_in_rad();
     ++diag_.replaced_headings;
-  } else if (!switching_) {
-    for (std::size_t i = 0; i + 1 < recent_heading_rad_.size(); ++i)
-      recent_heading_rad_[i] = recent_heading_rad_[i + 1];
-    recent_heading_rad_.back() = heading;
-    recent_count_ = std::min(recent_count_ + 1, static_cast<int>(recent_heading_rad_.size()));
+  } else if (!switch_.switching()) {
+    switch_.note_heading(heading);
   }
   // Eq. (13) and eq. (11). The first step has no frequency yet: the person's usual walk.
   const double hz = out_.step_hz > 0.0 ? out_.step_hz : 1.8;
-  const double step_m = lengths_.length_m(applied_pose_, params_.height_m, hz) *
-                        params_.step_scale[static_cast<std::size_t>(applied_pose_)];
+  const double step_m = step_length_.step_m(pose_.pose(), hz);
   double len = (per_event + missed) * step_m;
   out_.last_step_length_m = len;
   heading_.set_speed(step_m * hz);
@@ -742,480 +235,61 @@ void Pdr::on_step(double t_s, StepSource source) {
   if (missed > 0 && !replaced) {
     // The steps a gap held are laid along the heading the gap had part by part (a corner walked
     // while the detector was blind is a corner, not a diagonal): one displacement, the chord.
-    const Eigen::Vector2d turn = gap_turn(t_prev, t_s, static_cast<int>(per_event) + missed);
+    const Eigen::Vector2d turn = gaps_.gap_turn(t_prev, t_s, static_cast<int>(per_event) + missed);
     heading = wrap_2pi(heading + std::atan2(turn.y(), turn.x()));
     len *= turn.norm();
   }
-  if (!foot && (!pose_known_ || !heading_.initialised())) {
+  if (!foot && (!pose_.known() || !heading_.initialised())) {
     // At the start the pose (hence the walking frame and the heading) is not known yet: the
     // first steps are laid along the first heading we get (a straight start).
-    pending_m_ += len;
+    track_.hold(len);
     return;
   }
-  const double laid_m = len + pending_m_;
-  out_.x_m += laid_m * std::sin(heading);
-  out_.y_m += laid_m * std::cos(heading);
-  pending_m_ = 0.0;
-  if (!switching_) {
-    pose_disp_ += laid_m * Eigen::Vector2d(std::sin(heading), std::cos(heading));
-    ++pose_steps_;
-    if (params_.revise_track && params_.calibrate_mag && have_mag_grad) {
-      // d(east, north)/dheading times dheading/doffset: how this step moves per uT of offset.
-      const Eigen::Matrix<double, 2, 3> a =
-          laid_m * Eigen::Vector2d(std::cos(heading), -std::sin(heading)) * mag_grad.transpose();
-      mag_a_ += a;
-      mag_c_ += a * mag_cal_.offset_uT();
-    }
-  }
-  if (params_.revise_track) revise_mag_offset();
+  track_.lay(len, heading, !switch_.switching(), mag_cal_.offset_uT());
   SwitchStep laid;  // what a later re-laying of this step needs
   laid.length_m = len;
   laid.laid_rad = heading;
-  laid.old_frame_rad = step_heading;
-  laid.slot = last_slot_;
-  laid.up = ups_[last_slot_];
+  laid.old_frame_rad = walked_rad;
+  laid.slot = switch_.slot();
+  laid.up = switch_.ups()[switch_.slot()];
   laid.axis_sum = {step_axis_x, step_axis_z};
-  if (switching_ && switch_steps_ < static_cast<int>(switch_.size()))
-    switch_[static_cast<std::size_t>(switch_steps_++)] = laid;
-  if (!switching_ && switch_steps_ > 0) {
-    relay_switch_steps(heading, applied_pose_);
-    switch_steps_ = 0;
-  } else if (switching_ && candidate_count_ > 0) {
+  book_laid_step(laid, heading, ups_before);
+  out_.heading_deg = heading * 180.0 / M_PI;
+}
+
+void Pdr::book_laid_step(const SwitchStep& laid, double heading,
+                         const std::array<Eigen::Vector3d, 2>& ups_before) {
+  const bool switching = switch_.switching();
+  if (switching) relay_.add(laid);
+  if (!switching && !relay_.empty()) {
+    relay_switch_steps(heading, pose_.pose());
+    relay_.clear();
+  } else if (const auto candidate = pose_.candidate(); switching && candidate) {
     // Meanwhile the switch's steps are laid as the pose the classifier now sees would lay them
     // (again at every step, each time from the latest up direction): a walk may end before the
     // new pose is confirmed (a phone put away on arrival), and its last metres then point
     // where they went, not along the heading from before the switch.
-    relay_switch_steps(std::nullopt, candidate_pose_);
+    relay_switch_steps(std::nullopt, *candidate);
   }
-  if (!switching_ && !foot) {
-    for (std::size_t i = 0; i + 1 < kLookback; ++i) {
-      last_steps_[i] = last_steps_[i + 1];
-      last_ups_before_[i] = last_ups_before_[i + 1];
-    }
-    last_steps_.back() = laid;
-    last_ups_before_.back() = ups_before;
-    last_count_ = std::min(last_count_ + 1, kLookback);
-  }
-  out_.heading_deg = heading * 180.0 / M_PI;
+  if (!switching && params_.mount != StepMount::kFoot) relay_.keep_last(laid, ups_before);
 }
 
-std::size_t Pdr::raw_first_at(double t_s) const {
-  // From the newest back: a step's worth of samples, not the whole ring.
-  std::size_t i = raw_size_;
-  while (i > 0 && raw_t_[(raw_head_ + i - 1) % kRaw] >= t_s) --i;
-  return i;
-}
-
-bool Pdr::quiet_between(double t0_s, double t1_s) const {
-  // A walker who stopped holds the phone still for a moment: |f| steady and little rotation
-  // (|f| alone is steady in a slow arm swing, whose pendulum acceleration is mostly across
-  // gravity). A walking trunk never is, for any stretch of a step. Without a gyroscope the
-  // rotation is unknown and no stretch counts as still.
-  const double window_s = params_.stand_still_s;
-  if (!(window_s > 0.0)) return false;
-  const double w2_limit = params_.stand_gyro_rad_s * params_.stand_gyro_rad_s;
-  const double limit = params_.still_acc_std_m_s2;
-  const std::size_t first = raw_first_at(t0_s);
-  double sum = 0.0, sum2 = 0.0, sum_w2 = 0.0;
-  std::size_t lo = first;
-  for (std::size_t i = first; i < raw_size_; ++i) {
-    const std::size_t k = (raw_head_ + i) % kRaw;
-    if (raw_t_[k] > t1_s) break;
-    const double m = raw_f_[k].norm();
-    sum += m;
-    sum2 += m * m;
-    sum_w2 += raw_w2_[k];
-    while (raw_t_[(raw_head_ + lo) % kRaw] < raw_t_[k] - window_s) {
-      const std::size_t kl = (raw_head_ + lo) % kRaw;
-      const double ml = raw_f_[kl].norm();
-      sum -= ml;
-      sum2 -= ml * ml;
-      sum_w2 -= raw_w2_[kl];
-      ++lo;
-    }
-    const auto n = static_cast<double>(i - lo + 1);
-    if (raw_t_[k] - raw_t_[(raw_head_ + lo) % kRaw] >= window_s * 0.9 && n >= 5) {
-      const double var = sum2 / n - (sum / n) * (sum / n);
-      if (var < limit * limit && sum_w2 / n < w2_limit) return true;
-    }
-  }
-  return false;
-}
-
-bool Pdr::walking_period(double lag_s) const {
-  constexpr double kSpanS = 4.0;
-  // Autocorrelation of |f| over the last few seconds at that lag: a step interval repeats the
-  // step (r ~ 0.5-0.9 even in a pocket, where the stride is the waveform's period); half of one
-  // puts a valley on a peak (r < 0).
-  if (raw_size_ < 8 || !(lag_s > 0.0)) return false;
-  const double t_end = raw_t_[(raw_head_ + raw_size_ - 1) % kRaw];
-  const std::size_t first = raw_first_at(t_end - kSpanS);
-  const std::size_t n = raw_size_ - first;
-  const double dt = (t_end - raw_t_[(raw_head_ + first) % kRaw]) / static_cast<double>(n - 1);
-  const auto lag = static_cast<std::size_t>(std::lround(lag_s / dt));
-  if (!(dt > 0.0) || lag == 0 || 2 * lag >= n) return false;
-  const auto mag = [&](std::size_t i) { return raw_f_[(raw_head_ + first + i) % kRaw].norm(); };
-  double mean = 0.0;
-  for (std::size_t i = 0; i < n; ++i) mean += mag(i);
-  mean /= static_cast<double>(n);
-  double num = 0.0, den = 0.0;
-  for (std::size_t i = 0; i + lag < n; ++i) num += (mag(i) - mean) * (mag(i + lag) - mean);
-  for (std::size_t i = 0; i < n; ++i) den += (mag(i) - mean) * (mag(i) - mean);
-  return den > 0.0 && num / den * static_cast<double>(n) / static_cast<double>(n - lag) > 0.3;
-}
-
-void Pdr::learn_interval(double interval_s) {
-  // A median, not a running mean: a hand moving the phone makes events at any moment, and two
-  // of them 0.3 s apart made the filler count 5 steps for a gap that held 3.
-  for (std::size_t i = 0; i + 1 < kIntervals; ++i) intervals_[i] = intervals_[i + 1];
-  intervals_.back() = interval_s;
-  interval_count_ = std::min(interval_count_ + 1, kIntervals);
-  // The newest interval_count_ of them, sorted by insertion (at most 5).
-  std::array<double, kIntervals> sorted{};
-  const std::size_t n = interval_count_;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double v = intervals_[kIntervals - n + i];
-    std::size_t j = i;
-    for (; j > 0 && sorted[j - 1] > v; --j) sorted[j] = sorted[j - 1];
-    sorted[j] = v;
-  }
-  const std::size_t mid = n / 2;
-  interval_s_ = n % 2 ? sorted[mid] : 0.5 * (sorted[mid - 1] + sorted[mid]);
-}
-
-void Pdr::add_heading_bin(double t_s, const Eigen::Vector2d& unit) {
-  const auto id = static_cast<std::int64_t>(std::floor(t_s / kHeadingBinS));
-  const std::size_t slot = ring_slot(id, kHeadingBins);
-  if (heading_bin_id_[slot] != id) {
-    heading_bin_id_[slot] = id;
-    heading_bins_[slot].setZero();
-  }
-  heading_bins_[slot] += unit;
-}
-
-Eigen::Vector2d Pdr::gap_turn(double t0_s, double t1_s, int parts) const {
-  const Eigen::Vector2d none(1.0, 0.0);
-  if (parts < 2 || !(t1_s > t0_s) || t0_s < heading_bins_from_t_s_ ||
-      t1_s - t0_s > kHeadingBinS * static_cast<double>(kHeadingBins - 2))
-    return none;
-  // Each part's heading: the circular mean of the bins its interval covers.
-  std::array<Eigen::Vector2d, kHeadingBins> part{};
-  Eigen::Vector2d all = Eigen::Vector2d::Zero();
-  const double span = (t1_s - t0_s) / parts;
-  for (int j = 0; j < parts; ++j) {
-    const double a = t0_s + j * span, b = a + span;
-    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
-    for (auto id = static_cast<std::int64_t>(std::floor(a / kHeadingBinS));
-         static_cast<double>(id) * kHeadingBinS < b; ++id) {
-      const std::size_t slot = ring_slot(id, kHeadingBins);
-      if (heading_bin_id_[slot] == id) sum += heading_bins_[slot];
-    }
-    if (!(sum.norm() > 1e-9)) return none;  // a part with no heading: no better than one
-    part[static_cast<std::size_t>(j)] = sum.normalized();
-    all += sum;
-  }
-  // Relative to the whole gap's mean: rotate each part's unit vector back by the mean's angle.
-  const double mean = std::atan2(all.y(), all.x());
-  Eigen::Vector2d turn = Eigen::Vector2d::Zero();
-  for (int j = 0; j < parts; ++j) {
-    const Eigen::Vector2d& u = part[static_cast<std::size_t>(j)];
-    const double h = std::atan2(u.y(), u.x()) - mean;
-    turn += Eigen::Vector2d(std::cos(h), std::sin(h));
-  }
-  return turn / parts;
-}
-
-void Pdr::swing_axis_direction() {
-  // Arm swing: the acceleration pattern is the arm's, not the trunk's, and says little about the
-  // walking direction (2.8 deg rms per pose in the simulator). The arm swings in the walking
-  // direction's vertical plane, so the step's principal rotation axis, made horizontal, is the
-  // walking frame's left; forward = left x up. The pattern's step sums are replaced by that unit
-  // direction (the arm's swing rate is ~1 rad/s, its gyro noise and bias ~0.01 rad/s).
-  const Eigen::Matrix3d sw = step_swing_;
-  step_swing_.setZero();
-  step_fwd_ = step_left_ = 0.0;
-  if (!(sw.trace() > 0.0)) return;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(sw);
-  const Eigen::Vector3d& up = heading_.state().up;
-  Eigen::Vector3d axis = eig.eigenvectors().col(2);
-  // The swing must dominate: a stronger second axis (no swing, a turn, a hand moving about)
-  // leaves the step without an estimate.
-  if (!(eig.eigenvalues()[2] > params_.swing_axis_ratio * eig.eigenvalues()[1])) return;
-  axis -= axis.dot(up) * up;
-  Eigen::Vector3d fwd, left;
-  if (axis.norm() < 0.5 || !horizontal_axes(up, fwd, left)) return;
-  if (axis.dot(left) < 0.0) axis = -axis;
-  const Eigen::Vector3d walk = axis.normalized().cross(up);
-  step_fwd_ = walk.dot(fwd);
-  step_left_ = walk.dot(left);
-}
-
-void Pdr::add_vertical_field(const Eigen::Vector3d& gyro, const Eigen::Vector3d& up,
-                             const Eigen::Vector3d& mag) {
-  // One sample of what the field's vertical component says about the up direction (sensor
-  // frame; learn_acc_bias). The caller leaves out arm swing (the pendulum's acceleration tilts
-  // up in step with the swing, which also turns the horizontal field in the phone) and the few
-  // up time constants after the phone moved. Turns are left out here: what is left of the
-  // centripetal acceleration tilts up with the turn, in step with the change of heading the
-  // estimate feeds on.
-  if (!(std::abs(gyro.dot(up)) < params_.acc_bias_max_turn_rad_s)) return;
-  const double vertical = mag.dot(up);
-  const Eigen::Vector3d r = (mag - vertical * up) / kStandardGravity_m_s2;
-  tilt_z_sum_ += vertical + r.dot(acc_bias_);
-  tilt_r_sum_ += r;
-  tilt_up_sum_ += up;
-  ++tilt_n_;
-}
-
-void Pdr::learn_acc_bias(double t_s) {
-  // The earth field's vertical component is the same wherever the walker faces. Up tilted by
-  // an angle d (a vector across up, rad) reads m.up + m_h.d, where m_h is the horizontal field
-  // in the sensor frame, which turns round as the walker turns: a tilt fixed in the phone shows
-  // as a vertical field that changes with the heading. An accelerometer bias b tilts up by
-  // b_h / g (its part across up), so, with the bias already removed (acc_bias_) and C the
-  // vertical field plus the hard-iron residual along up (constant while the phone sits the same
-  // way, free after a pose change):
-  //   m.up + m_h.acc_bias_ / g = C + m_h.b / g.
-  // One measurement per step (the step's means), a Kalman filter for [C, b].
-  const double n = tilt_n_;
-  const double z = tilt_z_sum_ / n;
-  const Eigen::Vector3d r = tilt_r_sum_ / n;
-  // A better hard-iron offset moves the corrected field, and C with it, by the change along up.
-  const Eigen::Vector3d offset = mag_cal_.offset_uT();
-  acc_x_[0] -= (offset - tilt_offset_uT_).dot(tilt_up_sum_ / n);
-  tilt_offset_uT_ = offset;
-  tilt_z_sum_ = 0.0;
-  tilt_r_sum_.setZero();
-  tilt_up_sum_.setZero();
-  tilt_n_ = 0;
-  if (tilt_t_s_ >= 0.0)
-    acc_p_(0, 0) += params_.acc_bias_vertical_walk_uT * params_.acc_bias_vertical_walk_uT *
-                    std::max(0.0, t_s - tilt_t_s_);
-  tilt_t_s_ = t_s;
-  Eigen::Vector4d h;
-  h << 1.0, r;
-  const double var = params_.acc_bias_step_noise_uT * params_.acc_bias_step_noise_uT;
-  const double innovation = z - h.dot(acc_x_);
-  const double s = h.dot(acc_p_ * h) + var;
-  if (!std::isfinite(innovation) || !(s > 0.0)) return;
-  // A magnetic disturbance (steel, a car) moves the vertical field by far more than a bias can.
-  if (innovation * innovation > 25.0 * s) return;
-  const Eigen::Vector4d k = acc_p_ * h / s;
-  acc_x_ += k * innovation;
-  acc_p_ -= k * h.transpose() * acc_p_;
-  acc_p_ = 0.5 * (acc_p_ + acc_p_.transpose()).eval();  // symmetric over hours of steps
-  // Past a few times the prior the estimate is no bias (a field that is not the earth's):
-  // the last plausible one stays.
-  if (acc_x_.tail<3>().norm() < 5.0 * params_.acc_bias_prior_m_s2) acc_bias_ = acc_x_.tail<3>();
-}
-
-void Pdr::forget_vertical_field() {
-  // The phone now sits another way: the hard-iron residual along up, hence C, is new.
-  acc_p_.row(0).setZero();
-  acc_p_.col(0).setZero();
-  acc_p_(0, 0) = 1e4;
-  tilt_settled_t_s_ = last_t_s_ + 3.0 * params_.heading.up_tau_s;
-  tilt_z_sum_ = 0.0;
-  tilt_r_sum_.setZero();
-  tilt_up_sum_.setZero();
-  tilt_n_ = 0;
-}
+void Pdr::forget_vertical_field() { acc_bias_.forget(last_t_s_ + 3.0 * params_.heading.up_tau_s); }
 
 void Pdr::reset_walking_direction() {
-  step_swing_.setZero();
-  yaw_fwd_ = yaw_left_ = 0.0;
-  step_fwd_ = step_left_ = last_fwd_ = last_left_ = 0.0;
-  have_last_raw_ = last_straight_ = false;
-  step_yaw_sum_ = step_yaw_sq_ = 0.0;
-  straight_steps_ = 0;
-  have_av_ = false;
-  // The steps of the pose that ends keep the correction they have.
-  pose_disp_.setZero();
-  pose_corr_rad_ = 0.0;
-  pose_steps_ = 0;
+  walking_.reset();
+  track_.new_pose();
 }
 
 void Pdr::revise_pose_yaw(double corr) {
-  // The pose's steps were laid with heading - pose_corr_rad_; with the better estimate they turn
-  // about the point where the pose began (headings clockwise, so east/north turn the other way).
-  const double d = corr - pose_corr_rad_;
+  const double d = track_.turn_pose(corr);
   if (d == 0.0) return;
-  const double c = std::cos(d), sn = std::sin(d);
-  const Eigen::Vector2d turned(pose_disp_.x() * c - pose_disp_.y() * sn,
-                               pose_disp_.y() * c + pose_disp_.x() * sn);
-  out_.x_m += turned.x() - pose_disp_.x();
-  out_.y_m += turned.y() - pose_disp_.y();
-  pose_disp_ = turned;
-  pose_corr_rad_ = corr;
-  // Steps a later switch may re-lay must know the heading they now have.
-  const std::size_t n = std::min(last_count_, pose_steps_);
-  for (std::size_t i = kLookback - n; i < kLookback; ++i)
-    last_steps_[i].laid_rad = wrap_2pi(last_steps_[i].laid_rad - d);
-}
-
-void Pdr::revise_mag_offset() {
-  // First order in the heading change (a few degrees at most: a 1 uT offset in a 20 uT
-  // horizontal field is 3 deg).
-  const Eigen::Vector2d corr = mag_a_ * mag_cal_.offset_uT() - mag_c_;
-  out_.x_m += corr.x() - mag_applied_.x();
-  out_.y_m += corr.y() - mag_applied_.y();
-  mag_applied_ = corr;
-}
-
-void Pdr::learn_gyro_bias(const ImuSample& s) {
-  if (still_n_ == 0) still_t0_ = s.t_s;
-  ++still_n_;
-  still_w_ += s.gyro_body_rad_s;
-  still_w2_ += s.gyro_body_rad_s.squaredNorm();
-  const double a = s.acc_body_m_s2.norm();
-  still_a_ += a;
-  still_a2_ += a * a;
-  if (s.t_s - still_t0_ < params_.still_window_s) return;
-  const double n = still_n_;
-  const Eigen::Vector3d mean_w = still_w_ / n;
-  const double var_w = still_w2_ / n - mean_w.squaredNorm();
-  const double mean_a = still_a_ / n, var_a = still_a2_ / n - mean_a * mean_a;
-  if (still_n_ >= 10 && var_w < params_.still_gyro_std_rad_s * params_.still_gyro_std_rad_s &&
-      var_a < params_.still_acc_std_m_s2 * params_.still_acc_std_m_s2 &&
-      mean_w.norm() < params_.still_max_bias_rad_s) {
-    ++diag_.still_windows;
-    gyro_bias_ += (mean_w - gyro_bias_) / std::min(diag_.still_windows, 10u);
-  }
-  still_n_ = 0;
-  still_w_.setZero();
-  still_w2_ = still_a_ = still_a2_ = 0.0;
+  relay_.turn_last(d, track_.pose_steps());
 }
 
 void Pdr::relay_switch_steps(std::optional<double> heading_after, PhonePose pose) {
-  // At each step of a pose switch and at the first after it (our addition to seed 003). While
-  // the phone was moved, the steps were laid with the heading from before the switch; with the
-  // pose the classifier sees (at the end, the confirmed one), each switch step is given the
-  // heading it really had:
-  //  - steps whose up direction (sensor frame, gyro-tracked: a corner's centripetal
-  //    acceleration does not tilt it) already matches the new steady one (same foot: an arm
-  //    swing alternates): the phone was in its new place, so the walking
-  //    direction is the new pose's forward axis, from that step's field and gyro-tracked up
-  //    (a turn during the settling steps is then measured, not interpolated);
-  //  - steps still in the old orientation: the heading filter's heading in the old frame;
-  //  - the steps of the movement itself: interpolated between those.
-  const double tol = std::cos(params_.switch_tilt_deg * M_PI / 180.0);
-  const std::size_t axis = pose_rotation(pose)(0, 0) > 0.5 ? 0 : 1;
-  const auto n = static_cast<std::size_t>(switch_steps_);
-  std::array<double, kMaxSwitchSteps> h{};
-  std::array<bool, kMaxSwitchSteps> known{}, in_new{};
-  bool moved = false;
-  for (std::size_t k = 0; k < n; ++k) {
-    const SwitchStep& r = switch_[k];
-    known[k] = false;
-    if (r.up.dot(ups_[r.slot]) > tol) {
-      const Eigen::Vector2d& v = r.axis_sum[axis];
-      if (v.norm() > 1e-9) {
-        h[k] = wrap_2pi(std::atan2(v.x(), v.y()));
-        known[k] = in_new[k] = true;
-      }
-      moved = true;
-    } else if (!moved && r.up.dot(pre_switch_ups_[r.slot]) > tol) {
-      h[k] = r.old_frame_rad;
-      known[k] = true;
-    } else {
-      moved = true;
-    }
-  }
-  // Interpolate the unknown ones between the nearest known headings (the replacement heading
-  // before the first, the heading after the switch after the last).
-  double before = have_replacement_ ? replacement_heading_rad_ : switch_[0].laid_rad;
-  std::size_t before_k = 0;
-  bool have_before_k = false;
-  for (std::size_t k = 0; k < n; ++k) {
-    if (known[k]) {
-      before = h[k];
-      before_k = k;
-      have_before_k = true;
-      continue;
-    }
-    std::size_t next = k;
-    while (next < n && !known[next]) ++next;
-    const double after = next < n ? h[next] : heading_after ? *heading_after : before;
-    const double span =
-        static_cast<double>(next) - (have_before_k ? static_cast<double>(before_k) : -1.0);
-    const double pos =
-        static_cast<double>(k) - (have_before_k ? static_cast<double>(before_k) : -1.0);
-    h[k] = before + std::remainder(after - before, kTwoPi) * pos / span;
-  }
-  for (std::size_t k = 0; k < n; ++k) {
-    SwitchStep& r = switch_[k];
-    out_.x_m += r.length_m * (std::sin(h[k]) - std::sin(r.laid_rad));
-    out_.y_m += r.length_m * (std::cos(h[k]) - std::cos(r.laid_rad));
-    r.laid_rad = h[k];  // a later re-laying moves it from here
-    // Steps walked in the new pose turn with its walking-direction correction once that is
-    // learnt (revise_pose_yaw), like the pose's later steps: they were laid with its raw axis.
-    if (heading_after && in_new[k])
-      pose_disp_ += r.length_m * Eigen::Vector2d(std::sin(h[k]), std::cos(h[k]));
-  }
-}
-
-bool Pdr::phone_step(const ImuSample& s, const Eigen::Matrix3d& m, StepEvent& ev,
-                     StepSource& source) {
-  const bool by_acc = phone_steps_.update(s, ev);
-  // While the phone swings (a swinging arm; a thigh, for a phone in a trouser pocket) its turns
-  // count the steps (SwingStepDetector), whatever the pose: in arm swing the hand's pendulum
-  // swamps the trunk's acceleration and the peak-valley detector loses steps, or the whole
-  // walk at a slow pace (and with it the pose, which is classified at the steps).
-  bool by_swing = false;
-  bool swinging = swing_steps_.swinging(s.t_s);  // before: the last step ends the swing
-  if (gyro_ok(s)) {
-    const Eigen::Vector3d up = m.transpose() * heading_.state().up;  // sensor frame
-    const Eigen::Vector3d& w = s.gyro_body_rad_s;
-    by_swing = swing_steps_.update(s.t_s, w - w.dot(up) * up);
-  }
-  swinging = swinging || swing_steps_.swinging(s.t_s);
-  if (by_acc || by_swing) {
-    if (s.t_s - walk_.last_event_t_s > params_.walk_pause_s) walk_ = {};  // a new walk
-    walk_.last_event_t_s = s.t_s;
-    walk_.swing_events += by_swing ? 1 : 0;
-  }
-  const bool swing = gyro_ok(s) && swinging;
-  if (!(swing ? by_swing : by_acc)) return false;
-  // The arm turns at a heel strike, the acceleration's valley closes a step just after one:
-  // when one detector takes over from the other, a step less than half an interval after the
-  // last one is that same step.
-  if (swing != last_step_by_swing_ && last_step_t_s_ >= 0.0 &&
-      s.t_s - last_step_t_s_ < 0.5 * std::max(interval_s_, swing_steps_.half_swing_s()))
-    return false;
-  // The two detectors mark a step at different moments of it (the acceleration's valley is
-  // confirmed 0.0-0.4 s after the strike, the arm's turn ~0.05 s): the interval across a handoff
-  // is no cadence.
-  source.handoff = swing != last_step_by_swing_;
-  source.after_stand = last_step_t_s_ >= 0.0 && quiet_between(last_step_t_s_, s.t_s);
-  // A walk after a stand (the phone still since the last step) begins with its first event
-  // held until a second follows within walk_start_intervals with no stand between: a hand
-  // moving the phone (putting it away, lifting it to the ear) makes one event, or two far apart.
-  if (params_.walk_start_intervals > 0.0 && interval_s_ > 0.0 && source.after_stand) {
-    const bool confirmed =
-        start_pending_t_s_ >= 0.0 &&
-        s.t_s - start_pending_t_s_ < params_.walk_start_intervals * interval_s_ &&
-        !quiet_between(start_pending_t_s_, s.t_s);
-    if (!confirmed) {
-      start_pending_t_s_ = s.t_s;
-      return false;
-    }
-    start_pending_t_s_ = -1.0;
-    ++source.backfill;      // the held event
-    ++walk_.steps;          // (a swinging start's backfill must know it was counted)
-    source.handoff = true;  // and no cadence across the stand
-  }
-  last_step_by_swing_ = swing;
-  // A walk that starts swinging: the swing is recognised after two half swings, and the
-  // acceleration may have missed the steps before (the pendulum lifts every valley above the
-  // standing mean). The arm's turns since the walk began say how many: they are counted with
-  // this step, if the walk is that young (its first kBackfillEvents turns).
-  constexpr int kBackfillEvents = 8;
-  if (swing && !walk_.backfilled && walk_.swing_events <= kBackfillEvents)
-    source.backfill += std::max(0, walk_.swing_events - walk_.steps - 1);
-  if (swing) walk_.backfilled = true;
-  ++walk_.steps;
-  ev.t_s = swing ? swing_steps_.step_t_s() : s.t_s;
-  return true;
+  relay_.relay(track_, switch_.ups(), switch_.stand_in_rad(), heading_after, pose,
+               params_.pose_switch.tilt_deg);
 }
 
 const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT) {
@@ -1226,25 +300,17 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
   }
   ImuSample s = raw;
   if (gyro_ok(s)) {
-    learn_gyro_bias(s);
-    s.gyro_body_rad_s -= gyro_bias_;
+    if (gyro_bias_.add(s)) ++diag_.still_windows;
+    s.gyro_body_rad_s -= gyro_bias_.bias_rad_s();
   }
   out_.t_s = s.t_s;
   const bool foot = params_.mount == StepMount::kFoot;
   if (!foot) {
-    features_.push(s);
-    if (raw_size_ == kRaw) {
-      raw_head_ = (raw_head_ + 1) % kRaw;
-      --raw_size_;
-    }
-    raw_t_[(raw_head_ + raw_size_) % kRaw] = s.t_s;
-    raw_f_[(raw_head_ + raw_size_) % kRaw] = s.acc_body_m_s2;
-    raw_w2_[(raw_head_ + raw_size_) % kRaw] =
-        gyro_ok(s) ? s.gyro_body_rad_s.squaredNorm() : kNoGyroW2;
-    ++raw_size_;
+    pose_.push(s);
+    recent_.push(s);
   }
   // Into the walking frame of the pose in force (eqs. (14)-(15)).
-  const Eigen::Matrix3d m = foot ? Eigen::Matrix3d::Identity() : pose_rotation(applied_pose_);
+  const Eigen::Matrix3d m = foot ? Eigen::Matrix3d::Identity() : pose_rotation(pose_.pose());
   Eigen::Vector3d mag = mag_uT;
   if (params_.calibrate_mag && mag.allFinite()) {
     // The hard-iron residual rotates with the phone, so its heading error changes with the
@@ -1252,42 +318,17 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
     mag_cal_.update(s.t_s, s.gyro_body_rad_s, mag);
     mag = mag_cal_.corrected(mag);
   }
-  heading_.update(s.t_s, m * s.gyro_body_rad_s, m * (s.acc_body_m_s2 - acc_bias_), m * mag);
-  if (!foot && !switching_ && params_.learn_acc_bias && mag.allFinite() && heading_.initialised() &&
-      gyro_ok(s) && applied_pose_ != PhonePose::kArmSwing && s.t_s > tilt_settled_t_s_)
-    add_vertical_field(s.gyro_body_rad_s, m.transpose() * heading_.state().up, mag);
-  if (!foot && !switching_ && params_.walking_direction && gyro_ok(s) &&
-      applied_pose_ != PhonePose::kArmSwing) {
-    // Walking direction from the acceleration pattern of the step (our addition): the trunk
-    // brakes after heel strike and speeds up before the next one, so the forward acceleration
-    // is in quadrature with the vertical one, correlated with its time derivative; sideways
-    // sway is at half the step frequency and a tilt error leaks the vertical in phase, both
-    // uncorrelated with it. The angle of that correlation in the horizontal plane of the pose's
-    // walking frame is how far the phone is yawed from the walking direction (2 deg rms per
-    // pose in the simulator, and what a hand really does).
-    const Eigen::Vector3d& up = heading_.state().up;
-    const Eigen::Vector3d a = m * s.acc_body_m_s2;
-    const double av = a.dot(up);
-    Eigen::Vector3d fwd, left;
-    if (have_av_ && horizontal_axes(up, fwd, left)) {
-      const double dav = (av - last_av_) / (s.t_s - last_av_t_);
-      step_fwd_ += a.dot(fwd) * dav;
-      step_left_ += a.dot(left) * dav;
-    }
-    last_av_ = av;
-    last_av_t_ = s.t_s;
-    have_av_ = true;
-  } else if (!foot && !switching_ && params_.walking_direction && gyro_ok(s) &&
-             applied_pose_ == PhonePose::kArmSwing) {
-    // A swinging arm turns the phone about the shoulder's axis, across the walking direction
-    // whatever the phone's yaw in the hand: its rotations are summed for the step's principal
-    // axis (swing_axis_direction), in place of the acceleration pattern (the arm's, not the
-    // trunk's).
-    const Eigen::Vector3d w = m * s.gyro_body_rad_s;
-    step_swing_.noalias() += w * w.transpose();
-    have_av_ = false;
+  heading_.update(s.t_s, m * s.gyro_body_rad_s, m * (s.acc_body_m_s2 - acc_bias_.bias_m_s2()),
+                  m * mag);
+  if (!foot && !switch_.switching() && params_.acc_bias.learn && mag.allFinite() &&
+      heading_.initialised() && gyro_ok(s) && pose_.pose() != PhonePose::kArmSwing &&
+      acc_bias_.settled(s.t_s))
+    acc_bias_.add(s.gyro_body_rad_s, m.transpose() * heading_.state().up, mag);
+  if (!foot && !switch_.switching() && params_.walking_direction.correct && gyro_ok(s)) {
+    walking_.add(s.t_s, m * s.acc_body_m_s2, m * s.gyro_body_rad_s, heading_.state().up,
+                 pose_.pose() == PhonePose::kArmSwing);
   } else {
-    have_av_ = false;
+    walking_.skip();
   }
   if (!foot && mag.allFinite() && heading_.initialised()) {
     // Walking direction of the two forward axes the poses use (sensor x: hand-held, arm swing;
@@ -1303,8 +344,7 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
     // horizontal field; |east| = |north| = H here), so every heading grows by east.db / H^2.
     const double h2 = north.squaredNorm();
     if (h2 > 1.0) {
-      mag_grad_sum_ += east / h2;
-      ++mag_grad_n_;
+      track_.add_offset_sensitivity(east / h2);
     }
     if (hx.norm() > 1e-9) axis_sum_[0] += hx.normalized();
     if (hz.norm() > 1e-9) axis_sum_[1] += hz.normalized();
@@ -1313,21 +353,27 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
     const Eigen::Vector2d unit(std::cos(heading_.heading_rad()), std::sin(heading_.heading_rad()));
     sum_sin_ += unit.y();
     sum_cos_ += unit.x();
-    add_heading_bin(s.t_s, unit);
-    step_up_ += m.transpose() * heading_.state().up;
+    gaps_.add_heading(s.t_s, unit);
+    switch_.add_up(m.transpose() * heading_.state().up);
     if (!out_.step)
-      out_.heading_deg = switching_ && have_replacement_ ? replacement_heading_rad_ * 180.0 / M_PI
-                                                         : heading_.heading_rad() * 180.0 / M_PI;
+      out_.heading_deg = switch_.switching() && switch_.stand_in_rad()
+                             ? *switch_.stand_in_rad() * 180.0 / M_PI
+                             : heading_.heading_rad() * 180.0 / M_PI;
   }
   StepEvent ev;
   StepSource source;
-  const bool step = foot ? foot_steps_.update(s, ev) : phone_step(s, m, ev, source);
+  const bool step =
+      foot ? foot_steps_.update(s, ev)
+           : phone_steps_.update(s, m.transpose() * heading_.state().up, gaps_.last_step_t_s(),
+                                 gaps_.interval_s(), recent_, ev, source);
   if (step) {
     on_step(ev.t_s, source);
+    out_.x_m = track_.x_m();
+    out_.y_m = track_.y_m();
     out_.step = true;
   }
-  out_.pose = applied_pose_;
-  out_.switching = switching_;
+  out_.pose = pose_.pose();
+  out_.switching = switch_.switching();
   return out_;
 }
 

@@ -172,7 +172,7 @@ TEST(Pdr, StraightWalkHandHeld) {
   for (int i = 0; i < kPoseCount; ++i) person.mount_yaw_deg[i] = person.mount_tilt_deg[i] = 0.0;
   const auto run = sim::simulate_gait(sc, person, 11);
   PdrParams p;
-  p.height_m = person.height_m;
+  p.step_length.height_m = person.height_m;
   Pdr pdr(p);
   for (const auto& s : run.samples) (void)pdr.update(s.imu, s.mag_uT);
   const auto& out = pdr.output();
@@ -192,7 +192,7 @@ TEST(Pdr, AccelerometerAndMagnetometerOnly) {
   const auto person = sim::random_person(12);
   const auto run = sim::simulate_gait(sc, person, 12);
   PdrParams p;
-  p.height_m = person.height_m;
+  p.step_length.height_m = person.height_m;
   Pdr pdr(p);
   for (auto s : run.samples) {
     s.imu.gyro_body_rad_s.setConstant(std::nan(""));
@@ -213,7 +213,7 @@ TEST(Pdr, DetectsPoseSwitchesAndEndsInTheTruePose) {
   const auto person = sim::random_person(5);
   const auto run = sim::simulate_gait(sc, person, 5);
   PdrParams p;
-  p.height_m = person.height_m;
+  p.step_length.height_m = person.height_m;
   Pdr pdr(p);
   for (const auto& s : run.samples) (void)pdr.update(s.imu, s.mag_uT);
   EXPECT_GE(pdr.diagnostics().switches, 3u);
@@ -240,7 +240,7 @@ TEST(Pdr, LearnsTheGyroBiasWhileStillAndKeepsItWalking) {
     }
   truth /= n;
   PdrParams p;
-  p.height_m = person.height_m;
+  p.step_length.height_m = person.height_m;
   Pdr pdr(p);
   unsigned windows_before_walk = 0, windows_at_walk_end = 0;
   const double walk_end_s = run.step_times_s.back();
@@ -285,7 +285,7 @@ TEST(Pdr, LearnsTheAccelerometerBiasFromTheVerticalField) {
     const Eigen::Vector3d up = g.normalized();
     auto across = [&up](const Eigen::Vector3d& v) { return (v - v.dot(up) * up).norm(); };
     PdrParams p;
-    p.height_m = person.height_m;
+    p.step_length.height_m = person.height_m;
     Pdr pdr(p);
     for (const auto& s : run.samples) (void)pdr.update(s.imu, s.mag_uT);
     EXPECT_TRUE(pdr.acc_bias_m_s2().allFinite());
@@ -313,11 +313,11 @@ TEST(Pdr, LearntBiasesSurviveNaNAndAMagneticDisturbance) {
     if (i == 2000) s.imu.gyro_body_rad_s = Eigen::Vector3d(40.0, -40.0, 40.0);
   }
   PdrParams p;
-  p.height_m = person.height_m;
+  p.step_length.height_m = person.height_m;
   Pdr pdr(p);
   for (const auto& s : run.samples) (void)pdr.update(s.imu, s.mag_uT);
   EXPECT_TRUE(pdr.acc_bias_m_s2().allFinite());
-  EXPECT_LT(pdr.acc_bias_m_s2().norm(), 5.0 * p.acc_bias_prior_m_s2);
+  EXPECT_LT(pdr.acc_bias_m_s2().norm(), 5.0 * p.acc_bias.prior_m_s2);
   EXPECT_TRUE(std::isfinite(pdr.output().x_m) && std::isfinite(pdr.output().y_m));
   EXPECT_GT(pdr.output().steps, run.step_times_s.size() * 9 / 10);
 }
@@ -336,8 +336,8 @@ TEST(Pdr, ArmSwingWalkingDirectionFromTheSwingAxis) {
       person.mount_yaw_deg[static_cast<int>(PhonePose::kArmSwing)] = yaw_deg;
       const auto run = sim::simulate_gait(sc, person, 1);
       PdrParams p;
-      p.height_m = person.height_m;
-      if (!axis) p.swing_axis_ratio = std::numeric_limits<double>::infinity();
+      p.step_length.height_m = person.height_m;
+      if (!axis) p.walking_direction.swing_axis_ratio = std::numeric_limits<double>::infinity();
       Pdr pdr(p);
       const double last_s = run.samples.back().imu.t_s - 25.0;
       double sn = 0.0, cs = 0.0;
@@ -375,7 +375,7 @@ double worst_arm_swing_heading_deg(std::uint64_t seed, bool lever_arm) {
     for (int k = 0; k < kPoseCount; ++k) person.mount_yaw_deg[k] = person.mount_tilt_deg[k] = 0;
     const auto run = sim::simulate_gait(sc, person, seed);
     PdrParams p;
-    p.height_m = person.height_m;
+    p.step_length.height_m = person.height_m;
     p.heading.lever_arm = lever_arm;
     Pdr pdr(p);
     double sn = 0.0, cs = 0.0;
@@ -413,7 +413,7 @@ TEST(Pdr, CountsEveryStepOfAnArmSwingWalk) {
       const auto run = sim::simulate_gait(sim::straight_phone_walk(g, PhonePose::kArmSwing, 40.0),
                                           person, seed * 32 + static_cast<std::uint64_t>(g));
       PdrParams p;
-      p.height_m = person.height_m;
+      p.step_length.height_m = person.height_m;
       Pdr pdr(p);
       for (const auto& s : run.samples) (void)pdr.update(s.imu, s.mag_uT);
       EXPECT_EQ(pdr.output().steps, run.step_times_s.size())
@@ -450,7 +450,7 @@ TEST(Pdr, AStopThenThePhonePutAwayCountsNoSteps) {
           << "person " << i;
       const auto extra = [&run, &person](double stand_s) {
         PdrParams p;
-        p.height_m = person.height_m;
+        p.step_length.height_m = person.height_m;
         p.stand_still_s = stand_s;
         Pdr pdr(p);
         for (const auto& s : run.samples) (void)pdr.update(s.imu, s.mag_uT);
@@ -485,7 +485,7 @@ TEST(Pdr, AWalkResumedAfterAStandCountsEveryStep) {
         const auto first = sim::simulate_gait(sc, person, g_seed);
         const auto second = sim::simulate_gait(sc, person, g_seed + 100);
         PdrParams p;
-        p.height_m = person.height_m;
+        p.step_length.height_m = person.height_m;
         Pdr pdr(p);
         for (const auto& s : first.samples) (void)pdr.update(s.imu, s.mag_uT);
         const double offset_s = first.samples.back().imu.t_s + 0.02;
@@ -514,9 +514,9 @@ TEST(Pdr, RevisingTheTrackWithTheLearntHardIronClosesLoops) {
     const auto run = sim::simulate_gait(sc, person, seed);
     for (const bool revise : {true, false}) {
       PdrParams p;
-      p.height_m = person.height_m;
-      p.step_scale.fill(sim::personal_step_scale(person, seed + 1000003));
-      p.revise_track = revise;
+      p.step_length.height_m = person.height_m;
+      p.step_length.scale.fill(sim::personal_step_scale(person, seed + 1000003));
+      p.track.revise = revise;
       Pdr pdr(p);
       for (const auto& s : run.samples) (void)pdr.update(s.imu, s.mag_uT);
       const auto& last = run.samples.back();

@@ -47,7 +47,7 @@ std::vector<CalibrationWalk> simulate_calibration_walks(std::uint64_t first, int
       sc.rate_hz = 50.0;
       const auto run = simulate_gait(sc, person, seed * 32 + static_cast<std::uint64_t>(g));
       PdrParams params;
-      params.height_m = person.height_m;
+      params.step_length.height_m = person.height_m;
       Pdr pdr(params, net);
       CalibrationWalk walk;
       walk.height_m = person.height_m;
@@ -80,7 +80,7 @@ double personal_step_scale(const Person& person, std::uint64_t seed, PhonePose p
   sc.segments = {{Gait::kWalk, pose, 1e6}};
   const auto run = simulate_gait(sc, person, seed);
   PdrParams params;
-  params.height_m = person.height_m;
+  params.step_length.height_m = person.height_m;
   Pdr pdr(params);
   for (const auto& s : run.samples) (void)pdr.update(s.imu, s.mag_uT);
   return pdr.output().distance_m > 0.0 ? run.distance_m / pdr.output().distance_m : 1.0;
@@ -99,13 +99,13 @@ LoopWalkResult simulate_pdr_loop(std::uint64_t seed, LoopVariant variant, bool c
   }
   const auto run = simulate_gait(sc, person, seed);
   PdrParams params;
-  params.height_m = person.height_m;
+  params.step_length.height_m = person.height_m;
   // The calibration walk's seed is far from every loop seed, so its noise and biases are its own.
-  if (calibrate) params.step_scale.fill(personal_step_scale(person, seed + 1000003));
+  if (calibrate) params.step_length.scale.fill(personal_step_scale(person, seed + 1000003));
   Pdr pdr(params);
   for (const auto& s : run.samples) (void)pdr.update(s.imu, s.mag_uT);
   LoopWalkResult r;
-  r.step_scale = params.step_scale[0];
+  r.step_scale = params.step_length.scale[0];
   r.distance_error_fraction = pdr.output().distance_m / run.distance_m - 1.0;
   const auto& last = run.samples.back();
   r.distance_m = run.distance_m;

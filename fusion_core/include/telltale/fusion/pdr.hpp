@@ -22,18 +22,23 @@
 /// from the walking direction removed using the step's acceleration pattern (shrunk toward 0
 /// while the pose is young, from straight steps only); the centripetal acceleration of turns
 /// taken out before the up direction follows the accelerometer; steps already walked re-laid when
-/// the hard-iron offset or the pose's yaw estimate improves (PdrParams::revise_track); the gyro
+/// the hard-iron offset or the pose's yaw estimate improves (TrackParams::revise); the gyro
 /// bias learnt while standing still; in arm swing the walking direction from the arm's swing axis
-/// (PdrParams::swing_axis_ratio); the accelerometer bias learnt from the constancy of the field's
-/// vertical component (PdrParams::learn_acc_bias); while the phone swings, the steps counted
-/// from its turns (SwingStepDetector, steps.hpp), whatever the pose; the swinging hand's
-/// pendulum acceleration taken out before the up direction follows the accelerometer
+/// (WalkingDirectionParams::swing_axis_ratio); the accelerometer bias learnt from the constancy of
+/// the field's vertical component (AccBiasParams); while the phone swings, the steps counted from
+/// its turns (SwingStepDetector, steps.hpp), whatever the pose; the swinging hand's pendulum
+/// acceleration taken out before the up direction follows the accelerometer
 /// (HeadingFilterParams::lever_arm); a personal step-length factor from one calibration walk of
-/// known length (PdrParams::step_scale).
+/// known length (StepLengthParams::scale).
 ///
 /// Frames: the phone's sensor axes are whatever the phone has; the walking frame is x forward, y
 /// left, z up with `v_walking = M_pose v_sensor` (M = I for hand-held and arm swing). Position is
 /// x east, y north (m) from the start; heading clockwise from north.
+///
+/// Structure: Pdr orders the work of a sample and of a step; each stage it calls owns its state
+/// and its Params (a member of PdrParams), one file pair each in pdr/ (docs/pdr.md lists them):
+/// phone_steps, recent_samples, step_gaps, pose_classifier, pose_switch, step_length,
+/// walking_heading, bias_learners, track.
 ///
 /// Memory: fixed-size buffers and Eigen fixed-size types, no heap in update().
 
@@ -47,104 +52,19 @@
 
 #include "telltale/fusion/hard_iron.hpp"
 #include "telltale/fusion/imu_sample.hpp"
+#include "telltale/fusion/pdr/bias_learners.hpp"
+#include "telltale/fusion/pdr/phone_steps.hpp"
+#include "telltale/fusion/pdr/pose_classifier.hpp"
+#include "telltale/fusion/pdr/pose_switch.hpp"
+#include "telltale/fusion/pdr/recent_samples.hpp"
+#include "telltale/fusion/pdr/step_gaps.hpp"
+#include "telltale/fusion/pdr/step_length.hpp"
+#include "telltale/fusion/pdr/track.hpp"
+#include "telltale/fusion/pdr/walking_heading.hpp"
 #include "telltale/fusion/phone_pose.hpp"
 #include "telltale/fusion/steps.hpp"
 
 namespace telltale::fusion {
-
-// ---------------------------------------------------------------------------------------------
-/// The three features seed 003 kept after PCA (Table 1), over a sliding time window:
-/// acceleration energy = total (3-axis) variance of the specific force, m^2/s^4;
-/// acceleration variance = variance of |f|, m^2/s^4; gyro variance = total (3-axis) variance of
-/// the angular rate, rad^2/s^2 (NaN when the samples carry no gyro).
-struct PoseFeatures {
-  double acc_energy = 0.0;
-  double acc_variance = 0.0;
-  double gyro_variance = 0.0;
-};
-
-class PoseFeatureWindow {
- public:
-  static constexpr std::size_t kCapacity = 1024;
-  explicit PoseFeatureWindow(double window_s = 2.0) : window_s_(window_s) {}
-  /// Adds one sample (t strictly increasing, finite acc; gyro may be NaN).
-  void push(const ImuSample& s);
-  [[nodiscard]] PoseFeatures features() const;
-  /// Mean specific force over the window (sensor frame): the gravity direction, m/s^2.
-  [[nodiscard]] Eigen::Vector3d mean_acc() const;
-  [[nodiscard]] std::size_t size() const { return size_; }
-  [[nodiscard]] double span_s() const;
-
- private:
-  void pop();
-  double window_s_;
-  std::array<ImuSample, kCapacity> buf_{};
-  std::size_t head_ = 0, size_ = 0;
-  Eigen::Vector3d sum_f_ = Eigen::Vector3d::Zero(), sum_f2_ = Eigen::Vector3d::Zero();
-  Eigen::Vector3d sum_w_ = Eigen::Vector3d::Zero(), sum_w2_ = Eigen::Vector3d::Zero();
-  double sum_m_ = 0.0, sum_m2_ = 0.0;
-  std::size_t gyro_count_ = 0;
-};
-
-// ---------------------------------------------------------------------------------------------
-/// BP network of seed 003 (eqs. (4)-(10)): 3 inputs, one sigmoid hidden layer, 4 linear outputs
-/// (one per pose, trained toward one-hot targets), pose = the largest output. Hidden size 8: the
-/// rules of eqs. (1)-(3) give sqrt(n+m)+a = 3..13, log2(n) = 2, sqrt(nm) = 3.5; 8 was the
-/// smallest that reached the training accuracy plateau (tools/train_pose.cpp).
-/// Inputs are log features, standardised with the training mean and scale.
-struct PoseNetwork {
-  static constexpr int kInputs = 3;
-  static constexpr int kHidden = 8;
-  static constexpr int kOutputs = kPoseCount;
-  using Input = Eigen::Matrix<double, kInputs, 1>;
-  using Output = Eigen::Matrix<double, kOutputs, 1>;
-  Eigen::Matrix<double, kHidden, kInputs> w_ih = Eigen::Matrix<double, kHidden, kInputs>::Zero();
-  Eigen::Matrix<double, kHidden, 1> b_h = Eigen::Matrix<double, kHidden, 1>::Zero();
-  Eigen::Matrix<double, kOutputs, kHidden> w_ho = Eigen::Matrix<double, kOutputs, kHidden>::Zero();
-  Output b_o = Output::Zero();
-  Input in_mean = Input::Zero();
-  Input in_scale = Input::Ones();
-  bool trained = false;
-
-  /// Network input for a feature triple (log, then standardised). NaN gyro variance -> NaN.
-  [[nodiscard]] Input input(const PoseFeatures& f) const;
-  [[nodiscard]] Output forward(const Input& x) const;
-  /// Pose for a feature triple; nullopt when untrained or a feature is not finite.
-  [[nodiscard]] std::optional<PhonePose> classify(const PoseFeatures& f) const;
-};
-
-/// Deterministic back-propagation training (seed 003, steps 1-7): per-sample gradient descent on
-/// the squared error with learning rate `eta`, samples visited in a seeded shuffled order each
-/// epoch. Sets the input standardisation from the data.
-struct PoseTrainingParams {
-  int epochs = 400;
-  double eta = 0.05;
-  std::uint64_t seed = 1;
-};
-[[nodiscard]] PoseNetwork train_pose_network(const std::vector<PoseFeatures>& features,
-                                             const std::vector<PhonePose>& labels,
-                                             PoseTrainingParams params = {});
-
-// ---------------------------------------------------------------------------------------------
-/// Seed 003 eq. (13): step length L = a*h + b*f_step + c per pose (h in m, f_step in Hz).
-struct StepLengthModel {
-  std::array<Eigen::Vector3d, kPoseCount> abc{};  ///< per pose: a (m/m), b (m/Hz), c (m)
-  StepLengthModel();                              ///< generic walking coefficients
-  [[nodiscard]] double length_m(PhonePose pose, double height_m, double step_hz) const;
-};
-
-/// A walk of known length used to calibrate the step-length model.
-struct CalibrationWalk {
-  double height_m = 1.75;
-  std::vector<double> step_hz;  ///< estimated step frequency at each counted step
-  double distance_m = 0.0;      ///< the known length of the walk
-};
-/// Least squares for (a, b, c): each walk says sum_i (a h + b f_i + c) = distance. With fewer
-/// walks than unknowns (or walks that do not vary h and f) the solution stays as close as
-/// possible to `prior` (ridge weight `prior_weight` per coefficient, relative to one walk).
-[[nodiscard]] Eigen::Vector3d calibrate_step_length(const std::vector<CalibrationWalk>& walks,
-                                                    const Eigen::Vector3d& prior,
-                                                    double prior_weight = 1e-3);
 
 /// The model file (fusion_core/data/pose_bp.txt): network + step-length coefficients, text.
 [[nodiscard]] std::string format_pdr_model(const PoseNetwork& net, const StepLengthModel& len);
@@ -154,184 +74,27 @@ struct CalibrationWalk {
 [[nodiscard]] const PoseNetwork& builtin_pose_network();
 [[nodiscard]] const StepLengthModel& builtin_step_length_model();
 
-/// Seed 003 eqs. (14)-(15): v_walking = M v_sensor for a pose (identity for hand-held, arm swing).
-[[nodiscard]] Eigen::Matrix3d pose_rotation(PhonePose pose);
-
-// ---------------------------------------------------------------------------------------------
-/// Heading of the walking frame's x axis from gyro + magnetometer (seed 004, Fig. 2): a two-state
-/// Kalman filter [heading, heading-rate bias]; prediction with the gyro rate about the tracked
-/// up direction, update with the tilt-compensated magnetic heading. The up direction is tracked
-/// by integrating the gyro and pulling toward the accelerometer (`up_tau_s`), with the
-/// centripetal acceleration of turns and a swinging hand's lever-arm acceleration taken out of
-/// the accelerometer first. Magnetic north (no declination).
-struct HeadingFilterParams {
-  double gyro_noise_rad_s = 0.02;  ///< heading-rate noise density, rad/s/sqrt(Hz)
-  double bias_walk_rad_s2 = 2e-4;  ///< bias random walk, rad/s^2/sqrt(Hz)
-  double mag_noise_deg = 6.0;      ///< magnetic heading noise per sample, deg
-  double gate_deg = 40.0;          ///< larger innovations are rejected...
-  double reset_after_s = 3.0;      ///< ...unless they persist this long (then reset)
-  double up_tau_s = 1.5;           ///< time constant of the pull toward the accelerometer
-  /// Lever arm: a phone that swings about a point (the shoulder, the hip) reads that point's
-  /// tangential and centripetal acceleration, w' x p + w x (w x p), with p the phone's position
-  /// from the point, fixed in the phone. p is fitted by weighted least squares (forgetting
-  /// `lever_arm_tau_s`, prior 0 +- `lever_arm_prior_m`, residual noise `lever_arm_noise_m_s2`
-  /// per sqrt(Hz)) from the rotation about the horizontal axes only, and taken out of the
-  /// accelerometer before the up direction is pulled toward it.
-  bool lever_arm = true;
-  double lever_arm_tau_s = 10.0;
-  double lever_arm_prior_m = 0.5;
-  double lever_arm_noise_m_s2 = 3.0;
-};
-class HeadingFilter {
- public:
-  using Params = HeadingFilterParams;
-  struct State {
-    double heading_rad = 0.0;
-    double bias_rad_s = 0.0;
-    Eigen::Matrix2d p = Eigen::Matrix2d::Identity();
-    Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  ///< up, walking frame
-    double last_t_s = 0.0;
-    double rejected_since_s = -1.0;
-    bool initialised = false;
-  };
-  struct Diagnostics {
-    unsigned rejected_non_finite = 0;
-    unsigned rejected_mag = 0;  ///< magnetometer updates refused by the gate
-    unsigned resets = 0;
-  };
-  explicit HeadingFilter(Params params = {}) : params_(params) {}
-  /// Feeds a sample already rotated into the walking frame; mag may be NaN (prediction only).
-  void update(double t_s, const Eigen::Vector3d& gyro_rad_s, const Eigen::Vector3d& acc_m_s2,
-              const Eigen::Vector3d& mag_uT);
-  /// Forgets the heading (next magnetic reading initialises it); keeps the up direction.
-  void reset_heading() { state_.initialised = false; }
-  /// Walking speed along the frame's x axis, m/s: its centripetal acceleration in turns is taken
-  /// out of the accelerometer before the up direction is pulled toward it.
-  void set_speed(double v_m_s) { speed_m_s_ = v_m_s; }
-  /// The walking frame changed by `r` (v_new = r v_old): re-expresses the up direction and
-  /// forgets the heading.
-  void change_frame(const Eigen::Matrix3d& r) {
-    state_.up = r * state_.up;
-    last_acc_ = r * last_acc_;
-    last_gyro_ = r * last_gyro_;
-    before_gyro_ = r * before_gyro_;
-    lever_info_.setZero();  // the phone sits another way in the hand: a new lever arm
-    lever_sum_.setZero();
-    lever_m_.setZero();
-    state_.initialised = false;
-  }
-  [[nodiscard]] double heading_rad() const { return state_.heading_rad; }
-  [[nodiscard]] bool initialised() const { return state_.initialised; }
-  [[nodiscard]] const State& state() const { return state_; }
-  void set_state(const State& s) { state_ = s; }
-  [[nodiscard]] const Diagnostics& diagnostics() const { return diag_; }
-  /// Tilt-compensated heading of the x axis from a magnetometer reading and the up direction
-  /// (same frame); NaN when x is near vertical or the field is degenerate.
-  [[nodiscard]] static double magnetic_heading_rad(const Eigen::Vector3d& mag,
-                                                   const Eigen::Vector3d& up);
-  /// The same for any unit axis of that frame (its horizontal projection's heading).
-  [[nodiscard]] static double magnetic_heading_rad(const Eigen::Vector3d& mag,
-                                                   const Eigen::Vector3d& up,
-                                                   const Eigen::Vector3d& axis);
-
- private:
-  Params params_;
-  State state_;
-  Diagnostics diag_;
-  bool up_init_ = false;
-  double speed_m_s_ = 0.0;
-  /// Pulls the up direction toward the previous sample's accelerometer reading (its angular
-  /// acceleration needs the rates on both sides of it: `gyro` is the current one).
-  void pull_up(double dt, const Eigen::Vector3d& gyro, bool gyro_ok, double t_s);
-
-  Eigen::Vector3d last_gyro_ = Eigen::Vector3d::Zero();  ///< for the trapezoidal rate
-  bool last_gyro_ok_ = false;
-  Eigen::Vector3d last_acc_ = Eigen::Vector3d::Zero();     ///< the sample the pull is for
-  Eigen::Vector3d before_gyro_ = Eigen::Vector3d::Zero();  ///< the rate a sample before that
-  bool before_gyro_ok_ = false;
-  double before_t_s_ = 0.0;
-  Eigen::Matrix3d lever_info_ = Eigen::Matrix3d::Zero();  ///< sum of A^T A dt, forgetting
-  Eigen::Vector3d lever_sum_ = Eigen::Vector3d::Zero();   ///< sum of A^T r dt, forgetting
-  Eigen::Vector3d lever_m_ = Eigen::Vector3d::Zero();
-  double lever_solved_t_s_ = -1e9;
-};
-
 // ---------------------------------------------------------------------------------------------
 struct PdrParams {
   StepMount mount = StepMount::kBody;  ///< kBody: phone (seed 003); kFoot: toe sensor (seed 004)
-  double height_m = 1.75;              ///< walker's height, m
-  double feature_window_s = 2.0;       ///< pose feature window, s
-  double switch_correlation = 0.5;     ///< step waveforms correlating less = pose switch...
-  double switch_tilt_deg = 15.0;       ///< ...if gravity also moved this much in the sensor frame
-                                       ///< (twice this much is a switch whatever the correlation)
-  int switch_exit_steps = 2;           ///< correlated steps needed to leave a switch
-  int pose_window_steps = 10;          ///< steps after a switch to confirm the new pose
-  int pose_fallback_steps = 10;        ///< identical answers that change the pose without a switch
-  /// The same between poses with one walking frame (hand-held and arm swing: no re-orientation
-  /// for the waveforms to see). Fewer are needed: no frame turns with a wrong answer, and until
-  /// the change the old pose's walking-direction correction is applied to the new pose's steps
-  /// (~10 deg after an arm swing, measured).
-  int pose_fallback_same_frame_steps = 5;
-  double pose_gravity_deg = 45.0;  ///< a pose whose M does not bring gravity this close to
-                                   ///< the walking frame's up is not plausible
-  double straight_deg = 10.0;      ///< 3 steps within this of their mean are "straight"
-  int pose_confirm_steps = 3;      ///< identical classifications before the pose changes
-  double fill_min_ratio = 1.6;     ///< a gap this many step intervals long has missed steps...
-  double fill_max_gap_s = 4.0;     ///< ...if shorter than this...
-  double fill_min_energy = 0.5;    ///< ...and the phone's acceleration energy says walking
-  /// ...and held no stand: the phone still (|f| within still_acc_std_m_s2, rotating at less
-  /// than stand_gyro_rad_s rms) for stand_still_s.
+  /// A stand: the phone still (|f| within gyro_bias.acc_std_m_s2, rotating at less than
+  /// stand_gyro_rad_s rms) for stand_still_s. A gap that held one has no missed steps
+  /// (StepGaps), and a walk after one must confirm its start (PhoneSteps).
   /// A walker who stops and then moves the phone (puts it away, lifts it to the ear) makes
   /// events after a gap that held no steps (2-3 steps too many on 10 of 400 loops). 0: off.
   double stand_still_s = 0.6;
-  /// After a stand a walk's first event counts only if a second follows within this many step
-  /// intervals, without a stand between (the hand's movement made 1-2 lone events). 0: off.
-  double walk_start_intervals = 2.0;
   /// A stand's rotation rate, rms: a still hand (0.05 rad/s), not a swinging arm (1-3 rad/s).
   double stand_gyro_rad_s = 0.2;
-  double min_step_interval_s = 0.2;  ///< 5 steps/s, a sprinter's: shorter is no cadence
-  double walk_pause_s = 2.0;         ///< no step for this long: the next is a new walk
-  bool walking_direction = true;     ///< correct the phone's yaw from the acceleration pattern
-  int walking_direction_steps = 4;   ///< straight steps in a pose before the correction applies
-  /// How far a phone is yawed in a hand or pocket, rms (a few degrees). The estimate is shrunk
-  /// toward 0 by prior^2 / (prior^2 + s^2), s its standard error from the scatter of the steps'
-  /// own angles, so a noisy estimate (a pocket, a swinging arm) corrects little and a clean one
-  /// (hand-held, at the ear) almost in full. Only steps walked straight (this and the neighbouring
-  /// step within straight_deg of each other) feed it: in a corner the centripetal acceleration
-  /// starts and stops within a step and correlates with the vertical's derivative (end-of-pose
-  /// error, seeds 100-139: hand-held 1.13 -> 0.47 deg rms, phone call 0.73 -> 0.14).
-  double walking_direction_prior_deg = 2.0;
-  /// In arm swing the walking direction comes from the step's principal rotation axis, when its
-  /// sum of squared rates is this many times the next axis's (a swing, not a turn or a fumble).
-  double swing_axis_ratio = 4.0;
-  /// Re-lay steps already walked when an estimate they were laid with improves (our addition):
-  /// the hard-iron offset (each step's heading moves by its sensitivity to the offset, so the
-  /// leg walked before the first corner calibrated the magnetometer is corrected too) and the
-  /// pose's yaw from the walking direction (every step since the pose began turns with it).
-  bool revise_track = true;
-  /// Gyro bias from standing still (our addition): a window of this length in which the rate
-  /// and |f| vary less than the limits below gives the bias as its mean rate (the average of the
-  /// last 10 such windows is subtracted from every sample). A mean rate above
-  /// still_max_bias_rad_s is a slow steady turn (a vehicle), not a bias.
-  double still_window_s = 1.0;
-  double still_gyro_std_rad_s = 0.03;
-  double still_acc_std_m_s2 = 0.15;
-  double still_max_bias_rad_s = 0.1;
-  /// Accelerometer bias from the field's vertical component (our addition): a bias b tilts the
-  /// up direction by its part across up over g, and the magnetic heading by tan(dip) times that
-  /// (0.05 m/s^2: 0.3 deg of tilt, 0.7 deg of heading at 65 deg dip), with a sign that turns
-  /// with the heading, so it does not cancel round a loop. Seen as a vertical field that
-  /// changes with the heading (Pdr::learn_acc_bias); the estimate is removed from the
-  /// accelerometer before the heading filter.
-  bool learn_acc_bias = true;
-  double acc_bias_prior_m_s2 = 0.1;         ///< prior std of each bias component
-  double acc_bias_step_noise_uT = 0.5;      ///< noise of one step's mean vertical field
-  double acc_bias_vertical_walk_uT = 0.05;  ///< drift of the vertical field, uT/sqrt(s)
-  double acc_bias_max_turn_rad_s = 0.4;     ///< samples turning faster than this are left out
-  /// Personal factor on the model's step length, per pose (1 = the population model). Set it from
-  /// a calibration walk of known length: known distance / `output().distance_m` of that walk.
-  std::array<double, kPoseCount> step_scale{1.0, 1.0, 1.0, 1.0};
+  StepGapParams gaps;
+  PhoneStepParams phone_steps;
+  GyroBiasParams gyro_bias;
+  AccBiasParams acc_bias;
+  PoseClassifierParams pose;
+  PoseSwitchParams pose_switch;
+  StepLengthParams step_length;
+  TrackParams track;
   HeadingFilterParams heading;
+  WalkingDirectionParams walking_direction;
   bool calibrate_mag = true;  ///< online hard-iron calibration (hard_iron.hpp) before the heading
   HardIronParams hard_iron;
 };
@@ -374,195 +137,64 @@ class Pdr {
   [[nodiscard]] const StepDiagnostics& step_diagnostics() const;
   [[nodiscard]] const HardIronCalibrator& mag_calibration() const { return mag_cal_; }
   /// Gyro bias learnt while still (sensor frame, rad/s; subtracted from every sample).
-  [[nodiscard]] const Eigen::Vector3d& gyro_bias_rad_s() const { return gyro_bias_; }
+  [[nodiscard]] const Eigen::Vector3d& gyro_bias_rad_s() const { return gyro_bias_.bias_rad_s(); }
   /// Accelerometer bias learnt from the vertical field (sensor frame, m/s^2; removed from the
   /// accelerometer before the heading filter).
-  [[nodiscard]] const Eigen::Vector3d& acc_bias_m_s2() const { return acc_bias_; }
+  [[nodiscard]] const Eigen::Vector3d& acc_bias_m_s2() const { return acc_bias_.bias_m_s2(); }
   /// Step frequencies seen at each step so far are not stored (no heap); for calibration, collect
   /// `output().step_hz` at every step in the caller.
 
  private:
-  static constexpr int kWave = 16;  ///< points per axis in a step waveform
-  using Wave = Eigen::Matrix<double, 3 * kWave, 1>;
-  /// How a phone step was found (phone_step): steps to count with it that the acceleration
-  /// missed at a walk's swinging start, whether its detector took over from the other one, and
-  /// whether the walker stood still since the last step.
-  struct StepSource {
-    int backfill = 0;
-    bool handoff = false;
-    bool after_stand = false;  ///< the phone stood still since the last step (quiet_between)
-  };
   void on_step(double t_s, StepSource source);
-  /// Phone-mounted step detection: the acceleration's peaks and valleys, the arm's turns while
-  /// the phone swings.
-  bool phone_step(const ImuSample& s, const Eigen::Matrix3d& m, StepEvent& ev, StepSource& source);
-  [[nodiscard]] Wave step_wave(double t0_s, double t1_s) const;
-
-  Params params_;
-  PoseNetwork net_;
-  StepLengthModel lengths_;
-  PeakValleyStepDetector phone_steps_;
-  SwingStepDetector swing_steps_;  ///< steps while the phone swings (its turns)
-  bool last_step_by_swing_ = false;
-  struct Walk {  ///< since the last pause (phone_step)
-    double last_event_t_s = -1e9;
-    int swing_events = 0;  ///< the arm's turns
-    int steps = 0;         ///< steps counted (either detector)
-    bool backfilled = false;
-  } walk_;
-  int filled_row_ = 0;               ///< steps in a row that filled a gap
-  double start_pending_t_s_ = -1.0;  ///< a walk's first event after a stand, held (phone_step)
-  AdaptiveStepDetector foot_steps_;
-  PoseFeatureWindow features_;
-  HeadingFilter heading_;
-  HardIronCalibrator mag_cal_;
-  Diagnostics diag_;
-  PdrOutput out_;
-  PhonePose applied_pose_ = PhonePose::kHandHeld;
-  PhonePose candidate_pose_ = PhonePose::kHandHeld;
-  int candidate_count_ = 0;
-  // Recent raw accelerations for the step waveforms.
-  static constexpr std::size_t kRaw = 512;
-  std::array<double, kRaw> raw_t_{};
-  std::array<Eigen::Vector3d, kRaw> raw_f_{};
-  std::array<double, kRaw> raw_w2_{};       ///< |w|^2 (kNoGyroW2 without a gyroscope)
-  static constexpr double kNoGyroW2 = 1e6;  ///< far above any stand's
-  std::size_t raw_head_ = 0, raw_size_ = 0;
-  std::array<Wave, 2> waves_{};             ///< the last two step waveforms
-  std::array<Eigen::Vector3d, 2> tilts_{};  ///< their mean gravity directions (sensor frame)
-  /// The up direction tracked by the heading filter (gyro, pulled toward the accelerometer with
-  /// the turn's centripetal acceleration taken out), sensor frame: summed over the step in
-  /// progress, and its mean over the last two steps. Unlike the waveform's mean acceleration it
-  /// does not tilt in a corner: the switch's re-laying tells by it where the phone sat.
-  Eigen::Vector3d step_up_ = Eigen::Vector3d::Zero();
-  std::array<Eigen::Vector3d, 2> ups_{};
-  bool settling_ = false;  ///< switch over, waiting for the new pose to be confirmed
-  int settling_steps_ = 0;
-  bool pose_known_ = false;
-  double pending_m_ = 0.0;  ///< distance walked before the first heading
-  /// A step walked during a pose switch, re-laid when the switch is over.
-  struct SwitchStep {
-    double length_m = 0.0;
-    double laid_rad = 0.0;       ///< heading it was laid with
-    double old_frame_rad = 0.0;  ///< heading filter's heading (pose before the switch)
-    Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  ///< mean tracked up, sensor frame
-    std::size_t slot = 0;                           ///< which foot (waves_/ups_ slot)
-    std::array<Eigen::Vector2d, 2> axis_sum{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
-  };
-  static constexpr std::size_t kMaxSwitchSteps = 32;
-  /// The last steps laid outside a switch, newest last: a switch is seen one or two steps after
-  /// the phone began to move, so those are re-laid with the switch.
-  static constexpr std::size_t kLookback = 2;
-  std::array<SwitchStep, kLookback> last_steps_{};
-  std::array<std::array<Eigen::Vector3d, 2>, kLookback> last_ups_before_{};
-  std::size_t last_count_ = 0;
-  /// Re-lays the switch's steps (switch_) for the phone now in `pose`; `heading_after` is the
-  /// heading of the step after them (none: the switch goes on).
+  /// Counts the step (and the steps a gap held, the cadence learnt from it); returns how many
+  /// more than `per_event` this event stands for.
+  int count_steps(double t_s, const StepSource& source, double per_event);
+  /// Compares the step [t_prev, t_s]'s waveform with the same foot's last: a pose switch
+  /// begins (its steps gathered; `ups_before` each foot's up before this step) or settles.
+  void detect_switch(double t_prev, double t_s, const std::array<Eigen::Vector3d, 2>& ups_before);
+  /// The pose classifier's vote at this step, and a new walking frame if it confirms one.
+  void classify_pose(double t_s);
+  /// The step's walking direction (rad): the heading over the step, yaw-corrected.
+  double walked_heading();
+  /// Lays the step (`missed` more with it) walked along `walked_rad`: its length, the heading a
+  /// switch or a gap gives it, the track, and what a later re-laying needs.
+  void lay_step(double t_s, double t_prev, double per_event, int missed, double walked_rad,
+                const std::array<Eigen::Vector3d, 2>& ups_before);
+  /// Re-lays the switch's steps for the phone now in `pose`; `heading_after` is the heading of
+  /// the step after them (none: the switch goes on).
   void relay_switch_steps(std::optional<double> heading_after, PhonePose pose);
+  /// Keeps a laid step for a switch's re-laying (in the switch, or among the last steps before
+  /// one) and re-lays the switch's steps when it ends or the classifier sees a pose.
+  void book_laid_step(const SwitchStep& laid, double heading,
+                      const std::array<Eigen::Vector3d, 2>& ups_before);
+  /// A new pose or a switch: the walking direction and the pose's track revision start again.
   void reset_walking_direction();
-  /// Adds one sample (sensor frame) to the step's vertical-field sums.
-  void add_vertical_field(const Eigen::Vector3d& gyro, const Eigen::Vector3d& up,
-                          const Eigen::Vector3d& mag);
-  /// Accelerometer bias from the vertical field's constancy (one Kalman update per step).
-  void learn_acc_bias(double t_s);
-  /// The phone changed how it sits: the vertical field plus hard-iron residual is unknown again.
+  /// The phone changed how it sits: the accelerometer bias's vertical field is unknown again.
   void forget_vertical_field();
-  /// Arm swing: the step's walking direction from its principal rotation axis (step_fwd_/left_).
-  void swing_axis_direction();
-  void learn_gyro_bias(const ImuSample& s);
   /// Turns the steps laid in this pose so far with a new yaw correction `corr` (rad).
   void revise_pose_yaw(double corr);
-  /// Moves the track by what the current hard-iron offset changes in every step laid so far.
-  void revise_mag_offset();
-  // Correlation of the horizontal acceleration with d(vertical)/dt in the pose's walking frame:
-  // the sums of straight steps, of the step in progress, and of the last step (kept until the
-  // next one shows whether it was straight).
-  double yaw_fwd_ = 0.0, yaw_left_ = 0.0;
-  /// Arm swing: sum of w w^T (walking frame) over the step in progress.
-  Eigen::Matrix3d step_swing_ = Eigen::Matrix3d::Zero();
-  double step_fwd_ = 0.0, step_left_ = 0.0, last_fwd_ = 0.0, last_left_ = 0.0;
-  double last_raw_heading_rad_ = 0.0;
-  bool have_last_raw_ = false, last_straight_ = false;
-  // Per straight step: sum and sum of squares of its own yaw angle, and how many.
-  double step_yaw_sum_ = 0.0, step_yaw_sq_ = 0.0;
-  int straight_steps_ = 0;
-  // Track revision for the pose's yaw: displacement of the steps laid in this pose (as laid),
-  // the correction they carry, and how many there are.
-  Eigen::Vector2d pose_disp_ = Eigen::Vector2d::Zero();
-  double pose_corr_rad_ = 0.0;
-  std::size_t pose_steps_ = 0;
-  // Track revision for the hard-iron offset: over all laid steps, sum of L dpos/dheading
-  // (dheading/doffset)^T (east, north per uT) and of the same times the offset each was laid
-  // with; the correction already applied. Over the current step: sum of dheading/doffset.
-  Eigen::Matrix<double, 2, 3> mag_a_ = Eigen::Matrix<double, 2, 3>::Zero();
-  Eigen::Vector2d mag_c_ = Eigen::Vector2d::Zero(), mag_applied_ = Eigen::Vector2d::Zero();
-  Eigen::Vector3d mag_grad_sum_ = Eigen::Vector3d::Zero();
-  int mag_grad_n_ = 0;
-  // Still windows for the gyro bias.
-  double still_t0_ = 0.0, still_w2_ = 0.0, still_a_ = 0.0, still_a2_ = 0.0;
-  Eigen::Vector3d still_w_ = Eigen::Vector3d::Zero(), gyro_bias_ = Eigen::Vector3d::Zero();
-  // Accelerometer bias from the vertical field: state [C (uT), b (m/s^2, sensor frame)], its
-  // covariance, the bias removed before the heading filter, and the step's sums.
-  Eigen::Vector4d acc_x_ = Eigen::Vector4d::Zero();
-  Eigen::Matrix4d acc_p_ = initial_acc_covariance();
-  Eigen::Vector3d acc_bias_ = Eigen::Vector3d::Zero();
-  double tilt_z_sum_ = 0.0, tilt_t_s_ = -1.0, tilt_settled_t_s_ = 0.0;
-  Eigen::Vector3d tilt_r_sum_ = Eigen::Vector3d::Zero(), tilt_up_sum_ = Eigen::Vector3d::Zero();
-  Eigen::Vector3d tilt_offset_uT_ = Eigen::Vector3d::Zero();  ///< hard-iron offset C is for
-  int tilt_n_ = 0;
-  [[nodiscard]] Eigen::Matrix4d initial_acc_covariance() const {
-    Eigen::Matrix4d p =
-        Eigen::Matrix4d::Identity() * params_.acc_bias_prior_m_s2 * params_.acc_bias_prior_m_s2;
-    p(0, 0) = 1e4;
-    return p;
-  }
-  int still_n_ = 0;
-  double last_av_ = 0.0, last_av_t_ = 0.0;
-  bool have_av_ = false;
-  std::array<SwitchStep, kMaxSwitchSteps> switch_{};
-  int switch_steps_ = 0;
-  std::array<Eigen::Vector3d, 2> pre_switch_ups_{
-      Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitZ()};  ///< both feet's up before the switch
-  std::size_t last_slot_ = 0;
+
+  Params params_;
+  StepLength step_length_;
+  PhoneSteps phone_steps_;
+  AdaptiveStepDetector foot_steps_;
+  PoseClassifier pose_;
+  RecentSamples recent_;  ///< phone pipeline only
+  StepGaps gaps_;
+  HeadingFilter heading_;
+  WalkingDirection walking_;
+  HardIronCalibrator mag_cal_;
+  GyroBiasLearner gyro_bias_;
+  AccBiasLearner acc_bias_;
+  Track track_;
+  Diagnostics diag_;
+  PdrOutput out_;
+  PoseSwitch switch_;  ///< phone pipeline only
+  SwitchRelay relay_;  ///< the steps of a pose switch, and the last ones before one
   /// Over the current step, sums of unit (east, north) vectors of the horizontal sensor x and
   /// -z axes: the walking direction if the pose's forward axis is that one.
   std::array<Eigen::Vector2d, 2> axis_sum_{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
-  int wave_count_ = 0;
-  double last_step_t_s_ = -1.0;
-  /// The step interval: the median of the last kIntervals measured ones (0 until one is).
-  double interval_s_ = 0.0;
-  static constexpr std::size_t kIntervals = 5;
-  std::array<double, kIntervals> intervals_{};
-  std::size_t interval_count_ = 0;
-  void learn_interval(double interval_s);
-  /// Whether the phone's acceleration repeats itself after `lag_s` (a step interval does).
-  [[nodiscard]] bool walking_period(double lag_s) const;
-  /// Index, from the oldest, of the first raw sample at or after t_s (raw_size_ if none).
-  [[nodiscard]] std::size_t raw_first_at(double t_s) const;
-  /// Whether the phone was still (|f| steady, little rotation) for stand_still_s somewhere in
-  /// [t0, t1]: a stand.
-  [[nodiscard]] bool quiet_between(double t0_s, double t1_s) const;
-  // Heading over the current step (circular mean) and of the last three steps.
-  double sum_sin_ = 0.0, sum_cos_ = 0.0;
-  /// The heading over the last seconds, in 0.1 s bins (sums of unit vectors, since the walking
-  /// frame last changed): a step that fills a gap lays the steps it adds along the heading each
-  /// part of the gap had (gap_turn).
-  static constexpr std::size_t kHeadingBins = 64;
-  static constexpr double kHeadingBinS = 0.1;
-  std::array<Eigen::Vector2d, kHeadingBins> heading_bins_{};
-  std::array<std::int64_t, kHeadingBins> heading_bin_id_{};
-  double heading_bins_from_t_s_ = 0.0;
-  void add_heading_bin(double t_s, const Eigen::Vector2d& unit);  ///< (cos, sin) of the heading
-  /// For a gap [t0, t1] walked in `parts` equal steps: the mean of the unit vectors of each
-  /// part's heading relative to the whole gap's (x along, y clockwise); (1, 0) when the bins do
-  /// not cover the gap.
-  [[nodiscard]] Eigen::Vector2d gap_turn(double t0_s, double t1_s, int parts) const;
-  std::array<double, 5> recent_heading_rad_{};  ///< oldest first
-  int recent_count_ = 0;
-  bool switching_ = false;
-  int correlated_steps_ = 0;
-  double replacement_heading_rad_ = 0.0;
-  bool have_replacement_ = false;
+  double sum_sin_ = 0.0, sum_cos_ = 0.0;  ///< heading over the current step (circular mean)
   bool have_t_ = false;
   double last_t_s_ = 0.0;
 };

@@ -38,7 +38,8 @@ namespace telltale::fusion::sim {
 /// The personal step-length calibration an athlete does once: walk a straight, known `length_m`
 /// (e.g. 100 m between two marks on a pontoon) at a normal pace with the phone in `pose`, then
 /// step_scale = known length / PDR distance. `seed` draws that walk's noise and sensor biases
-/// (another run than the evaluated one). Returns the factor for PdrParams::step_scale.
+/// (another run than the evaluated one). Returns the factor for StepLengthParams::scale
+/// (PdrParams::step_length).
 [[nodiscard]] double personal_step_scale(const Person& person, std::uint64_t seed,
                                          PhonePose pose = PhonePose::kHandHeld,
                                          double length_m = 100.0);
