@@ -681,7 +681,7 @@ int main(int argc, char** argv) {
                        ? std::string()
                        : "'" + v + "' is not a finite number of metres";
           },
-          "FINITE")
+          "")
       ->check(CLI::Range(-50.0, 50.0))
       ->capture_default_str()
       ->group(mounting);

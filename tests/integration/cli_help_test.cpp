@@ -97,7 +97,7 @@ std::vector<HelpCase> cases() {
                    {"--source", "--imu-rate-hz", "--seed", "--gyro-range-dps", "--acc-range-g",
                     "--replay-fast", "--replay-loop"}},
                   {"GNSS and heading", {"--gnss", "--heading", "--variation-deg"}},
-                  {"Mounting", {"--axis-remap", "--mount-file", "--calibrate-s"}},
+                  {"Mounting", {"--axis-remap", "--mount-file", "--sensor-offset", "--calibrate-s"}},
                   {"Session log", {"--log-dir", "--log-max-mb", "--deliver-earlier-days"}},
                   {"Alarms and LED panel",
                    {"--console", "--warn-command", "--led-step-deg", "--leds-per-bar",
