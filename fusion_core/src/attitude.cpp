@@ -42,8 +42,13 @@ std::string attitude_filter_description(std::string_view name) {
   return {};
 }
 
-std::unique_ptr<AttitudeFilter> make_attitude_filter(std::string_view name) {
-  if (name == "telltale") return std::make_unique<TelltaleAttitudeFilter>();
+std::unique_ptr<AttitudeFilter> make_attitude_filter(std::string_view name,
+                                                     const Eigen::Vector3d& lever_arm_m) {
+  if (name == "telltale") {
+    TelltaleAttitudeParams params;
+    params.lever_arm_m = lever_arm_m;
+    return std::make_unique<TelltaleAttitudeFilter>(params);
+  }
   if (name == "seed") return std::make_unique<SeedAttitudeFilter>();
   if (name == "gyro") return std::make_unique<GyroAttitudeFilter>();
   if (name == "accel") return std::make_unique<AccelAttitudeFilter>();

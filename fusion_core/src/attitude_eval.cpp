@@ -5,7 +5,6 @@
 #include <cmath>
 
 #include "telltale/fusion/attitude_speed.hpp"
-#include "telltale/fusion/attitude_telltale.hpp"
 #include "telltale/fusion/sim/scenario.hpp"
 
 namespace telltale::fusion {
@@ -41,21 +40,13 @@ std::vector<TiltErrorStats> evaluate_on_scenario(const std::vector<std::string>&
   if (errors != nullptr) options.errors = *errors;
   auto sc = sim::make_scenario(scenario_name, seed, rate_hz, duration_s, options);
   if (!sc) return st;
+  // A boat's node is installed: configured with where its sensor sits from the boat's centre
+  // (the point the GNSS fixes describe), as boat_node --sensor-offset does. The other scenarios
+  // are no boat installation (a pendulum's bob, a desk, a turntable), and BROAD and the phones
+  // have no centre to refer to: the filters there run as configured by default (no offset).
+  const Eigen::Vector3d installed = sc->has_gnss() ? sc->lever_arm() : Eigen::Vector3d::Zero();
   std::vector<std::unique_ptr<AttitudeFilter>> filters;
-  for (const auto& name : filter_names) {
-    if (name == "telltale" && sc->has_gnss()) {
-      // A boat's node is installed: configured with where its sensor sits from the boat's centre
-      // (the point the GNSS fixes describe), as boat_node --sensor-offset does. The other
-      // scenarios are no boat installation (a pendulum's bob, a desk, a turntable), and BROAD
-      // and the phones have no centre to refer to: the filter there runs as configured by
-      // default (no offset).
-      TelltaleAttitudeParams params;
-      params.lever_arm_m = sc->lever_arm();
-      filters.push_back(std::make_unique<TelltaleAttitudeFilter>(params));
-    } else {
-      filters.push_back(make_attitude_filter(name));
-    }
-  }
+  for (const auto& name : filter_names) filters.push_back(make_attitude_filter(name, installed));
   std::vector<double> se_h(n, 0.0);
   std::vector<double> se_p(n, 0.0);
   ImuSample imu;

@@ -183,7 +183,10 @@ inline void output_from_up(const Eigen::Vector3d& gyro_body_rad_s, const Eigen::
 [[nodiscard]] std::string attitude_filter_description(std::string_view name);
 /// Name of the production filter (the default of fusion_cli attitude and of the boat node).
 inline constexpr std::string_view kDefaultAttitudeFilter = "telltale";
-/// Builds a filter with its default Params; nullptr for an unknown name.
-[[nodiscard]] std::unique_ptr<AttitudeFilter> make_attitude_filter(std::string_view name);
+/// Builds a filter with its default Params; nullptr for an unknown name. `lever_arm_m` is the
+/// installation's sensor offset from the boat's centre (TelltaleAttitudeParams::lever_arm_m);
+/// the baselines have no model of it and ignore it.
+[[nodiscard]] std::unique_ptr<AttitudeFilter> make_attitude_filter(
+    std::string_view name, const Eigen::Vector3d& lever_arm_m = Eigen::Vector3d::Zero());
 
 }  // namespace telltale::fusion
