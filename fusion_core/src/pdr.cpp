@@ -300,7 +300,8 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
   }
   ImuSample s = raw;
   if (gyro_ok(s)) {
-    if (gyro_bias_.add(s)) ++diag_.still_windows;
+    gyro_bias_.add(s);
+    diag_.still_windows = gyro_bias_.windows();
     s.gyro_body_rad_s -= gyro_bias_.bias_rad_s();
   }
   out_.t_s = s.t_s;

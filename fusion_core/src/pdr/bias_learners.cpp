@@ -7,7 +7,7 @@
 
 namespace telltale::fusion {
 
-bool GyroBiasLearner::add(const ImuSample& s) {
+void GyroBiasLearner::add(const ImuSample& s) {
   if (n_ == 0) t0_ = s.t_s;
   ++n_;
   w_ += s.gyro_body_rad_s;
@@ -15,7 +15,7 @@ bool GyroBiasLearner::add(const ImuSample& s) {
   const double a = s.acc_body_m_s2.norm();
   a_ += a;
   a2_ += a * a;
-  if (s.t_s - t0_ < params_.window_s) return false;
+  if (s.t_s - t0_ < params_.window_s) return;
   const double n = n_;
   const Eigen::Vector3d mean_w = w_ / n;
   const double var_w = w2_ / n - mean_w.squaredNorm();
@@ -30,7 +30,6 @@ bool GyroBiasLearner::add(const ImuSample& s) {
   n_ = 0;
   w_.setZero();
   w2_ = a_ = a2_ = 0.0;
-  return still;
 }
 
 void AccBiasLearner::add(const Eigen::Vector3d& gyro, const Eigen::Vector3d& up,

@@ -27,11 +27,12 @@ class GyroBiasLearner {
  public:
   using Params = GyroBiasParams;
   explicit GyroBiasLearner(Params params) : params_(params) {}
-  /// Adds a sample that has a gyro (raw, sensor frame); true when it closed a still window,
-  /// which then set the bias.
-  bool add(const ImuSample& s);
+  /// Adds a sample that has a gyro (raw, sensor frame); a still window it closes sets the bias.
+  void add(const ImuSample& s);
   /// Sensor frame, rad/s.
   [[nodiscard]] const Eigen::Vector3d& bias_rad_s() const { return bias_; }
+  /// Still windows that set the bias so far (Pdr::Diagnostics::still_windows).
+  [[nodiscard]] unsigned windows() const { return windows_; }
 
  private:
   Params params_;
