@@ -217,7 +217,11 @@ std::string ipol_detail(const IpolTrial& t, const std::string& side, const std::
 ///   the steps outside it. The files do annotate 1-3 steps per trial whose heel strike falls
 ///   inside the U-turn (a foot that lands while the trunk turns); an annotated step is inside
 ///   when its heel strike is, the event a step is reported at. A detector reporting exactly the
-///   annotated heel strikes scores 100 %.
+///   annotated heel strikes scores 100 %. Nine of the 22 shared trials annotate heel strikes
+///   after their recording's last sample (1-2 per trial, the walker going on after the file
+///   ends): no detector can count those, so the table prints them per file ("past the end") and
+///   the README score of an exact detector, one that reports every annotated heel strike the
+///   recording holds ("ceiling"). Scored as the README says, they stay in the annotated count.
 /// - every annotated step: the same detections against every annotated step, the U-turn's
 ///   included (an earlier version of this table printed it as the README rule: an exact detector
 ///   scores ~92.6 % there, since no step it reports inside the U-turn may count).
@@ -236,13 +240,14 @@ void ipol_table(const EvalOptions& o, bool foot) {
   std::printf(
       "\n## IPOL healthy gait (%s), %s sensor%s: steps counted outside the U-turn (accuracy "
       "README rule / against every annotated step, %%)\n\n| file | annotated (outside U-turn / "
-      "all) |",
+      "all) | past the end |",
       dir.c_str(), foot ? "foot" : "lower-back", foot ? " (that foot's steps)" : " (every step)");
   for (auto n : names) std::printf(" %.*s |", static_cast<int>(n.size()), n.data());
-  std::printf("\n|---|---|");
+  std::printf("\n|---|---|---|");
   for (std::size_t i = 0; i < names.size(); ++i) std::printf("---|");
   std::printf("\n");
   std::vector<double> sum_readme(names.size(), 0.0), sum_all(names.size(), 0.0);
+  double sum_ceiling = 0.0;
   std::vector<double> worst(names.size(), 1.0);
   std::string details;
   int files = 0, i = 0;
@@ -259,8 +264,13 @@ void ipol_table(const EvalOptions& o, bool foot) {
       const auto outside = [&t](double x) { return x < t.uturn0_s || x > t.uturn1_s; };
       const auto truth_out = static_cast<std::size_t>(std::count_if(hs.begin(), hs.end(), outside));
       const auto records = read_imu_csv(path, false);
+      const double end_s = records.empty() ? 0.0 : records.back().imu.t_s;
+      const auto past = static_cast<std::size_t>(
+          std::count_if(hs.begin(), hs.end(), [&](double x) { return x > end_s && outside(x); }));
+      sum_ceiling += count_accuracy(truth_out - past, truth_out);
       ++files;
-      std::printf("| %s_%s | %zu / %zu |", t.name.c_str(), side.c_str(), truth_out, hs.size());
+      std::printf("| %s_%s | %zu / %zu | %zu |", t.name.c_str(), side.c_str(), truth_out, hs.size(),
+                  past);
       for (std::size_t m = 0; m < names.size(); ++m) {
         auto d = fusion::make_step_detector(names[m], mount);
         std::size_t n = 0;
@@ -282,12 +292,15 @@ void ipol_table(const EvalOptions& o, bool foot) {
     }
   }
   if (files == 0) return;
-  std::printf("| **mean README / every annotated step** | |");
+  std::printf("| **mean README / every annotated step** | | |");
   for (std::size_t m = 0; m < names.size(); ++m)
     std::printf(" **%.2f / %.2f** |", 100.0 * sum_readme[m] / files, 100.0 * sum_all[m] / files);
-  std::printf("\n| worst file, README | |");
+  std::printf("\n| worst file, README | | |");
   for (std::size_t m = 0; m < names.size(); ++m) std::printf(" %.1f |", 100.0 * worst[m]);
-  std::printf("\n");
+  std::printf(
+      "\n\nCeiling: an exact detector (every annotated heel strike the recording holds, none "
+      "past its end) scores %.2f %% mean README.\n",
+      100.0 * sum_ceiling / files);
   if (!details.empty())
     std::printf(
         "\n%s: every file, detections against the annotated heel strikes (s). missed: annotated, "
