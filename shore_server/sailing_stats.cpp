@@ -4,18 +4,12 @@
 #include <cmath>
 #include <limits>
 
+#include "telltale/fusion/angles.hpp"
+
 namespace telltale::shore {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-/// a - b wrapped to (-180, 180].
-double diff180(double a, double b) {
-  double d = std::fmod(a - b, 360.0);
-  if (d > 180.0) d -= 360.0;
-  if (d <= -180.0) d += 360.0;
-  return d;
-}
 
 bool sailing(const SailingPoint& p) {
   return std::isfinite(p.sog_m_s) && std::isfinite(p.cog_deg) && p.sog_m_s >= kSailingMinSog_m_s;
@@ -58,7 +52,7 @@ std::optional<double> estimate_wind_from_deg(const std::vector<SailingPoint>& pt
     double sx[2] = {0, 0}, sy[2] = {0, 0};
     for (const auto& p : pts) {
       if (!sailing(p)) continue;
-      const double off = diff180(p.cog_deg, refined);
+      const double off = fusion::diff_180_deg(p.cog_deg, refined);
       const double a = std::abs(off);
       if (a < 25.0 || a > 60.0) continue;
       const int side = off > 0 ? 1 : 0;
@@ -68,7 +62,7 @@ std::optional<double> estimate_wind_from_deg(const std::vector<SailingPoint>& pt
     if ((sx[0] == 0 && sy[0] == 0) || (sx[1] == 0 && sy[1] == 0)) break;
     const double m0 = std::atan2(sy[0], sx[0]) * 180.0 / M_PI;
     const double m1 = std::atan2(sy[1], sx[1]) * 180.0 / M_PI;
-    refined = std::fmod(m0 + diff180(m1, m0) / 2.0 + 360.0, 360.0);
+    refined = std::fmod(m0 + fusion::diff_180_deg(m1, m0) / 2.0 + 360.0, 360.0);
   }
   // Upwind or downwind: upwind the boat heels away from the wind's side. Starboard tack (wind
   // over the starboard side, course left of the wind) heels to port (heel < 0).
@@ -76,7 +70,8 @@ std::optional<double> estimate_wind_from_deg(const std::vector<SailingPoint>& pt
     double a = 0.0;
     for (const auto& p : pts) {
       if (!sailing(p) || !std::isfinite(p.heel_deg)) continue;
-      const double off = diff180(w, p.cog_deg);  // + : wind clockwise of the course = starboard
+      const double off =
+          fusion::diff_180_deg(w, p.cog_deg);  // + : wind clockwise of the course = starboard
       if (std::abs(off) < 30.0 || std::abs(off) > 55.0) continue;
       a += (off > 0 ? -p.heel_deg : p.heel_deg) * p.dt_s;
     }
@@ -115,7 +110,7 @@ HeelSpeed heel_speed(const std::vector<SailingPoint>& pts, std::optional<double>
       out.unsplit_s += p.dt_s;
       continue;
     }
-    const double off = diff180(*out.wind_from_deg, p.cog_deg);
+    const double off = fusion::diff_180_deg(*out.wind_from_deg, p.cog_deg);
     const double a = std::abs(off);
     if (a > 70.0 && a < 110.0) {
       out.reaching_s += p.dt_s;

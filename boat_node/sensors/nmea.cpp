@@ -1,8 +1,6 @@
 // NMEA 0183: framing, heading sentences, line assembler, serial and UDP readers (see nmea.hpp).
 #include "nmea.hpp"
 
-#include "serial_port.hpp"
-
 #include <arpa/inet.h>
 #include <fcntl.h>
 #include <netinet/in.h>
@@ -18,7 +16,8 @@
 #include <stdexcept>
 #include <system_error>
 
-#include "telltale/fusion/heading_monitor.hpp"
+#include "serial_port.hpp"
+#include "telltale/fusion/angles.hpp"
 
 namespace telltale::sensors {
 namespace {

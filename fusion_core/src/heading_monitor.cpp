@@ -4,20 +4,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "telltale/fusion/angles.hpp"
+
 namespace telltale::fusion {
-
-double wrap_180_deg(double a_deg) {
-  double w = std::fmod(a_deg + 180.0, 360.0);
-  if (w < 0.0) w += 360.0;
-  return w - 180.0;
-}
-
-double wrap_360_deg(double a_deg) {
-  double w = std::fmod(a_deg, 360.0);
-  if (w < 0.0) w += 360.0;
-  if (w >= 360.0) w -= 360.0;  // fmod of a tiny negative number rounds up to 360
-  return w;
-}
 
 const char* heading_sensor_status_name(HeadingSensorStatus s) {
   switch (s) {

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "telltale/fusion/angles.hpp"
+
 namespace telltale::fusion {
 namespace {
 
@@ -12,24 +14,17 @@ constexpr double kDeg = M_PI / 180.0;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kDt = 0.1;  // grid step, s
 
-double wrap360(double a) {
-  a = std::fmod(a, 360.0);
-  return a < 0 ? a + 360.0 : a;
-}
-// a - b in (-180, 180] for any a and b: b is often the unwrapped course, which a 720 or a day of
-// rounding marks one way takes past +-540, where fmod(a - b + 540) went negative and the course
-// jumped by 360 (a later turn then measured, or taken for a penalty, by where the data began).
-double diff180(double a, double b) {
-  const double d = std::remainder(a - b, 360.0);
-  return d == -180.0 ? 180.0 : d;
-}
+// Differences go through diff_180_deg, right for any a and b: b is often the unwrapped course,
+// which a 720 or a day of rounding marks one way takes past +-540, where fmod(a - b + 540) went
+// negative and the course jumped by 360 (a later turn then measured, or taken for a penalty, by
+// where the data began).
 
 /// Circular median: the sample minimising the summed absolute circular distance.
 double circular_median(const std::vector<double>& a) {
   double best = a.front(), best_cost = 1e300;
   for (double c : a) {
     double cost = 0.0;
-    for (double x : a) cost += std::abs(diff180(x, c));
+    for (double x : a) cost += std::abs(diff_180_deg(x, c));
     if (cost < best_cost) best_cost = cost, best = c;
   }
   return best;
@@ -65,7 +60,7 @@ struct Grid {
     if (b0 <= a0 || cnt < 0.5 * static_cast<double>(b0 - a0)) return kNaN;
     const double c = pc[b] - pc[a], s = ps[b] - ps[a];
     if (r) *r = std::hypot(c, s) / cnt;
-    return wrap360(std::atan2(s, c) / kDeg);
+    return wrap_360_deg(std::atan2(s, c) / kDeg);
   }
   /// Mean of the unwrapped course over [a, b) (only within a window without a full turn).
   [[nodiscard]] double mean_unwrapped(long a0, long b0) const {
@@ -125,7 +120,8 @@ Grid make_grid(std::span<const CourseSample> in, std::span<const HeelSample> hee
     if (s.t_s > t || t - s.t_s > 1.0) continue;
     const double c = std::isfinite(s.heading_deg) ? s.heading_deg : s.cog_deg;
     if (std::isfinite(c) && std::isfinite(s.sog_m_s)) {
-      const double u = std::isfinite(prev_course) ? prev_course + diff180(c, prev_course) : wrap360(c);
+      const double u =
+          std::isfinite(prev_course) ? prev_course + diff_180_deg(c, prev_course) : wrap_360_deg(c);
       g.course[k] = u;
       prev_course = u;
     }
@@ -276,7 +272,7 @@ bool side_means(const Grid& g, Turn& m, long span, long prev_b, long next_a) {
 /// Kind from the wind: where the unwrapped path from the course before crosses the wind.
 ManoeuvreKind classify(double before_deg, double total_deg, double wind_from, bool penalty) {
   if (penalty) return ManoeuvreKind::kPenalty;
-  const double rb = diff180(before_deg, wind_from);  // 0: head to wind
+  const double rb = diff_180_deg(before_deg, wind_from);  // 0: head to wind
   const double lo = std::min(rb, rb + total_deg), hi = std::max(rb, rb + total_deg);
   const auto crosses = [&](double v) {
     for (double x = v - 720.0; x <= v + 720.0; x += 360.0)
@@ -287,7 +283,7 @@ ManoeuvreKind classify(double before_deg, double total_deg, double wind_from, bo
   if (eye && !down) return ManoeuvreKind::kTack;
   if (down && !eye) return ManoeuvreKind::kGybe;
   if (eye && down) return ManoeuvreKind::kOther;
-  const double ra = diff180(before_deg + total_deg, wind_from);
+  const double ra = diff_180_deg(before_deg + total_deg, wind_from);
   return std::abs(ra) > std::abs(rb) ? ManoeuvreKind::kBearAway : ManoeuvreKind::kRoundUp;
 }
 
@@ -314,7 +310,7 @@ double upwind_evidence(const std::vector<WindTurn>& turns, double wind) {
   double heel[2] = {0, 0}, sog[2] = {0, 0};
   int nh[2] = {0, 0}, ns[2] = {0, 0};
   for (const auto& m : turns) {
-    const auto k = classify(wrap360(m.before), m.total, wind, m.penalty);
+    const auto k = classify(wrap_360_deg(m.before), m.total, wind, m.penalty);
     if (k != ManoeuvreKind::kTack && k != ManoeuvreKind::kGybe) continue;
     const int i = k == ManoeuvreKind::kTack ? 0 : 1;
     if (std::isfinite(m.heel_abs)) heel[i] += m.heel_abs, ++nh[i];
@@ -336,7 +332,7 @@ std::optional<double> wind_from_turns(const std::vector<WindTurn>& turns) {
   std::vector<double> doubled;
   for (const auto& m : turns) {
     const double t = std::abs(m.total);
-    if (!m.penalty && t >= 50.0 && t <= 140.0) doubled.push_back(wrap360(2.0 * m.bisector));
+    if (!m.penalty && t >= 50.0 && t <= 140.0) doubled.push_back(wrap_360_deg(2.0 * m.bisector));
   }
   if (doubled.empty()) return std::nullopt;
   std::optional<double> wind;
@@ -345,20 +341,20 @@ std::optional<double> wind_from_turns(const std::vector<WindTurn>& turns) {
   if (evidence == 0.0) {
     // Tacks only or gybes only: the end where the turns it calls tacks exceed 72 deg.
     for (const auto& m : turns) {
-      const auto k = classify(wrap360(m.before), m.total, axis, m.penalty);
+      const auto k = classify(wrap_360_deg(m.before), m.total, axis, m.penalty);
       const double t = std::abs(m.total);
       if (k == ManoeuvreKind::kTack) evidence += t - 72.0;
       if (k == ManoeuvreKind::kGybe) evidence -= t - 72.0;
     }
   }
-  wind = evidence >= 0.0 ? axis : wrap360(axis + 180.0);
+  wind = evidence >= 0.0 ? axis : wrap_360_deg(axis + 180.0);
   // The median of the tacks' bisectors and the gybes' inverted, twice.
   for (int pass = 0; pass < 2; ++pass) {
     std::vector<double> b;
     for (const auto& m : turns) {
-      const auto k = classify(wrap360(m.before), m.total, *wind, m.penalty);
+      const auto k = classify(wrap_360_deg(m.before), m.total, *wind, m.penalty);
       if (k == ManoeuvreKind::kTack) b.push_back(m.bisector);
-      if (k == ManoeuvreKind::kGybe) b.push_back(wrap360(m.bisector + 180.0));
+      if (k == ManoeuvreKind::kGybe) b.push_back(wrap_360_deg(m.bisector + 180.0));
     }
     if (b.empty()) break;
     wind = circular_median(b);
@@ -473,7 +469,7 @@ ManoeuvreReport analyse_manoeuvres(std::span<const CourseSample> course,
   }
 
   // 3. The wind: given, or estimated from the turns.
-  const auto bisector = [](const Turn& m) { return wrap360(0.5 * (m.before + m.after)); };
+  const auto bisector = [](const Turn& m) { return wrap_360_deg(0.5 * (m.before + m.after)); };
   std::optional<double> wind = o.wind_from_deg;
   if (wind) {
     rep.wind_given = true;
@@ -495,15 +491,15 @@ ManoeuvreReport analyse_manoeuvres(std::span<const CourseSample> course,
     if (o.wind_at) {
       if (const auto measured = o.wind_at(g.t_start + m.t0_k * kDt)) here = *measured;
     }
-    r.kind = here ? classify(wrap360(m.before), total, *here, m.penalty)
+    r.kind = here ? classify(wrap_360_deg(m.before), total, *here, m.penalty)
                   : (m.penalty ? ManoeuvreKind::kPenalty : ManoeuvreKind::kOther);
     const long k0 = std::lround(m.t0_k);
     r.t0_s = g.t_start + m.t0_k * kDt;
     r.turn_deg = std::abs(total);
     r.turn_dir = total >= 0 ? 1 : -1;
-    r.course_before_deg = wrap360(m.before);
-    r.course_after_deg = wrap360(m.after);
-    r.bisector_deg = m.penalty ? wrap360(m.before) : bisector(m);
+    r.course_before_deg = wrap_360_deg(m.before);
+    r.course_after_deg = wrap_360_deg(m.after);
+    r.bisector_deg = m.penalty ? wrap_360_deg(m.before) : bisector(m);
     const auto at = [&](double s) { return k0 + std::lround(s / kDt); };
     r.entry_sog_m_s = g.mean_sog(at(-20), at(-10));
     r.exit_sog_m_s = g.mean_sog(at(15), at(25));
@@ -544,8 +540,8 @@ ManoeuvreReport analyse_manoeuvres(std::span<const CourseSample> course,
     r.distance_lost_m = (ee * ue + en * un) * 30.0 - g.made_along(at(-10), at(20), ue, un);
     r.vmg_lost_m = kNaN;
     if (here) {
-      const bool up = std::abs(diff180(r.course_before_deg, *here)) < 90.0;
-      const double wd = up ? *here : wrap360(*here + 180.0);
+      const bool up = std::abs(diff_180_deg(r.course_before_deg, *here)) < 90.0;
+      const double wd = up ? *here : wrap_360_deg(*here + 180.0);
       const double we = std::sin(wd * kDeg), wn = std::cos(wd * kDeg);
       r.vmg_lost_m = (ee * we + en * wn) * 30.0 - g.made_along(at(-10), at(20), we, wn);
     }
@@ -596,12 +592,12 @@ ManoeuvreReport analyse_manoeuvres(std::span<const CourseSample> course,
     // The wind estimate as it stood after each tack or gybe.
     if (!rep.wind_given && (r.kind == ManoeuvreKind::kTack || r.kind == ManoeuvreKind::kGybe)) {
       running.push_back(r.kind == ManoeuvreKind::kTack ? r.bisector_deg
-                                                        : wrap360(r.bisector_deg + 180.0));
+                                                       : wrap_360_deg(r.bisector_deg + 180.0));
       WindPoint wp;
       wp.t_s = r.t0_s;
       wp.from_deg = circular_median(running);
       std::vector<double> dev;
-      for (double b : running) dev.push_back(std::abs(diff180(b, wp.from_deg)));
+      for (double b : running) dev.push_back(std::abs(diff_180_deg(b, wp.from_deg)));
       std::nth_element(dev.begin(), dev.begin() + static_cast<long>(dev.size() / 2), dev.end());
       const double mad = dev[dev.size() / 2];
       wp.n = static_cast<int>(running.size());

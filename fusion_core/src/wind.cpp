@@ -3,18 +3,14 @@
 #include <algorithm>
 #include <vector>
 
+#include "telltale/fusion/angles.hpp"
+
 namespace telltale::fusion {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kDegToRad = M_PI / 180.0;
 constexpr double kStillM_s = 0.3;  // below it a GNSS course is noise (the boat's GNSS gate's)
-
-double wrap360(double deg) {
-  if (!std::isfinite(deg)) return kNaN;
-  const double w = std::fmod(std::fmod(deg, 360.0) + 360.0, 360.0);
-  return w >= 360.0 ? 0.0 : w;
-}
 
 }  // namespace
 
@@ -35,11 +31,11 @@ TrueWind true_wind(const WindReading& r, double heading_deg, double sog_m_s, dou
   const double bow = std::isfinite(heading_deg) ? heading_deg : cog_deg;
   switch (r.ref) {
     case WindRef::kTrueDirection:
-      return {wrap360(r.angle_deg), speed};
+      return {wrap_360_deg(r.angle_deg), speed};
     case WindRef::kMagneticDirection:
-      return {wrap360(r.angle_deg + declination_deg), speed};
+      return {wrap_360_deg(r.angle_deg + declination_deg), speed};
     case WindRef::kTrueOffBow:
-      return {wrap360(bow + r.angle_deg), speed};
+      return {wrap_360_deg(bow + r.angle_deg), speed};
     case WindRef::kApparent:
       break;
   }
@@ -55,7 +51,7 @@ TrueWind true_wind(const WindReading& r, double heading_deg, double sog_m_s, dou
   }
   const double ground = std::hypot(wn, we);
   if (ground < 0.05) return {kNaN, ground};  // the boat's own motion cancelled it: no direction
-  return {wrap360(std::atan2(-we, -wn) / kDegToRad), ground};
+  return {wrap_360_deg(std::atan2(-we, -wn) / kDegToRad), ground};
 }
 
 std::optional<WindMean> wind_mean(std::span<const double> from_deg) {
@@ -73,7 +69,8 @@ std::optional<WindMean> wind_mean(std::span<const double> from_deg) {
   for (const double d : from_deg) off.push_back(std::remainder(d - mean, 360.0));
   const auto mid = off.begin() + static_cast<std::ptrdiff_t>(off.size() / 2);
   std::nth_element(off.begin(), mid, off.end());
-  return WindMean{wrap360(mean + *mid), std::sqrt(-2.0 * std::log(std::min(1.0, r))) / kDegToRad};
+  return WindMean{wrap_360_deg(mean + *mid),
+                  std::sqrt(-2.0 * std::log(std::min(1.0, r))) / kDegToRad};
 }
 
 }  // namespace telltale::fusion

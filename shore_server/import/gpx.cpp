@@ -3,6 +3,8 @@
 #include <cmath>
 #include <string>
 
+#include "telltale/fusion/angles.hpp"
+
 namespace telltale::shore::import {
 namespace {
 
@@ -71,7 +73,7 @@ ParseResult parse_gpx(std::istream& in, const ImportOptions& options, ImportSink
     in_point = false;
     if (!have_time) return false;
     p.sog_m_s = std::isfinite(p.sog_m_s) && p.sog_m_s >= 0.0 && p.sog_m_s < 100.0 ? p.sog_m_s : kNaN;
-    p.cog_deg = wrap360(p.cog_deg);
+    p.cog_deg = fusion::wrap_360_deg(p.cog_deg);
     apply_offsets(options, p);
     sink.point(p);
     ++r.points;

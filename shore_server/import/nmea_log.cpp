@@ -9,6 +9,7 @@
 #include "nmea.hpp"
 #include "nmea_gnss.hpp"
 #include "nmea_wind.hpp"
+#include "telltale/fusion/angles.hpp"
 #include "telltale/fusion/wind.hpp"
 
 namespace telltale::shore::import {
@@ -293,7 +294,7 @@ ParseResult parse_nmea_log(std::istream& in, const ImportOptions& options, Impor
         if (std::isfinite(h.heading.true_deg)) {
           epochs.heading(h.heading.true_deg);
         } else if (std::isfinite(h.heading.magnetic_deg) && std::isfinite(options.declination_deg)) {
-          epochs.heading(wrap360(h.heading.magnetic_deg + options.declination_deg));
+          epochs.heading(fusion::wrap_360_deg(h.heading.magnetic_deg + options.declination_deg));
         }
       }
     } else if (type == "XDR") {

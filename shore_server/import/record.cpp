@@ -7,6 +7,7 @@
 
 #include "gpx.hpp"
 #include "nmea_log.hpp"
+#include "telltale/fusion/angles.hpp"
 #include "vakaros_csv.hpp"
 #include "vkx.hpp"
 #include "vtk.hpp"
@@ -169,13 +170,6 @@ std::optional<double> parse_decimal(std::string_view s) {
   return v;
 }
 
-double wrap360(double deg) {
-  if (!std::isfinite(deg)) return kNaN;
-  double w = std::fmod(deg, 360.0);
-  if (w < 0.0) w += 360.0;
-  return w >= 360.0 ? 0.0 : w;
-}
-
 Euler euler_from_ned_quaternion(double w, double x, double y, double z) {
   const double n = std::sqrt(w * w + x * x + y * y + z * z);
   if (!std::isfinite(n) || n < 1e-9) return {};
@@ -189,7 +183,8 @@ Euler euler_from_ned_quaternion(double w, double x, double y, double z) {
   e.heel_deg = std::atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y)) * kRadToDeg;
   const double sp = std::clamp(2.0 * (w * y - z * x), -1.0, 1.0);
   e.pitch_deg = std::asin(sp) * kRadToDeg;
-  e.heading_deg = wrap360(std::atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)) * kRadToDeg);
+  e.heading_deg = fusion::wrap_360_deg(
+      std::atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)) * kRadToDeg);
   return e;
 }
 

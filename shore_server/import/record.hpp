@@ -128,9 +128,6 @@ struct Euler {
 };
 [[nodiscard]] Euler euler_from_ned_quaternion(double w, double x, double y, double z);
 
-/// Wraps to [0, 360).
-[[nodiscard]] double wrap360(double deg);
-
 /// Applies the zero offsets of `options` to a point's heel and pitch.
 void apply_offsets(const ImportOptions& options, ImportPoint& p);
 

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <string>
 
+#include "telltale/fusion/angles.hpp"
+
 namespace telltale::shore::import {
 namespace {
 
@@ -166,8 +168,8 @@ ParseResult parse_vakaros_csv(std::istream& in, const ImportOptions& options, Im
     if (std::isnan(p.lat_deg) != std::isnan(p.lon_deg))
       return fail(line_no, "a latitude without a longitude or the reverse");
     p.sog_m_s = sog_kn * kKnotToMS;
-    p.cog_deg = wrap360(p.cog_deg);
-    p.heading_deg = wrap360(p.heading_deg);
+    p.cog_deg = fusion::wrap_360_deg(p.cog_deg);
+    p.heading_deg = fusion::wrap_360_deg(p.heading_deg);
     p.heel_deg = heel;
     p.pitch_deg = pitch;
     apply_offsets(options, p);

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstring>
 
+#include "telltale/fusion/angles.hpp"
 #include "telltale/fusion/wind.hpp"
 
 namespace telltale::shore::import {
@@ -109,7 +110,7 @@ ParseResult parse_vkx(std::istream& in, const ImportOptions& options, ImportSink
         }
         const double sog = f32(p + 16);
         if (std::isfinite(sog) && sog >= 0.0 && sog < 100.0) pt.sog_m_s = sog;
-        pt.cog_deg = wrap360(f32(p + 20) * kRadToDeg);
+        pt.cog_deg = fusion::wrap_360_deg(f32(p + 20) * kRadToDeg);
         const Euler e = euler_from_ned_quaternion(f32(p + 28), f32(p + 32), f32(p + 36), f32(p + 40));
         pt.heel_deg = e.heel_deg;
         pt.pitch_deg = e.pitch_deg;

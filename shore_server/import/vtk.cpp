@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "telltale/fusion/angles.hpp"
+
 namespace telltale::shore::import {
 namespace {
 
@@ -127,7 +129,8 @@ bool decode_record(const unsigned char* data, std::size_t n, const ImportOptions
           p.lon_deg = lon;
         }
         if (has[5]) p.sog_m_s = static_cast<double>(static_cast<std::uint32_t>(v[5])) * 0.1 * kKnotToMS;
-        if (has[6]) p.cog_deg = wrap360(static_cast<double>(static_cast<std::uint32_t>(v[6])));
+        if (has[6])
+          p.cog_deg = fusion::wrap_360_deg(static_cast<double>(static_cast<std::uint32_t>(v[6])));
         if (has[7] || has[8] || has[9] || has[10]) {
           const Euler e = euler_from_ned_quaternion(
               static_cast<double>(zigzag(v[7])) * 1e-3, static_cast<double>(zigzag(v[8])) * 1e-3,
@@ -137,7 +140,7 @@ bool decode_record(const unsigned char* data, std::size_t n, const ImportOptions
           p.pitch_deg = -e.pitch_deg;
           const double decl =
               std::isfinite(st.declination_deg) ? st.declination_deg : options.declination_deg;
-          p.heading_deg = wrap360(-e.heading_deg + decl);
+          p.heading_deg = fusion::wrap_360_deg(-e.heading_deg + decl);
         }
         apply_offsets(options, p);
         st.last_t_ns = p.t_utc_ns;

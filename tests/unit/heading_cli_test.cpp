@@ -11,7 +11,7 @@
 
 #include "csv.hpp"
 #include "fusion_cli_fixture.hpp"
-#include "telltale/fusion/heading_monitor.hpp"
+#include "telltale/fusion/angles.hpp"
 
 namespace {
 

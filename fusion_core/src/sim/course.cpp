@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "telltale/fusion/angles.hpp"
+
 namespace telltale::fusion::sim {
 namespace {
 constexpr double kDeg = M_PI / 180.0;
@@ -11,15 +13,6 @@ constexpr double kUpwindTwa = 42.0;
 constexpr double kBearAwayTwa = 120.0;
 constexpr double kEarthR = 6371000.0;
 
-double wrap360(double a) {
-  a = std::fmod(a, 360.0);
-  return a < 0 ? a + 360.0 : a;
-}
-/// a - b wrapped to (-180, 180].
-double diff180(double a, double b) {
-  double d = std::fmod(a - b + 540.0, 360.0) - 180.0;
-  return d == -180.0 ? 180.0 : d;
-}
 /// Boat speed from true wind speed and angle: a dinghy-like polar (no planing), m/s.
 double polar(double tws, double twa_deg) {
   const double a = std::abs(twa_deg);
@@ -65,7 +58,7 @@ CourseSim::CourseSim(std::uint64_t seed, CourseParams p)
   x_m_ = 60.0 * std::sin(up) + along * std::cos(up);
   y_m_ = 60.0 * std::cos(up) - along * std::sin(up);
   wind_from_deg_ = p_.wind_from_deg;
-  heading_deg_ = wrap360(wind_from_deg_ + side_ * -kUpwindTwa);
+  heading_deg_ = wrap_360_deg(wind_from_deg_ + side_ * -kUpwindTwa);
   speed_m_s_ = polar(p_.wind_m_s, kUpwindTwa) * factor_;
   tws_ = p_.wind_m_s;
   if (p_.drills) {
@@ -97,7 +90,7 @@ void CourseSim::begin(TruthKind kind) {
     open_.turned = prev.turn_deg;
     open_.cross_s = prev.t_s;
     open_.crossed = prev.crossed;
-    open_.prev_rel = diff180(heading_deg_, wind_from_deg_);
+    open_.prev_rel = diff_180_deg(heading_deg_, wind_from_deg_);
     open_.path.emplace_back(prev.start_s, 0.0);
     return;
   }
@@ -105,7 +98,7 @@ void CourseSim::begin(TruthKind kind) {
   open_.active = true;
   open_.kind = kind;
   open_.start_s = t_s_;
-  open_.prev_rel = diff180(heading_deg_, wind_from_deg_);
+  open_.prev_rel = diff_180_deg(heading_deg_, wind_from_deg_);
   open_.path.emplace_back(t_s_, 0.0);
 }
 
@@ -115,7 +108,7 @@ void CourseSim::track_turn(double turn, double dt, double err) {
   if (!open_.active) return;
   open_.turned += turn;
   open_.path.emplace_back(t_s_, open_.turned);
-  const double rel = diff180(heading_deg_, wind_from_deg_);
+  const double rel = diff_180_deg(heading_deg_, wind_from_deg_);
   if (open_.cross_s < 0 && (open_.prev_rel < 0) != (rel < 0) && std::abs(turn) > 0.0) {
     const bool through_eye = std::abs(rel) < 90.0;
     if (open_.kind == TruthKind::kTack || open_.kind == TruthKind::kGybe ||
@@ -158,7 +151,7 @@ void CourseSim::step(double dt) {
   const double wx = upwind_ ? p_.leg_m * std::sin(p_.wind_from_deg * kDeg) : 0.0;
   const double wy = upwind_ ? p_.leg_m * std::cos(p_.wind_from_deg * kDeg) : 0.0;
   const double dx = wx - x_m_, dy = wy - y_m_;
-  const double to_mark = wrap360(std::atan2(dx, dy) / kDeg);
+  const double to_mark = wrap_360_deg(std::atan2(dx, dy) / kDeg);
   const bool drilling = bear_left_s_ > 0.0 || spin_left_deg_ > 0.0;
   if (std::hypot(dx, dy) < 15.0 && !drilling) {
     // Rounding: up to the other mark on the side that points at it.
@@ -190,8 +183,8 @@ void CourseSim::step(double dt) {
   // it) drifts away from the side the boat sails on; once it is `corridor_deg_` on the other
   // side (never beyond the layline), turn. Each boat has its own corridor: some play the middle,
   // some go to the laylines.
-  const double axis = upwind_ ? wind_from_deg_ : wrap360(wind_from_deg_ + 180.0);
-  const double rel = diff180(to_mark, axis);
+  const double axis = upwind_ ? wind_from_deg_ : wrap_360_deg(wind_from_deg_ + 180.0);
+  const double rel = diff_180_deg(to_mark, axis);
   const double offset = upwind_ ? -side_ * twa : side_ * (180.0 - twa);
   const double limit = std::min(corridor_deg_, std::abs(offset) - 2.0);
   if (manoeuvre_s_ > 20.0 && rel * offset < 0.0 && std::abs(rel) >= limit && !drilling &&
@@ -203,10 +196,10 @@ void CourseSim::step(double dt) {
   }
   manoeuvre_s_ += dt;
   drill_quiet_s_ += dt;
-  const double target = wrap360(wind_from_deg_ - side_ * twa);
+  const double target = wrap_360_deg(wind_from_deg_ - side_ * twa);
   // Helm: turn towards the target at up to 20 deg/s (a tack takes ~4 s); in a 720, round and
   // round at that rate.
-  const double err = diff180(target, heading_deg_);
+  const double err = diff_180_deg(target, heading_deg_);
   double turn = std::clamp(err, -20.0 * dt, 20.0 * dt);
   if (spin_left_deg_ > 0.0) {
     turn = spin_dir_ * std::min(20.0 * dt, spin_left_deg_);
@@ -216,21 +209,21 @@ void CourseSim::step(double dt) {
       drill_quiet_s_ = 0.0;
     }
   }
-  heading_deg_ = wrap360(heading_deg_ + turn);
-  const double v_target = polar(tws, diff180(heading_deg_, wind_from_deg_)) * factor_;
+  heading_deg_ = wrap_360_deg(heading_deg_ + turn);
+  const double v_target = polar(tws, diff_180_deg(heading_deg_, wind_from_deg_)) * factor_;
   // A tack or gybe costs speed: halved at the turn, back with an 8 s time constant.
   const double loss = manoeuvre_s_ < 4.0 || spin_left_deg_ > 0.0 ? 0.5 : 1.0;
   speed_m_s_ += (v_target * loss - speed_m_s_) * std::min(1.0, dt / 8.0);
   x_m_ += speed_m_s_ * std::sin(heading_deg_ * kDeg) * dt;
   y_m_ += speed_m_s_ * std::cos(heading_deg_ * kDeg) * dt;
   // Heel (no random draws): to leeward, more upwind, with the wind; 1 s lag.
-  const double r = diff180(heading_deg_, wind_from_deg_);
+  const double r = diff_180_deg(heading_deg_, wind_from_deg_);
   const double a = std::abs(r);
   const double h = (a < 30.0 ? 14.0 * a / 30.0 : a < 90.0 ? 14.0 : 14.0 - 9.0 * (a - 90.0) / 90.0) *
                    std::min(tws / p_.wind_m_s, 1.5);
   const double heel_target = (r < 0 ? -1.0 : 1.0) * h;
   heel_deg_ += (heel_target - heel_deg_) * std::min(1.0, dt / 1.0);
-  track_turn(turn, dt, diff180(target, heading_deg_));
+  track_turn(turn, dt, diff_180_deg(target, heading_deg_));
 }
 
 CourseState CourseSim::at(double t_s) {
@@ -250,7 +243,7 @@ CourseState CourseSim::at(double t_s) {
   r.lat_deg = p_.origin_lat_deg + ny / kEarthR / kDeg;
   r.lon_deg = p_.origin_lon_deg + ex / (kEarthR * std::cos(p_.origin_lat_deg * kDeg)) / kDeg;
   r.sog_m_s = std::max(0.0, speed_m_s_ + 0.05 * n(rng_));
-  r.cog_deg = wrap360(heading_deg_ + 1.0 * n(rng_));
+  r.cog_deg = wrap_360_deg(heading_deg_ + 1.0 * n(rng_));
   r.heading_deg = heading_deg_;
   r.wind_from_deg = wind_from_deg_;
   r.wind_m_s = tws_;

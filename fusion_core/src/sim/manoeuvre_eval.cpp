@@ -5,14 +5,11 @@
 #include <cmath>
 #include <cstdio>
 
+#include "telltale/fusion/angles.hpp"
 #include "telltale/fusion/sim/course.hpp"
 
 namespace telltale::fusion::sim {
 namespace {
-double diff180(double a, double b) {
-  double d = std::fmod(a - b + 540.0, 360.0) - 180.0;
-  return d == -180.0 ? 180.0 : d;
-}
 ManoeuvreKind as_detected(TruthKind k) {
   switch (k) {
     case TruthKind::kTack: return ManoeuvreKind::kTack;
@@ -73,7 +70,7 @@ ManoeuvreEval evaluate_manoeuvres(std::uint64_t first_seed, int seeds, double mi
       const auto mean_heading = [&](double a, double b, double ref) {
         double sum = 0.0;
         int n = 0;
-        for (double x = a; x < b; x += 0.1, ++n) sum += diff180(state_at(x).heading_deg, ref);
+        for (double x = a; x < b; x += 0.1, ++n) sum += diff_180_deg(state_at(x).heading_deg, ref);
         return n ? ref + sum / n : ref;
       };
       const double kDeg = M_PI / 180.0;
@@ -155,7 +152,8 @@ ManoeuvreEval evaluate_manoeuvres(std::uint64_t first_seed, int seeds, double mi
     }
     for (KindScore* sc : {&ev.tack, &ev.gybe, &ev.bear_away, &ev.round_up, &ev.penalty})
       (void)sc;
-    const double we = rep.wind_from_deg ? std::abs(diff180(*rep.wind_from_deg, p.wind_from_deg)) : 180.0;
+    const double we =
+        rep.wind_from_deg ? std::abs(diff_180_deg(*rep.wind_from_deg, p.wind_from_deg)) : 180.0;
     wind_sum += we;
     ev.wind_err_max_deg = std::max(ev.wind_err_max_deg, we);
   }

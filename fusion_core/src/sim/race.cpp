@@ -5,11 +5,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "telltale/fusion/angles.hpp"
+
 namespace telltale::fusion::sim {
 namespace {
 constexpr double kDeg = M_PI / 180.0;
-/// a - b wrapped to [-180, 180).
-double diff180(double a, double b) { return std::fmod(a - b + 540.0, 360.0) - 180.0; }
 }  // namespace
 
 RaceCourse::RaceCourse(std::uint64_t seed, CourseParams params) : sim_(seed, params) {}
@@ -25,7 +25,7 @@ void RaceCourse::step() {
   s.heading_deg = steps_.empty()
                       ? s.state.heading_deg
                       : steps_.back().heading_deg +
-                            diff180(s.state.heading_deg, steps_.back().state.heading_deg);
+                            diff_180_deg(s.state.heading_deg, steps_.back().state.heading_deg);
   steps_.push_back(s);
   // Knot j sits on step 5 j; it is complete once the two steps after it are in (its speed mean).
   if (k >= 2 && (k - 2) % kKnotSteps == 0) {

@@ -32,6 +32,7 @@
 #include <span>
 #include <string_view>
 
+#include "telltale/fusion/angles.hpp"
 #include "telltale/fusion/heading_monitor.hpp"
 
 namespace telltale::fusion {

@@ -131,9 +131,4 @@ class HeadingSensorMonitor {
   State state_;
 };
 
-/// Angle difference wrapped to [-180, 180).
-[[nodiscard]] double wrap_180_deg(double a_deg);
-/// Angle wrapped to [0, 360).
-[[nodiscard]] double wrap_360_deg(double a_deg);
-
 }  // namespace telltale::fusion

@@ -9,15 +9,10 @@
 
 #include <cmath>
 
+#include "telltale/fusion/angles.hpp"
 #include "telltale/fusion/imu_sample.hpp"
 
 namespace telltale::fusion {
-
-/// An angle in [0, 2 pi).
-[[nodiscard]] inline double wrap_2pi(double a) {
-  a = std::fmod(a, 2.0 * M_PI);
-  return a < 0.0 ? a + 2.0 * M_PI : a;
-}
 
 /// The walking frame's forward (its x axis made horizontal) and left, for an up direction in
 /// that frame; false when x is within ~17 deg of vertical (no forward direction).
