@@ -26,37 +26,30 @@ void run_handheld(const PdrOptions& o, const std::vector<ImuRecord>& records, bo
   fusion::HandheldPdrParams params;
   params.height_m = o.height_m;
   params.step_scale = o.step_scale;
-  fusion::HandheldPdr pdr(params);
+  const HandheldWalk walk = run_handheld_walk(records, params);
   io::CsvWriter track(o.out, {"t_s", "x_m", "y_m", "heading_deg", "pose", "steps", "distance_m",
                               "step_length_m", "cadence_spm", "switching"});
   auto write = [&track](const fusion::HandheldStep& r) {
     track.row({r.t_s, r.x_m, r.y_m, r.heading_deg, 0.0, static_cast<double>(r.steps),
                r.distance_m, r.length_m, 60.0 * r.step_hz, 0.0});
   };
-  std::chrono::nanoseconds spent{0};
   if (!records.empty()) {
     fusion::HandheldStep first;
     first.t_s = records.front().imu.t_s;
     write(first);
   }
-  for (const auto& r : records) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const int n = pdr.update(r.imu, r.mag_uT);
-    spent += std::chrono::steady_clock::now() - t0;
-    for (int k = 0; k < n; ++k) write(pdr.steps()[static_cast<std::size_t>(k)]);
-  }
+  for (const auto& s : walk.steps) write(s);
   track.close();
-  const auto& f = pdr.last();
-  const auto& b = pdr.gyro_bias_rad_s();
+  const fusion::HandheldStep f = walk.steps.empty() ? fusion::HandheldStep{} : walk.steps.back();
+  const auto& b = walk.gyro_bias_rad_s;
   std::printf(
       "{\"samples\": %zu, \"steps\": %zu, \"distance_m\": %.3f, \"end_x_m\": %.3f, "
       "\"end_y_m\": %.3f, \"heading_deg\": %.2f, \"pose\": 0, \"cadence_spm\": %.1f, "
       "\"gyro_bias_rad_s\": [%.5f, %.5f, %.5f], \"gyro\": %s, \"mag\": %s, "
       "\"repeated_stamps\": %zu, \"ns_per_sample\": %.1f}\n",
-      records.size(), f.steps, f.distance_m, f.x_m, f.y_m, f.heading_deg, 60.0 * f.step_hz,
-      b.x(), b.y(), b.z(), has_gyro ? "true" : "false", has_mag ? "true" : "false", repeated,
-      records.empty() ? 0.0
-                      : static_cast<double>(spent.count()) / static_cast<double>(records.size()));
+      records.size(), f.steps, f.distance_m, f.x_m, f.y_m, f.heading_deg, 60.0 * f.step_hz, b.x(),
+      b.y(), b.z(), has_gyro ? "true" : "false", has_mag ? "true" : "false", repeated,
+      walk.ns_per_sample);
 }
 
 void run_pdr(const PdrOptions& o) {

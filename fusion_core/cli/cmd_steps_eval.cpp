@@ -482,15 +482,9 @@ void ipin_table(const EvalOptions& o) {
     const auto records = read_imu_csv(dir + "/" + name + ".imu.csv", false);
     fusion::HandheldPdrParams params;
     params.height_m = 1.75;
-    fusion::HandheldPdr pdr(params);
     std::vector<std::array<double, 3>> track;  // t, x, y: one row per step
-    for (const auto& r : records) {
-      const int n = pdr.update(r.imu, r.mag_uT);
-      for (int k = 0; k < n; ++k) {
-        const auto& st = pdr.steps()[static_cast<std::size_t>(k)];
-        track.push_back({st.t_s, st.x_m, st.y_m});
-      }
-    }
+    for (const auto& st : run_handheld_walk(records, params).steps)
+      track.push_back({st.t_s, st.x_m, st.y_m});
     const double t0 = marks.front()[0], t1 = marks.back()[0];
     double poly = 0.0;
     for (std::size_t i = 1; i < marks.size(); ++i)

@@ -1,5 +1,7 @@
 #include "gait_io.hpp"
 
+#include <chrono>
+
 #include "csv.hpp"
 
 namespace telltale::cli {
@@ -71,6 +73,24 @@ void write_gait_run(const fusion::sim::GaitRun& run, const std::string& imu_path
                static_cast<double>(s.pose), s.switching ? 1.0 : 0.0, static_cast<double>(s.steps),
                static_cast<double>(s.foot_steps), s.step_hz, s.step_length_m});
   truth.close();
+}
+
+HandheldWalk run_handheld_walk(const std::vector<ImuRecord>& records,
+                               const fusion::HandheldPdrParams& params) {
+  HandheldWalk walk;
+  fusion::HandheldPdr pdr(params);
+  std::chrono::nanoseconds spent{0};
+  for (const auto& r : records) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const int n = pdr.update(r.imu, r.mag_uT);
+    spent += std::chrono::steady_clock::now() - t0;
+    for (int k = 0; k < n; ++k) walk.steps.push_back(pdr.steps()[static_cast<std::size_t>(k)]);
+  }
+  walk.gyro_bias_rad_s = pdr.gyro_bias_rad_s();
+  fusion::relay_track(walk.steps, walk.gyro_bias_rad_s);
+  if (!records.empty())
+    walk.ns_per_sample = static_cast<double>(spent.count()) / static_cast<double>(records.size());
+  return walk;
 }
 
 }  // namespace telltale::cli

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "telltale/fusion/handheld_pdr.hpp"
 #include "telltale/fusion/imu_sample.hpp"
 #include "telltale/fusion/sim/gait_sim.hpp"
 
@@ -34,6 +35,17 @@ struct ImuRecord {
 [[nodiscard]] std::vector<ImuRecord> read_imu_csv(const std::string& path, bool require_gyro,
                                                   bool* has_gyro = nullptr, bool* has_mag = nullptr,
                                                   std::size_t* repeated_stamps = nullptr);
+
+/// A phone walk through HandheldPdr, as `fusion_cli pdr --mount phone` writes it and steps-eval
+/// scores it: every step laid as walked, then the whole track re-laid with the gyro bias the
+/// walk ended with (fusion::relay_track says why). `ns_per_sample`: the updates' time only.
+struct HandheldWalk {
+  std::vector<fusion::HandheldStep> steps;
+  Eigen::Vector3d gyro_bias_rad_s = Eigen::Vector3d::Zero();
+  double ns_per_sample = 0.0;
+};
+[[nodiscard]] HandheldWalk run_handheld_walk(const std::vector<ImuRecord>& records,
+                                             const fusion::HandheldPdrParams& params);
 
 /// Writes the IMU CSV (t_s, gyro, acc, mag) and, if `truth_path` is not empty, the truth CSV:
 /// t_s,x_m,y_m,heading_deg,distance_m,gait,pose,switching,steps,foot_steps,step_hz,step_length_m

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "telltale/fusion/angles.hpp"
+
 namespace telltale::fusion {
 
 namespace {
@@ -372,30 +374,59 @@ bool WalkStepDetector::run_is_walk() const {
 
 // ---------------------------------------------------------------------------------------------
 void WalkingHeading::update(double t_s, const Eigen::Vector3d& gyro_unbiased,
-                            const Eigen::Vector3d& up) {
+                            const Eigen::Vector3d& bias, const Eigen::Vector3d& up) {
   if (started_) {
     const double dt = t_s - last_t_s_;
-    if (dt > 0.0 && dt < 1.0) yaw_rad_ += gyro_unbiased.dot(up) * dt;
+    if (dt > 0.0 && dt < 1.0) {
+      yaw_rad_ += gyro_unbiased.dot(up) * dt;
+      bias_yaw_rad_ += bias.dot(up) * dt;
+      up_s_ += up * dt;
+    }
   }
   started_ = true;
   last_t_s_ = t_s;
   const std::size_t i = (hist_head_ + hist_size_) % kHistory;
   hist_t_[i] = t_s;
   hist_yaw_[i] = yaw_rad_;
+  hist_bias_yaw_[i] = bias_yaw_rad_;
+  hist_up_s_[i] = up_s_;
   if (hist_size_ < kHistory)
     ++hist_size_;
   else
     hist_head_ = (hist_head_ + 1) % kHistory;
 }
 
-double WalkingHeading::heading_at(double t_s) const {
+WalkingHeading::At WalkingHeading::at(double t_s) const {
+  if (hist_size_ == 0) return {heading_rad(), bias_yaw_rad_, up_s_};
   // Newest first: the last sample at or before t_s (the oldest kept if t_s is older).
+  std::size_t i = hist_head_;
   for (std::size_t k = hist_size_; k-- > 0;) {
-    const std::size_t i = (hist_head_ + k) % kHistory;
-    if (hist_t_[i] <= t_s) return offset_rad_ - hist_yaw_[i];
+    const std::size_t j = (hist_head_ + k) % kHistory;
+    if (hist_t_[j] <= t_s) {
+      i = j;
+      break;
+    }
   }
-  if (hist_size_ == 0) return heading_rad();
-  return offset_rad_ - hist_yaw_[hist_head_];
+  return {offset_rad_ - hist_yaw_[i], hist_bias_yaw_[i], hist_up_s_[i]};
+}
+
+void relay_track(std::span<HandheldStep> steps, const Eigen::Vector3d& bias_rad_s) {
+  if (steps.empty()) return;
+  // yaw = (raw gyro . up) integrated - bias_yaw; with the constant bias b instead of the biases
+  // in use it is larger by bias_yaw - b . up_s, and the heading (offset - yaw) smaller by that.
+  const auto moved = [&bias_rad_s](const HandheldStep& s) {
+    return s.bias_yaw_rad - bias_rad_s.dot(s.up_s);
+  };
+  const double anchor = moved(steps.front());
+  double x = 0.0, y = 0.0;
+  for (auto& s : steps) {
+    const double heading = s.heading_deg * (M_PI / 180.0) - (moved(s) - anchor);
+    x += s.length_m * std::sin(heading);
+    y += s.length_m * std::cos(heading);
+    s.x_m = x;
+    s.y_m = y;
+    s.heading_deg = wrap_360_deg(heading * (180.0 / M_PI));
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -414,7 +445,7 @@ int HandheldPdr::update(const ImuSample& s, const Eigen::Vector3d& mag_uT) {
   const Eigen::Vector3d up = att_.state().up_body;
   bias_.update(s, up, mag_uT);
   const Eigen::Vector3d w = s.gyro_body_rad_s - bias_.bias_rad_s();
-  heading_.update(s.t_s, w, up);
+  heading_.update(s.t_s, w, bias_.bias_rad_s(), up);
 
   // The track's orientation, once: while standing before the first walk, each magnetometer
   // sample says offset = (magnetic heading of the forward axis) + yaw (circular mean).
@@ -449,7 +480,8 @@ int HandheldPdr::update(const ImuSample& s, const Eigen::Vector3d& mag_uT) {
     const double hz = interval > 0.0 ? 1.0 / interval : 1.8;
     const double len =
         params_.step_scale * walk_ratio_step_length_m(params_.height_m, hz, params_.length);
-    const double heading = heading_.heading_at(c.t_s);
+    const WalkingHeading::At at = heading_.at(c.t_s);
+    const double heading = at.heading_rad;
     last_.t_s = c.t_s;
     last_.x_m += len * std::sin(heading);
     last_.y_m += len * std::cos(heading);
@@ -457,6 +489,8 @@ int HandheldPdr::update(const ImuSample& s, const Eigen::Vector3d& mag_uT) {
     if (last_.heading_deg < 0.0) last_.heading_deg += 360.0;
     last_.length_m = len;
     last_.step_hz = hz;
+    last_.bias_yaw_rad = at.bias_yaw_rad;
+    last_.up_s = at.up_s;
     last_.distance_m += len;
     ++last_.steps;
     laid_[static_cast<std::size_t>(k)] = last_;

@@ -25,6 +25,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstddef>
+#include <span>
 
 #include "telltale/fusion/attitude_telltale.hpp"
 #include "telltale/fusion/imu_sample.hpp"
@@ -214,22 +215,37 @@ class WalkStepDetector {
 // ---------------------------------------------------------------------------------------------
 /// The phone's yaw about the vertical: d(yaw)/dt = (w - bias) . up (counter-clockwise seen from
 /// above), heading = start - yaw. A short history lets a step confirmed late take the heading
-/// it had when it was walked.
+/// it had when it was walked. Beside the yaw it integrates what relay_track needs to lay the
+/// walk again with another bias: the yaw the bias in use took off, integral of bias . up dt,
+/// and the integral of up dt (the yaw any constant bias b takes off is b . that integral).
 class WalkingHeading {
  public:
   static constexpr std::size_t kHistory = 1024;  ///< samples: 20 s at 50 Hz
-  void update(double t_s, const Eigen::Vector3d& gyro_unbiased, const Eigen::Vector3d& up);
-  /// Heading (clockwise from north, rad) now, and at an earlier time within the history.
+  /// `gyro_unbiased` = the gyro minus `bias`.
+  void update(double t_s, const Eigen::Vector3d& gyro_unbiased, const Eigen::Vector3d& bias,
+              const Eigen::Vector3d& up);
+  /// Heading (clockwise from north, rad) now.
   [[nodiscard]] double heading_rad() const { return offset_rad_ - yaw_rad_; }
-  [[nodiscard]] double heading_at(double t_s) const;
+  /// The heading and the two integrals at an earlier time within the history (the last sample
+  /// at or before it; the oldest kept if it is older).
+  struct At {
+    double heading_rad = 0.0;
+    double bias_yaw_rad = 0.0;
+    Eigen::Vector3d up_s = Eigen::Vector3d::Zero();
+  };
+  [[nodiscard]] At at(double t_s) const;
   /// The yaw integrated so far (counter-clockwise, rad) and the offset heading = offset - yaw.
   [[nodiscard]] double yaw_rad() const { return yaw_rad_; }
   void set_offset(double offset_rad) { offset_rad_ = offset_rad; }
 
  private:
   double yaw_rad_ = 0.0, offset_rad_ = 0.0, last_t_s_ = 0.0;
+  double bias_yaw_rad_ = 0.0;
+  Eigen::Vector3d up_s_ = Eigen::Vector3d::Zero();
   bool started_ = false;
   std::array<double, kHistory> hist_yaw_{};
+  std::array<double, kHistory> hist_bias_yaw_{};
+  std::array<Eigen::Vector3d, kHistory> hist_up_s_{};
   std::array<double, kHistory> hist_t_{};
   std::size_t hist_head_ = 0, hist_size_ = 0;
 };
@@ -275,7 +291,24 @@ struct HandheldStep {
   double x_m = 0.0, y_m = 0.0, heading_deg = 0.0, length_m = 0.0, step_hz = 0.0;
   double distance_m = 0.0;
   std::size_t steps = 0;
+  /// At the step, for relay_track: the yaw the gyro bias in use had taken off since the start
+  /// (rad) and the integral of the up direction (phone frame, s).
+  double bias_yaw_rad = 0.0;
+  Eigen::Vector3d up_s = Eigen::Vector3d::Zero();
 };
+
+/// A walk's steps (in order, every step since the start) laid again with one gyro bias for the
+/// whole walk: the one the walk ended with. The bias is a constant of the gyro over a walk
+/// (it drifts with temperature over tens of minutes), and each stand measures it; live, a step
+/// can only be laid with the stands before it, so a walk whose first stand measured it badly
+/// (a walker turning slowly on the spot, a magnetic estimate refused) walks its first legs with
+/// that error, and the later, better stands only mend the legs after them. The estimate every
+/// stand has made is the best for every step, the first ones included. Each step's heading moves
+/// by the yaw the two biases part by up to it, (bias in use - bias) integrated about the up
+/// direction; the first step keeps its heading (the track's orientation, from the
+/// magnetometer), the lengths are kept. For a walk reviewed after it ends (fusion_cli pdr,
+/// steps-eval); the live track (the wearable node) cannot know the stands ahead of it.
+void relay_track(std::span<HandheldStep> steps, const Eigen::Vector3d& bias_rad_s);
 
 class HandheldPdr {
  public:
