@@ -121,8 +121,9 @@ void register_pdr(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--mount", opts->mount,
                   "phone: held in front (reading pose; steps only while walking, heading from "
-                  "the gyro about the vertical) | body: the four simulated poses of seed 003 | "
-                  "foot")
+                  "the gyro about the vertical; the track re-laid once the walk is over with the "
+                  "gyro bias all its stands measured) | body: the four simulated poses of seed "
+                  "003 | foot")
       ->capture_default_str();
   cmd->callback([opts] { run_pdr(*opts); });
 }
