@@ -78,10 +78,14 @@ void butterworth_step(const Butterworth& c, const Eigen::Matrix<double, 3, 5>& x
 /// A unit vector perpendicular to the unit vector u (continuity does not matter: each motion
 /// update is a measurement on its own, the covariance lives in the body frame). Always inlined:
 /// with three callers the compiler makes it a call, 27 instructions per update (callgrind).
+/// The normalisation is Eigen's normalized() written out (the same squared norm, square root and
+/// division, so the same bits): GCC kept that one an out-of-line call.
 [[gnu::always_inline]] inline Eigen::Vector3d perpendicular(const Eigen::Vector3d& u) {
   const Eigen::Vector3d a =
       std::abs(u.x()) < 0.8 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-  return (a - a.dot(u) * u).normalized();
+  const Eigen::Vector3d v = a - a.dot(u) * u;
+  const double n2 = v.squaredNorm();
+  return n2 > 0.0 ? Eigen::Vector3d(v / std::sqrt(n2)) : v;
 }
 
 /// The end of the start's Kalman filter: the low-pass in its steady state (b0, a2: its
@@ -108,7 +112,9 @@ TelltaleAttitudeFilter::TelltaleAttitudeFilter(Params params)
     : params_(params),
       gate_{params.gyro_range_rad_s, params.acc_range_m_s2, params.saturation_fraction,
             params.max_gap_s, true},
-      lever_((params.lever_arm_m.array() != 0.0).any()) {}
+      lever_((params.lever_arm_m.array() != 0.0).any()),
+      inv_sqrt2_tau_motion_(M_SQRT1_2 / params.tau_acc_s),
+      inv_sqrt2_tau_rest_(M_SQRT1_2 / std::min(params.tau_acc_rest_s, params.tau_acc_s)) {}
 
 void TelltaleAttitudeFilter::initialise(const ImuSample& s) {
   // Frame I starts level-consistent with the first accelerometer sample (yaw 0):
@@ -305,7 +311,10 @@ AttitudeOutput TelltaleAttitudeFilter::output() const {
   Eigen::Vector3d u = u0 + params_.sensor_delay_s * u0.cross(state_.rate_rad_s);
   u *= 1.5 - 0.5 * u.squaredNorm();
   output_from_up(state_.rate_rad_s, u, o);
-  o.acc_weight = state_.weight;
+  // Reported weight: the share of the specific force's deviation budget left (1 = steady; 0
+  // saturated, acc_dev2 = +Inf). Formed here rather than in update(): two divisions that only a
+  // read of the output needs.
+  o.acc_weight = 1.0 / (1.0 + state_.acc_dev2 / (params_.rest_acc_m_s2 * params_.rest_acc_m_s2));
   // Quality from a rough tilt variance: a bias error e tilts frame I at e, which the low-pass
   // follows with a lag of tau (ramp response of the Butterworth), so the tilt variance is about
   // (2/3 of the bias covariance's trace) * tau^2; while the low-pass is still a growing mean,
@@ -392,9 +401,9 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
                       !(st.speed_m_s > p.rest_max_speed_m_s);
   st.rest_time_s = steady ? st.rest_time_s + dt : 0.0;
   const bool at_rest = st.rest_time_s >= p.rest_min_s;
-  // Reported weight: the share of the specific force's deviation budget left (1 = steady).
-  st.weight = 1.0 / (1.0 + acc_dev2 / (p.rest_acc_m_s2 * p.rest_acc_m_s2));
-  if (acc_sat) st.weight = 0.0;
+  // The reported weight's input (output() forms the weight; 1 / (1 + Inf) is the 0 of a
+  // saturated sample).
+  st.acc_dev2 = acc_sat ? std::numeric_limits<double>::infinity() : acc_dev2;
 
   // --- Low-pass in frame I: the specific force, and the rotation matrix and R * bias that the
   // motion-bias model needs filtered the same way. A saturated sample is fed as it is: it is
@@ -491,18 +500,24 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // included, as std::max(1, NaN) is 1) and Newton's step from z = 1 gives (2 + 1) * (1 / 3) = 1
   // exactly (3 times the double nearest 1/3 rounds to 1). Skipping it gives the same z, bit for
   // bit, without a square root and two divisions.
-  double z = 1.0;
+  // (With z = 1 tau_acc_s / z is tau_acc_s and M_SQRT1_2 / tau the constructor's: the same
+  // bits without the two divisions, which lie on the chain from dt to the low-pass.)
+  double tau_motion = p.tau_acc_s;
+  bool scaled = false;
   if (var_h > sm2 || st.tau_scale != 1.0 || start_ends) {
     // x = (var_h / sigma_m^2)^(1/2) -> tau = tau_acc_s / cbrt(max(1, x)); Newton on z^3 = x.
     const double ratio = std::max(1.0, std::sqrt(var_h / sm2));
     // (At the start's end the covariance has jumped since the last step: the root itself.)
-    z = start_ends ? std::cbrt(ratio) : st.tau_scale;
+    double z = start_ends ? std::cbrt(ratio) : st.tau_scale;
     z = (2.0 * z + ratio / (z * z)) * (1.0 / 3.0);
     st.tau_scale = z;
+    tau_motion = p.tau_acc_s / z;
+    scaled = true;
   }
-  const double tau_motion = p.tau_acc_s / z;
   const double tau = at_rest ? std::min(p.tau_acc_rest_s, tau_motion) : tau_motion;
-  const Butterworth c = butterworth(dt, M_SQRT1_2 / tau);
+  const double inv_sqrt2_tau =
+      scaled ? M_SQRT1_2 / tau : (at_rest ? inv_sqrt2_tau_rest_ : inv_sqrt2_tau_motion_);
+  const Butterworth c = butterworth(dt, inv_sqrt2_tau);
   if (start_ends) end_start_fit(st, r, c.b0, c.a2, tau, p.g_m_s2);
   if (gap) st.lp_running = false;
   Eigen::Matrix<double, 3, 5> x;

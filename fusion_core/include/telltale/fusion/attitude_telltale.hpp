@@ -152,7 +152,9 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
     Eigen::Vector3d gyro_rest_lp_rad_s = Eigen::Vector3d::Zero();
     Eigen::Vector3d acc_rest_lp_m_s2 = Eigen::Vector3d::Zero();
     double rest_time_s = 0.0;
-    double weight = 0.0;
+    /// The accelerometer's squared deviation from its rest low-pass in the last update
+    /// ((m/s^2)^2; +Inf when saturated): output() makes it the reported weight.
+    double acc_dev2 = std::numeric_limits<double>::infinity();
     double last_t_s = 0.0;
     /// The output's inputs (output() is computed from them on demand): the vertical seen in the
     /// body (unit) and the bias-corrected body rate of the last update.
@@ -241,6 +243,9 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
   Params params_;
   ImuGateParams gate_;  ///< the sensor's ranges and the longest gap, from params_
   bool lever_ = false;  ///< params_.lever_arm_m is not zero
+  /// M_SQRT1_2 / tau of the usual step (tau_scale 1, see update): in motion and at rest.
+  double inv_sqrt2_tau_motion_ = 0.0;
+  double inv_sqrt2_tau_rest_ = 0.0;
   State state_;
   Diagnostics diag_;
 };
