@@ -61,6 +61,7 @@
 #include "telltale/fusion/pdr/step_length.hpp"
 #include "telltale/fusion/pdr/track.hpp"
 #include "telltale/fusion/pdr/walking_heading.hpp"
+#include "telltale/fusion/pdr_output.hpp"
 #include "telltale/fusion/phone_pose.hpp"
 #include "telltale/fusion/steps.hpp"
 
@@ -97,23 +98,6 @@ struct PdrParams {
   WalkingDirectionParams walking_direction;
   bool calibrate_mag = true;  ///< online hard-iron calibration (hard_iron.hpp) before the heading
   HardIronParams hard_iron;
-};
-
-/// Everything a node publishes after a sample.
-struct PdrOutput {
-  double t_s = 0.0;
-  std::size_t steps = 0;     ///< steps of both feet
-  double cadence_spm = 0.0;  ///< steps per minute (0 until two steps)
-  double step_hz = 0.0;      ///< step frequency used for the step length
-  double last_step_length_m = 0.0;
-  double distance_m = 0.0;
-  double x_m = 0.0;          ///< east of the start, m
-  double y_m = 0.0;          ///< north of the start, m
-  double heading_deg = 0.0;  ///< walking direction, clockwise from north
-  PhonePose pose = PhonePose::kHandHeld;
-  bool switching = false;  ///< a pose switch is in progress (heading held)
-  int gait = 1;            ///< coarse gait from cadence: 0 slow walk .. 4 run
-  bool step = false;       ///< a step completed at this sample
 };
 
 class Pdr {
