@@ -47,12 +47,18 @@ int StepGaps::at_step(double t_s, const StepSource& source, double per_event, bo
     interval_s_ = 0.0;
     interval_count_ = 0;
   }
-  if (last_step_t_s_ >= 0.0 && missed == 0 && !source.handoff) {
-    const double interval = gap / per_event;
+  end_gap(t_s, per_event, missed == 0 && !source.handoff);
+  return missed;
+}
+
+void StepGaps::learn_cadence(double t_s, double per_event) { end_gap(t_s, per_event, true); }
+
+void StepGaps::end_gap(double t_s, double per_event, bool learn) {
+  if (learn && last_step_t_s_ >= 0.0) {
+    const double interval = (t_s - last_step_t_s_) / per_event;
     if (interval >= params_.min_interval_s && interval < 2.0) learn_interval(interval);
   }
   last_step_t_s_ = t_s;
-  return missed;
 }
 
 void StepGaps::learn_interval(double interval_s) {
