@@ -34,11 +34,10 @@ class StepGaps {
   void add_heading(double t_s, const Eigen::Vector2d& unit);
   /// The walking frame changed at t_s: the headings before are in another frame.
   void new_frame(double t_s) { bins_from_t_s_ = t_s; }
-  /// A step event at t_s that stands for `per_event` steps: returns how many more the gap
-  /// before it held (only with `fill`: the phone; `energy` the phone's acceleration energy over
-  /// the feature window) and learns the cadence from it.
-  int at_step(double t_s, const StepSource& source, double per_event, bool fill, double energy,
-              const RecentSamples& recent);
+  /// A step event of the phone at t_s: returns how many more steps the gap before it held
+  /// (`energy` the phone's acceleration energy over the feature window) and learns the cadence
+  /// from it.
+  int at_step(double t_s, const StepSource& source, double energy, const RecentSamples& recent);
   /// An event at t_s that stands for `per_event` steps (a foot sensor's stride: 2) and whose
   /// gap is never filled: learns the cadence only.
   void learn_cadence(double t_s, double per_event);
