@@ -42,7 +42,8 @@ struct FootPdrParams {
   /// Shorter step intervals are no cadence (StepGapParams::min_interval_s).
   double min_step_interval_s = StepGapParams{}.min_interval_s;
   GyroBiasParams gyro_bias;
-  /// The step-length model's hand-held row: the seed's line, fitted to our gait simulator.
+  /// Height and personal factor; the model's hand-held row and its `scale` are the foot's (it
+  /// has no pose): the seed's line, fitted to our gait simulator.
   StepLengthParams step_length;
   TrackParams track;
   HeadingFilterParams heading;
