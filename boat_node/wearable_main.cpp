@@ -14,6 +14,7 @@
 #include "dds_security.hpp"
 #include "run_clock.hpp"
 #include "shutdown.hpp"
+#include "telltale/fusion/foot_pdr.hpp"
 #include "telltale/fusion/handheld_pdr.hpp"
 #include "telltale/fusion/pdr.hpp"
 #include "telltale/fusion/sim/gait_sim.hpp"
@@ -149,6 +150,11 @@ std::unique_ptr<WearableSource> make_source(const Options& o) {
                               "' (sim, sim:SCENARIO, replay:FILE.csv, witmotion:DEVICE[@BAUD])");
 }
 
+/// Samples the PDR's gate refused (non-finite, or time not after the last).
+unsigned rejected(const fusion::ImuGateCounts& c) {
+  return c.rejected_non_finite + c.rejected_time;
+}
+
 void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   static const std::regex kId("[A-Za-z0-9_-]{1,32}");
   if (!std::regex_match(o.athlete_id, kId))
@@ -164,19 +170,24 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   const bool handheld = o.mount == "phone";
   auto source = make_source(o);
   // One pipeline per mount, the same as `fusion_cli pdr --mount`: phone -> HandheldPdr (a phone
-  // held in front), body -> the seed-003 Pdr with its four poses, foot -> the foot Pdr.
-  fusion::PdrParams params;
-  params.mount = foot ? fusion::StepMount::kFoot : fusion::StepMount::kBody;
-  params.step_length.height_m = o.height_m;
-  params.step_length.scale.fill(o.step_scale);
-  std::unique_ptr<fusion::Pdr> pdr;                 // 110 kB: not on the stack
+  // held in front), body -> the seed-003 Pdr with its four poses, foot -> FootPdr.
+  std::unique_ptr<fusion::Pdr> pdr;  // 110 kB: not on the stack
+  std::unique_ptr<fusion::FootPdr> foot_pdr;
   std::unique_ptr<fusion::HandheldPdr> phone_pdr;
   if (handheld) {
     fusion::HandheldPdrParams hp;
     hp.height_m = o.height_m;
     hp.step_scale = o.step_scale;
     phone_pdr = std::make_unique<fusion::HandheldPdr>(hp);
+  } else if (foot) {
+    fusion::FootPdrParams params;
+    params.step_length.height_m = o.height_m;
+    params.step_length.scale.fill(o.step_scale);
+    foot_pdr = std::make_unique<fusion::FootPdr>(params);
   } else {
+    fusion::PdrParams params;
+    params.step_length.height_m = o.height_m;
+    params.step_length.scale.fill(o.step_scale);
     pdr = std::make_unique<fusion::Pdr>(params);
   }
   unsigned rejected_non_finite = 0;  // HandheldPdr drops such samples without counting them
@@ -238,7 +249,9 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       handheld_out.heading_deg = h.heading_deg;
       handheld_out.distance_m = h.distance_m;
     }
-    const fusion::PdrOutput& p = handheld ? handheld_out : pdr->update(s->imu, s->mag_uT);
+    const fusion::PdrOutput& p = handheld ? handheld_out
+                                 : foot   ? foot_pdr->update(s->imu, s->mag_uT)
+                                          : pdr->update(s->imu, s->mag_uT);
     if (t >= next_publish) {
       next_publish = t + 1.0 / o.rate_hz;
       telltale::boat::to_wire({++seq, start_utc + static_cast<unsigned long long>(t * 1e9), p, foot},
@@ -247,9 +260,9 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
     }
     if (Clock::now() >= next_status) {
       next_status += std::chrono::seconds(1);
-      const unsigned bad =
-          handheld ? rejected_non_finite
-                   : pdr->diagnostics().rejected_non_finite + pdr->diagnostics().rejected_time;
+      const unsigned bad = handheld ? rejected_non_finite
+                           : foot   ? rejected(foot_pdr->diagnostics())
+                                    : rejected(pdr->diagnostics());
       status.t_utc_ns(run_clock.now_ns());
       status.uptime_s(std::chrono::duration<double>(Clock::now() - start).count());
       status.samples_published(seq);

@@ -6,6 +6,7 @@
 #include "commands.hpp"
 #include "csv.hpp"
 #include "gait_io.hpp"
+#include "telltale/fusion/foot_pdr.hpp"
 #include "telltale/fusion/handheld_pdr.hpp"
 #include "telltale/fusion/pdr.hpp"
 
@@ -52,25 +53,22 @@ void run_handheld(const PdrOptions& o, const std::vector<ImuRecord>& records, bo
       walk.ns_per_sample);
 }
 
-void run_pdr(const PdrOptions& o) {
-  if (!(o.height_m > 0.5 && o.height_m < 2.5))
-    throw UsageError("--height-m must be a body height in metres (0.5-2.5)");
-  if (!(o.step_scale >= 0.5 && o.step_scale <= 1.5))
-    throw UsageError("--step-scale must be a personal factor between 0.5 and 1.5");
-  if (o.mount != "phone" && o.mount != "body" && o.mount != "foot")
-    throw UsageError("unknown mount '" + o.mount + "' (phone, body, foot)");
-  bool has_gyro = false, has_mag = false;
-  std::size_t repeated = 0;
-  const auto records = read_imu_csv(o.in, false, &has_gyro, &has_mag, &repeated);
-  if (o.mount == "phone") {
-    run_handheld(o, records, has_gyro, has_mag, repeated);
-    return;
-  }
-  fusion::PdrParams params;
-  params.step_length.height_m = o.height_m;
-  params.step_length.scale.fill(o.step_scale);
-  params.mount = o.mount == "foot" ? fusion::StepMount::kFoot : fusion::StepMount::kBody;
-  fusion::Pdr pdr(params);
+/// The pose-switch counts of the summary (all 0 for a foot: it has no pose).
+struct Switches {
+  unsigned switches = 0, pose_changes = 0, replaced_headings = 0;
+};
+Switches switches_of(const fusion::Pdr& pdr) {
+  const auto& d = pdr.diagnostics();
+  return {d.switches, d.pose_changes, d.replaced_headings};
+}
+Switches switches_of(const fusion::FootPdr& /*pdr*/) { return {}; }
+
+/// Runs `pdr` (Pdr or FootPdr) over the records: the track CSV, one row per step, and the JSON
+/// summary. The two print the same columns and fields, so that a foot's track and a phone's
+/// read alike: the foot's pose and switch columns are those of a pose that never changes.
+template <class Pipeline>
+void run_track(const PdrOptions& o, const std::vector<ImuRecord>& records, bool has_gyro,
+               bool has_mag, std::size_t repeated, Pipeline& pdr) {
   io::CsvWriter track(o.out, {"t_s", "x_m", "y_m", "heading_deg", "pose", "steps", "distance_m",
                               "step_length_m", "cadence_spm", "switching"});
   auto write = [&track](const fusion::PdrOutput& r) {
@@ -89,7 +87,7 @@ void run_pdr(const PdrOptions& o) {
   }
   track.close();
   const auto& f = pdr.output();
-  const auto& d = pdr.diagnostics();
+  const Switches d = switches_of(pdr);
   std::printf(
       "{\"samples\": %zu, \"steps\": %zu, \"distance_m\": %.3f, \"end_x_m\": %.3f, "
       "\"end_y_m\": %.3f, \"heading_deg\": %.2f, \"pose\": %d, \"cadence_spm\": %.1f, "
@@ -99,6 +97,35 @@ void run_pdr(const PdrOptions& o) {
       f.cadence_spm, d.switches, d.pose_changes, d.replaced_headings, has_gyro ? "true" : "false",
       has_mag ? "true" : "false", repeated,
       static_cast<double>(spent.count()) / static_cast<double>(records.size()));
+}
+
+void run_pdr(const PdrOptions& o) {
+  if (!(o.height_m > 0.5 && o.height_m < 2.5))
+    throw UsageError("--height-m must be a body height in metres (0.5-2.5)");
+  if (!(o.step_scale >= 0.5 && o.step_scale <= 1.5))
+    throw UsageError("--step-scale must be a personal factor between 0.5 and 1.5");
+  if (o.mount != "phone" && o.mount != "body" && o.mount != "foot")
+    throw UsageError("unknown mount '" + o.mount + "' (phone, body, foot)");
+  bool has_gyro = false, has_mag = false;
+  std::size_t repeated = 0;
+  const auto records = read_imu_csv(o.in, false, &has_gyro, &has_mag, &repeated);
+  if (o.mount == "phone") {
+    run_handheld(o, records, has_gyro, has_mag, repeated);
+    return;
+  }
+  if (o.mount == "foot") {
+    fusion::FootPdrParams params;
+    params.step_length.height_m = o.height_m;
+    params.step_length.scale.fill(o.step_scale);
+    fusion::FootPdr pdr(params);
+    run_track(o, records, has_gyro, has_mag, repeated, pdr);
+    return;
+  }
+  fusion::PdrParams params;
+  params.step_length.height_m = o.height_m;
+  params.step_length.scale.fill(o.step_scale);
+  fusion::Pdr pdr(params);
+  run_track(o, records, has_gyro, has_mag, repeated, pdr);
 }
 
 }  // namespace

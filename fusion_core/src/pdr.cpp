@@ -104,10 +104,6 @@ Pdr::Pdr(Params params, const PoseNetwork& net, const StepLengthModel& lengths)
     : params_(params),
       step_length_(params.step_length, lengths),
       phone_steps_(params.phone_steps),
-      foot_steps_([] {
-        AdaptiveStepParams p;
-        return p;
-      }()),
       pose_(params.pose, net),
       recent_(StandLimits{params.stand_still_s, params.stand_gyro_rad_s,
                           params.gyro_bias.acc_std_m_s2}),
@@ -120,17 +116,13 @@ Pdr::Pdr(Params params, const PoseNetwork& net, const StepLengthModel& lengths)
       track_(params.track, params.calibrate_mag),
       switch_(params.pose_switch) {}
 
-const StepDiagnostics& Pdr::step_diagnostics() const {
-  return params_.mount == StepMount::kFoot ? foot_steps_.diagnostics() : phone_steps_.diagnostics();
-}
+const StepDiagnostics& Pdr::step_diagnostics() const { return phone_steps_.diagnostics(); }
 
-int Pdr::count_steps(double t_s, const StepSource& source, double per_event) {
-  int missed = gaps_.at_step(t_s, source, per_event, params_.mount != StepMount::kFoot,
-                             pose_.window().features().acc_energy, recent_);
+int Pdr::count_steps(double t_s, const StepSource& source) {
+  int missed = gaps_.at_step(t_s, source, pose_.window().features().acc_energy, recent_);
   missed += source.backfill;  // the start of a swinging walk (PhoneSteps)
   diag_.filled_steps += static_cast<unsigned>(missed);
-  out_.steps += static_cast<std::size_t>(missed);
-  out_.steps += static_cast<std::size_t>(per_event);
+  out_.steps += static_cast<std::size_t>(missed) + 1;
   if (gaps_.interval_s() > 0.0) {
     out_.step_hz = 1.0 / gaps_.interval_s();
     out_.cadence_spm = 60.0 * out_.step_hz;
@@ -194,25 +186,20 @@ double Pdr::walked_heading() {
 }
 
 void Pdr::on_step(double t_s, StepSource source) {
-  const bool foot = params_.mount == StepMount::kFoot;
   track_.begin_step();
   const std::array<Eigen::Vector3d, 2> ups_before = switch_.ups();
-  const double per_event = foot ? 2.0 : 1.0;  // a foot sensor sees one event per two steps
   const double t_prev = gaps_.last_step_t_s();
-  const int missed = count_steps(t_s, source, per_event);
-  if (!foot) {
-    acc_bias_.at_step(t_s, mag_cal_.offset_uT());
-    if (t_prev >= 0.0) detect_switch(t_prev, t_s, ups_before);
-    switch_.end_step();
-    classify_pose(t_s);
-  }
+  const int missed = count_steps(t_s, source);
+  acc_bias_.at_step(t_s, mag_cal_.offset_uT());
+  if (t_prev >= 0.0) detect_switch(t_prev, t_s, ups_before);
+  switch_.end_step();
+  classify_pose(t_s);
   const double walked_rad = walked_heading();
-  lay_step(t_s, t_prev, per_event, missed, walked_rad, ups_before);
+  lay_step(t_s, t_prev, missed, walked_rad, ups_before);
 }
 
-void Pdr::lay_step(double t_s, double t_prev, double per_event, int missed, double walked_rad,
+void Pdr::lay_step(double t_s, double t_prev, int missed, double walked_rad,
                    const std::array<Eigen::Vector3d, 2>& ups_before) {
-  const bool foot = params_.mount == StepMount::kFoot;
   double heading = walked_rad;
   const Eigen::Vector2d step_axis_x = axis_sum_[0], step_axis_z = axis_sum_[1];
   axis_sum_[0].setZero();
@@ -228,18 +215,18 @@ void Pdr::lay_step(double t_s, double t_prev, double per_event, int missed, doub
   // Eq. (13) and eq. (11). The first step has no frequency yet: the person's usual walk.
   const double hz = out_.step_hz > 0.0 ? out_.step_hz : 1.8;
   const double step_m = step_length_.step_m(pose_.pose(), hz);
-  double len = (per_event + missed) * step_m;
+  double len = (1.0 + missed) * step_m;
   out_.last_step_length_m = len;
   heading_.set_speed(step_m * hz);
   out_.distance_m += len;
   if (missed > 0 && !replaced) {
     // The steps a gap held are laid along the heading the gap had part by part (a corner walked
     // while the detector was blind is a corner, not a diagonal): one displacement, the chord.
-    const Eigen::Vector2d turn = gaps_.gap_turn(t_prev, t_s, static_cast<int>(per_event) + missed);
+    const Eigen::Vector2d turn = gaps_.gap_turn(t_prev, t_s, 1 + missed);
     heading = wrap_2pi(heading + std::atan2(turn.y(), turn.x()));
     len *= turn.norm();
   }
-  if (!foot && (!pose_.known() || !heading_.initialised())) {
+  if (!pose_.known() || !heading_.initialised()) {
     // At the start the pose (hence the walking frame and the heading) is not known yet: the
     // first steps are laid along the first heading we get (a straight start).
     track_.hold(len);
@@ -271,7 +258,7 @@ void Pdr::book_laid_step(const SwitchStep& laid, double heading,
     // where they went, not along the heading from before the switch.
     relay_switch_steps(std::nullopt, *candidate);
   }
-  if (!switching && params_.mount != StepMount::kFoot) relay_.keep_last(laid, ups_before);
+  if (!switching) relay_.keep_last(laid, ups_before);
 }
 
 void Pdr::forget_vertical_field() { acc_bias_.forget(last_t_s_ + 3.0 * params_.heading.up_tau_s); }
@@ -305,13 +292,10 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
     s.gyro_body_rad_s -= gyro_bias_.bias_rad_s();
   }
   out_.t_s = s.t_s;
-  const bool foot = params_.mount == StepMount::kFoot;
-  if (!foot) {
-    pose_.push(s);
-    recent_.push(s);
-  }
+  pose_.push(s);
+  recent_.push(s);
   // Into the walking frame of the pose in force (eqs. (14)-(15)).
-  const Eigen::Matrix3d m = foot ? Eigen::Matrix3d::Identity() : pose_rotation(pose_.pose());
+  const Eigen::Matrix3d m = pose_rotation(pose_.pose());
   Eigen::Vector3d mag = mag_uT;
   if (params_.calibrate_mag && mag.allFinite()) {
     // The hard-iron residual rotates with the phone, so its heading error changes with the
@@ -321,17 +305,16 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
   }
   heading_.update(s.t_s, m * s.gyro_body_rad_s, m * (s.acc_body_m_s2 - acc_bias_.bias_m_s2()),
                   m * mag);
-  if (!foot && !switch_.switching() && params_.acc_bias.learn && mag.allFinite() &&
-      heading_.initialised() && gyro_ok(s) && pose_.pose() != PhonePose::kArmSwing &&
-      acc_bias_.settled(s.t_s))
+  if (!switch_.switching() && params_.acc_bias.learn && mag.allFinite() && heading_.initialised() &&
+      gyro_ok(s) && pose_.pose() != PhonePose::kArmSwing && acc_bias_.settled(s.t_s))
     acc_bias_.add(s.gyro_body_rad_s, m.transpose() * heading_.state().up, mag);
-  if (!foot && !switch_.switching() && params_.walking_direction.correct && gyro_ok(s)) {
+  if (!switch_.switching() && params_.walking_direction.correct && gyro_ok(s)) {
     walking_.add(s.t_s, m * s.acc_body_m_s2, m * s.gyro_body_rad_s, heading_.state().up,
                  pose_.pose() == PhonePose::kArmSwing);
   } else {
     walking_.skip();
   }
-  if (!foot && mag.allFinite() && heading_.initialised()) {
+  if (mag.allFinite() && heading_.initialised()) {
     // Walking direction of the two forward axes the poses use (sensor x: hand-held, arm swing;
     // sensor -z: call, pocket), from the field and the gyro-tracked up (sensor frame), summed
     // as unit vectors over the step: a switch's steps are re-laid with them (relay_switch_steps).
@@ -363,11 +346,8 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
   }
   StepEvent ev;
   StepSource source;
-  const bool step =
-      foot ? foot_steps_.update(s, ev)
-           : phone_steps_.update(s, m.transpose() * heading_.state().up, gaps_.last_step_t_s(),
-                                 gaps_.interval_s(), recent_, ev, source);
-  if (step) {
+  if (phone_steps_.update(s, m.transpose() * heading_.state().up, gaps_.last_step_t_s(),
+                          gaps_.interval_s(), recent_, ev, source)) {
     on_step(ev.t_s, source);
     out_.x_m = track_.x_m();
     out_.y_m = track_.y_m();

@@ -19,8 +19,8 @@ StepGaps::StepGaps(Params params) : params_(params) {
   bin_id_.fill(std::numeric_limits<std::int64_t>::min());
 }
 
-int StepGaps::at_step(double t_s, const StepSource& source, double per_event, bool fill,
-                      double energy, const RecentSamples& recent) {
+int StepGaps::at_step(double t_s, const StepSource& source, double energy,
+                      const RecentSamples& recent) {
   // Steps the detector missed: its thresholds follow the last steps' peaks and valleys, so after
   // an arm swing the smaller steps of the next pose go unseen until its memory resets (4-9
   // steps lost per arm-swing exit, measured; not always while a switch is detected). A gap of
@@ -28,7 +28,7 @@ int StepGaps::at_step(double t_s, const StepSource& source, double per_event, bo
   // the last window) counts n - 1 more steps; a stop does not.
   int missed = 0;
   const double gap = t_s - last_step_t_s_;
-  if (fill && last_step_t_s_ >= 0.0 && interval_s_ > 0.0) {
+  if (last_step_t_s_ >= 0.0 && interval_s_ > 0.0) {
     const double ratio = gap / interval_s_;
     if (ratio > params_.min_ratio && gap < params_.max_gap_s && energy > params_.min_energy &&
         !source.after_stand)
@@ -47,12 +47,18 @@ int StepGaps::at_step(double t_s, const StepSource& source, double per_event, bo
     interval_s_ = 0.0;
     interval_count_ = 0;
   }
-  if (last_step_t_s_ >= 0.0 && missed == 0 && !source.handoff) {
-    const double interval = gap / per_event;
+  end_gap(t_s, 1.0, missed == 0 && !source.handoff);
+  return missed;
+}
+
+void StepGaps::learn_cadence(double t_s, double per_event) { end_gap(t_s, per_event, true); }
+
+void StepGaps::end_gap(double t_s, double per_event, bool learn) {
+  if (learn && last_step_t_s_ >= 0.0) {
+    const double interval = (t_s - last_step_t_s_) / per_event;
     if (interval >= params_.min_interval_s && interval < 2.0) learn_interval(interval);
   }
   last_step_t_s_ = t_s;
-  return missed;
 }
 
 void StepGaps::learn_interval(double interval_s) {

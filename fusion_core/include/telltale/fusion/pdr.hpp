@@ -1,15 +1,16 @@
 #pragma once
 /// \file
-/// Pedestrian dead reckoning with a phone carried in four poses (seed 003, SPEC section 5), or
-/// with a foot-mounted IMU (seed 004).
+/// Pedestrian dead reckoning with a phone carried in four poses (seed 003, SPEC section 5). A
+/// foot-mounted IMU has its own pipeline (FootPdr, foot_pdr.hpp, which says what it leaves out
+/// and why); the two share the stages in pdr/ they both need.
 ///
-/// Pipeline per sample (Pdr::update): step detection (peak-valley of seed 003 for the phone, the
-/// adaptive detector of seed 004 for the foot) -> pose features over a sliding window -> BP pose
-/// classifier (3 inputs, 4 outputs) at every step -> heading of the walking direction from gyro +
-/// magnetometer (a two-state Kalman filter, seed 004 Fig. 2) in the walking frame given by the pose
-/// rotation matrices of seed 003 (eqs. (14)-(15)) -> pose-switch detection by cross-correlation of
-/// consecutive step waveforms, with the mean heading of the 3 straight steps before the switch used
-/// during it -> step length L = a h + b f + c per pose (eq. (13)) -> position (eq. (11)).
+/// Pipeline per sample (Pdr::update): step detection (peak-valley of seed 003) -> pose features
+/// over a sliding window -> BP pose classifier (3 inputs, 4 outputs) at every step -> heading of
+/// the walking direction from gyro + magnetometer (a two-state Kalman filter, seed 004 Fig. 2)
+/// in the walking frame given by the pose rotation matrices of seed 003 (eqs. (14)-(15)) ->
+/// pose-switch detection by cross-correlation of consecutive step waveforms, with the mean
+/// heading of the 3 straight steps before the switch used during it -> step length
+/// L = a h + b f + c per pose (eq. (13)) -> position (eq. (11)).
 ///
 /// Our additions (each measured on closed loops, `fusion_cli steps-eval --tables pdr`): online
 /// gyro-aided hard-iron calibration of the magnetometer (hard_iron.hpp); a switch's steps, and
@@ -61,6 +62,7 @@
 #include "telltale/fusion/pdr/step_length.hpp"
 #include "telltale/fusion/pdr/track.hpp"
 #include "telltale/fusion/pdr/walking_heading.hpp"
+#include "telltale/fusion/pdr_output.hpp"
 #include "telltale/fusion/phone_pose.hpp"
 #include "telltale/fusion/steps.hpp"
 
@@ -76,7 +78,6 @@ namespace telltale::fusion {
 
 // ---------------------------------------------------------------------------------------------
 struct PdrParams {
-  StepMount mount = StepMount::kBody;  ///< kBody: phone (seed 003); kFoot: toe sensor (seed 004)
   /// A stand: the phone still (|f| within gyro_bias.acc_std_m_s2, rotating at less than
   /// stand_gyro_rad_s rms) for stand_still_s. A gap that held one has no missed steps
   /// (StepGaps), and a walk after one must confirm its start (PhoneSteps).
@@ -97,23 +98,6 @@ struct PdrParams {
   WalkingDirectionParams walking_direction;
   bool calibrate_mag = true;  ///< online hard-iron calibration (hard_iron.hpp) before the heading
   HardIronParams hard_iron;
-};
-
-/// Everything a node publishes after a sample.
-struct PdrOutput {
-  double t_s = 0.0;
-  std::size_t steps = 0;     ///< steps of both feet
-  double cadence_spm = 0.0;  ///< steps per minute (0 until two steps)
-  double step_hz = 0.0;      ///< step frequency used for the step length
-  double last_step_length_m = 0.0;
-  double distance_m = 0.0;
-  double x_m = 0.0;          ///< east of the start, m
-  double y_m = 0.0;          ///< north of the start, m
-  double heading_deg = 0.0;  ///< walking direction, clockwise from north
-  PhonePose pose = PhonePose::kHandHeld;
-  bool switching = false;  ///< a pose switch is in progress (heading held)
-  int gait = 1;            ///< coarse gait from cadence: 0 slow walk .. 4 run
-  bool step = false;       ///< a step completed at this sample
 };
 
 class Pdr {
@@ -147,8 +131,8 @@ class Pdr {
  private:
   void on_step(double t_s, StepSource source);
   /// Counts the step (and the steps a gap held, the cadence learnt from it); returns how many
-  /// more than `per_event` this event stands for.
-  int count_steps(double t_s, const StepSource& source, double per_event);
+  /// more than one this event stands for.
+  int count_steps(double t_s, const StepSource& source);
   /// Compares the step [t_prev, t_s]'s waveform with the same foot's last: a pose switch
   /// begins (its steps gathered; `ups_before` each foot's up before this step) or settles.
   void detect_switch(double t_prev, double t_s, const std::array<Eigen::Vector3d, 2>& ups_before);
@@ -158,7 +142,7 @@ class Pdr {
   double walked_heading();
   /// Lays the step (`missed` more with it) walked along `walked_rad`: its length, the heading a
   /// switch or a gap gives it, the track, and what a later re-laying needs.
-  void lay_step(double t_s, double t_prev, double per_event, int missed, double walked_rad,
+  void lay_step(double t_s, double t_prev, int missed, double walked_rad,
                 const std::array<Eigen::Vector3d, 2>& ups_before);
   /// Re-lays the switch's steps for the phone now in `pose`; `heading_after` is the heading of
   /// the step after them (none: the switch goes on).
@@ -177,9 +161,8 @@ class Pdr {
   Params params_;
   StepLength step_length_;
   PhoneSteps phone_steps_;
-  AdaptiveStepDetector foot_steps_;
   PoseClassifier pose_;
-  RecentSamples recent_;  ///< phone pipeline only
+  RecentSamples recent_;
   StepGaps gaps_;
   HeadingFilter heading_;
   WalkingDirection walking_;
@@ -189,7 +172,7 @@ class Pdr {
   Track track_;
   Diagnostics diag_;
   PdrOutput out_;
-  PoseSwitch switch_;  ///< phone pipeline only
+  PoseSwitch switch_;
   SwitchRelay relay_;  ///< the steps of a pose switch, and the last ones before one
   /// Over the current step, sums of unit (east, north) vectors of the horizontal sensor x and
   /// -z axes: the walking direction if the pose's forward axis is that one.

@@ -4,7 +4,7 @@
 /// detectors (the acceleration's peaks and valleys, the arm's turns while the phone swings), the
 /// handoff between them and the walk they are in (its start after a stand held until confirmed,
 /// the steps a swinging start missed), because which detector speaks and what a step stands for
-/// is decided together. The foot pipeline uses AdaptiveStepDetector (steps.hpp) alone.
+/// is decided together. The foot pipeline (FootPdr) uses AdaptiveStepDetector (steps.hpp) alone.
 ///
 /// Memory: the detectors' fixed-size buffers, no heap.
 

@@ -3,7 +3,8 @@
 /// PDR stage (phone pipeline): the last seconds of raw samples, and what the phone's step
 /// detection, cadence and pose-switch detection ask of them: whether the phone stood still
 /// between two moments, whether the acceleration repeats at a step interval, and a step's
-/// waveform. Owned here so that those questions read one ring; the foot pipeline needs none.
+/// waveform. Owned here so that those questions read one ring; the foot pipeline (FootPdr)
+/// needs none.
 ///
 /// Memory: fixed-size arrays (512 samples: 10 s at 50 Hz), no heap.
 

@@ -3,7 +3,8 @@
 /// PDR stage: the cadence and the steps a detector left in a gap (our addition). Owns the step
 /// interval (the median of the last measured ones), the last step's time and the heading over
 /// the last seconds, because a gap is measured in step intervals and its steps are laid along
-/// the heading each part of it had. The foot pipeline uses the cadence only (it fills no gap).
+/// the heading each part of it had. The foot pipeline (FootPdr) uses the cadence only: its
+/// detector sees every stride, so it fills no gap (learn_cadence).
 ///
 /// Memory: fixed-size arrays, no heap.
 
@@ -33,11 +34,13 @@ class StepGaps {
   void add_heading(double t_s, const Eigen::Vector2d& unit);
   /// The walking frame changed at t_s: the headings before are in another frame.
   void new_frame(double t_s) { bins_from_t_s_ = t_s; }
-  /// A step event at t_s that stands for `per_event` steps: returns how many more the gap
-  /// before it held (only with `fill`: the phone; `energy` the phone's acceleration energy over
-  /// the feature window) and learns the cadence from it.
-  int at_step(double t_s, const StepSource& source, double per_event, bool fill, double energy,
-              const RecentSamples& recent);
+  /// A step event of the phone at t_s: returns how many more steps the gap before it held
+  /// (`energy` the phone's acceleration energy over the feature window) and learns the cadence
+  /// from it.
+  int at_step(double t_s, const StepSource& source, double energy, const RecentSamples& recent);
+  /// An event at t_s that stands for `per_event` steps (a foot sensor's stride: 2) and whose
+  /// gap is never filled: learns the cadence only.
+  void learn_cadence(double t_s, double per_event);
   /// For a gap [t0, t1] walked in `parts` equal steps: the mean of the unit vectors of each
   /// part's heading relative to the whole gap's (x along, y clockwise); (1, 0) when the
   /// headings kept do not cover the gap.
@@ -48,6 +51,9 @@ class StepGaps {
   [[nodiscard]] double last_step_t_s() const { return last_step_t_s_; }
 
  private:
+  /// The event at t_s ends the gap since the last; with `learn`, its interval per step
+  /// (`per_event` steps in it) is a cadence measurement.
+  void end_gap(double t_s, double per_event, bool learn);
   void learn_interval(double interval_s);
   Params params_;
   double last_step_t_s_ = -1.0;
