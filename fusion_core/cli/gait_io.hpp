@@ -1,7 +1,8 @@
 #pragma once
 /// \file
 /// IMU CSV reading and gait-simulator CSV writing shared by the steps, pdr, gait-sim and
-/// steps-eval subcommands (SPEC section 6 column names).
+/// steps-eval subcommands (SPEC section 6 column names), and the one run of a phone walk that
+/// `pdr` writes and `steps-eval` scores (run_handheld_walk).
 
 #include <CLI/CLI.hpp>
 #include <limits>

@@ -38,7 +38,7 @@ void FootPdr::on_stride(double t_s) {
   out_.gait = f < 1.6 ? 0 : f < 1.95 ? 1 : f < 2.35 ? 2 : f < 2.75 ? 3 : 4;
   // The heading filter's circular mean over the stride (its heading if it had none).
   double heading = heading_.heading_rad();
-  if (sum_sin_ != 0.0 || sum_cos_ != 0.0) heading = wrap_2pi(std::atan2(sum_sin_, sum_cos_));
+  if (sum_sin_ != 0.0 || sum_cos_ != 0.0) heading = std::atan2(sum_sin_, sum_cos_);
   sum_sin_ = sum_cos_ = 0.0;
   heading = wrap_2pi(heading);
   // The first stride has no frequency yet: the person's usual walk.

@@ -485,8 +485,7 @@ int HandheldPdr::update(const ImuSample& s, const Eigen::Vector3d& mag_uT) {
     last_.t_s = c.t_s;
     last_.x_m += len * std::sin(heading);
     last_.y_m += len * std::cos(heading);
-    last_.heading_deg = std::remainder(heading * 180.0 / M_PI, 360.0);
-    if (last_.heading_deg < 0.0) last_.heading_deg += 360.0;
+    last_.heading_deg = wrap_360_deg(heading * 180.0 / M_PI);
     last_.length_m = len;
     last_.step_hz = hz;
     last_.bias_yaw_rad = at.bias_yaw_rad;
