@@ -68,6 +68,52 @@ double LowPass2::step(double x, double dt_s) {
 }
 
 // ---------------------------------------------------------------------------------------------
+void TiltWindow::add(double t_s, const Eigen::Vector3d& f) {
+  constexpr double kBlock_s = 1.0 / static_cast<double>(kBlocksPerSecond);
+  if (!started_) {
+    started_ = true;
+    block_end_s_ = t_s + kBlock_s;
+  }
+  // Close every block this sample's time has passed (more than one across a gap: the skipped
+  // ones stay empty), then add the sample to the open one. Each sample counts once: only the
+  // direction of the sum is read, and a sample after a gap must not stand for the whole gap.
+  for (std::size_t closed = 0; t_s >= block_end_s_; ++closed) {
+    if (closed == kBlocks) {  // a gap longer than the window: start it again
+      filled_ = 0;
+      head_ = 0;
+      block_end_s_ = t_s + kBlock_s;
+      break;
+    }
+    const std::size_t slot = (head_ + filled_) % kBlocks;
+    blocks_[slot] = current_;
+    if (filled_ < kBlocks)
+      ++filled_;
+    else
+      head_ = (head_ + 1) % kBlocks;
+    current_.setZero();
+    block_end_s_ += kBlock_s;
+  }
+  current_ += f;
+}
+
+double TiltWindow::angle_rad() const {
+  // Until two seconds are in (the first moments after a start, when a phone is often still in
+  // the hand), the blocks there are, split in halves.
+  const std::size_t half = filled_ / 2;
+  if (half == 0) return 0.0;
+  const std::size_t first = head_ + filled_ - 2 * half;
+  Eigen::Vector3d before = Eigen::Vector3d::Zero();
+  Eigen::Vector3d last = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < half; ++i) {
+    before += blocks_[(first + i) % kBlocks];
+    last += blocks_[(first + half + i) % kBlocks];
+  }
+  const double n = before.norm() * last.norm();
+  if (!(n > 0.0)) return 0.0;
+  return std::acos(std::clamp(before.dot(last) / n, -1.0, 1.0));
+}
+
+// ---------------------------------------------------------------------------------------------
 AdaptiveStepDetector::AdaptiveStepDetector(Params params)
     : params_(params), acc_lp_(params.acc_cutoff_hz), gyro_lp_(params.gyro_cutoff_hz) {
   interval_ema_s_ = params_.initial_interval_s;
@@ -291,12 +337,31 @@ bool SwingStepDetector::swinging(double t_s) const {
          std::min(done_sweeps_[0], done_sweeps_[1]) >= min_sweep;
 }
 
+bool PeakValleyStepDetector::keeps_rhythm(double t_s) const {
+  const auto k = static_cast<std::size_t>(std::clamp(params_.rhythm_steps, 1, 7));
+  if (n_step_times_ < k + 1) return false;
+  const auto at = [&](std::size_t back) {  // back = 0: the last counted step
+    return step_times_[(n_step_times_ - 1 - back) % kRhythmCapacity];
+  };
+  const double mean = (at(0) - at(k)) / static_cast<double>(k);
+  const double lo = (1.0 - params_.rhythm_tolerance) * mean;
+  const double hi = (1.0 + params_.rhythm_tolerance) * mean;
+  const double gap = t_s - at(0);
+  if (!(gap >= lo && gap <= hi)) return false;
+  for (std::size_t i = 0; i < k; ++i) {
+    const double iv = at(i) - at(i + 1);
+    if (!(iv >= lo && iv <= hi)) return false;
+  }
+  return true;
+}
+
 void PeakValleyStepDetector::reset() { *this = PeakValleyStepDetector(params_); }
 
 bool PeakValleyStepDetector::update(const ImuSample& s, StepEvent& event) {
   const double dt = gate(s, have_t_, last_t_s_, diag_);
   if (dt < 0.0) return false;
   const double y = lp_.step(s.acc_body_m_s2.norm(), dt);
+  tilt_.add(s.t_s, s.acc_body_m_s2);
   const double k_mean = dt > 0.0 ? dt / (2.0 + dt) : 1.0;
   mean_m_s2_ = n_ == 0 ? y : mean_m_s2_ + k_mean * (y - mean_m_s2_);
   const bool is_max = n_ >= 2 && y1_ > y2_ && y1_ >= y;
@@ -352,11 +417,21 @@ bool PeakValleyStepDetector::update(const ImuSample& s, StepEvent& event) {
     }
     return false;
   }
+  if (params_.max_tilt_deg > 0.0 && tilt_.angle_rad() > params_.max_tilt_deg * (M_PI / 180.0) &&
+      !keeps_rhythm(s.t_s)) {
+    // The phone is being handled: its swing is the hand's, not a step's. Not a step, and
+    // nothing learnt from it.
+    ++diag_.rejected_handling;
+    phase_ = Phase::kSeekPeak;
+    return false;
+  }
   const double since = cand_peak_t_s_ - last_peak_t_s_;
   if (have_prev_ && since > 0.0 && since < params_.max_interval_s)
     interval_ema_s_ += 0.3 * (since - interval_ema_s_);
   event.t_s = s.t_s;
   event.interval_s = have_prev_ ? s.t_s - last_step_t_s_ : 0.0;
+  step_times_[n_step_times_ % kRhythmCapacity] = s.t_s;
+  ++n_step_times_;
   prev_peak_ = cand_peak_;
   prev_valley_ = valley_;
   have_prev_ = true;
@@ -606,6 +681,7 @@ std::unique_ptr<StepDetector> make_step_detector(std::string_view name, StepMoun
     if (foot) {
       p.min_interval_s = 0.36;
       p.min_swing_m_s2 = 2.0;
+      p.max_tilt_deg = 0.0;  // a foot turns through 30-100 deg in every swing
     }
     return std::make_unique<PeakValleyStepDetector>(p);
   }

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -206,6 +207,102 @@ TEST(PeakValleyStepDetector, PhoneInEveryPoseWalking) {
   }
 }
 
+// --- a phone handled, not carried ---------------------------------------------------------------
+TEST(TiltWindow, AngleBetweenTheLastSecondAndTheOneBeforeAtAnyRate) {
+  const Eigen::Vector3d down(0.0, 0.0, kG);
+  const Eigen::Vector3d tilted =
+      Eigen::AngleAxisd(40.0 * M_PI / 180.0, Eigen::Vector3d::UnitX()) * down;
+  for (double rate : {50.0, 100.0, 400.0}) {
+    TiltWindow w;
+    EXPECT_EQ(w.angle_rad(), 0.0);
+    const auto n = static_cast<int>(std::lround(4.0 * rate));
+    double at_one_s = -1.0, at_two_s = -1.0, at_three_s = -1.0;
+    for (int k = 0; k <= n; ++k) {
+      const double t = k / rate;
+      w.add(t, t < 2.0 ? down : tilted);  // tilted by 40 deg at t = 2 s
+      if (k == static_cast<int>(rate)) at_one_s = w.angle_rad();
+      if (k == static_cast<int>(2.0 * rate) - 1) at_two_s = w.angle_rad();
+      if (k == static_cast<int>(3.0 * rate)) at_three_s = w.angle_rad();
+    }
+    // Held still: the halves agree (to acos's resolution near 1, ~1e-8 rad).
+    EXPECT_NEAR(at_one_s, 0.0, 1e-7) << rate;
+    EXPECT_NEAR(at_two_s, 0.0, 1e-7) << rate;
+    // At 3 s the last whole second is tilted, the one before is not.
+    EXPECT_NEAR(at_three_s * 180.0 / M_PI, 40.0, 1e-9) << rate;
+    EXPECT_NEAR(w.angle_rad(), 0.0, 1e-7) << rate;  // two seconds after: still again
+  }
+}
+
+TEST(TiltWindow, AGapLongerThanTheWindowStartsItAgain) {
+  TiltWindow w;
+  for (int k = 0; k < 200; ++k) w.add(k * 0.01, Eigen::Vector3d(0.0, 0.0, kG));
+  w.add(10.0, Eigen::Vector3d(kG, 0.0, 0.0));  // 8 s later, on its side
+  EXPECT_EQ(w.angle_rad(), 0.0);               // nothing before the gap is compared with it
+  for (int k = 1; k < 100; ++k) w.add(10.0 + k * 0.01, Eigen::Vector3d(kG, 0.0, 0.0));
+  EXPECT_NEAR(w.angle_rad(), 0.0, 1e-7);
+}
+
+// A phone taken out of a pocket and turned up to be read while its owner stands: the hand's
+// shake (2 Hz, 3 m/s^2 on |f|) passes every amplitude and timing test of a step, but the phone
+// tilts through 120 deg in 3 s (40 deg/s), then is held. Six steps with the rule off (so the
+// test can fail); the first second's only with it.
+std::vector<ImuSample> handled_phone(double rate_hz) {
+  std::vector<ImuSample> v;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (int k = 0; k < static_cast<int>(6.0 * rate_hz); ++k) {
+    const double t = k / rate_hz;
+    const double in_hand = std::clamp(t - 1.5, 0.0, 3.0);  // 1.5-4.5 s
+    const double tilt = (120.0 * M_PI / 180.0) * in_hand / 3.0;
+    const double shake =
+        in_hand > 0.0 && in_hand < 3.0 ? 3.0 * std::sin(2.0 * M_PI * 2.0 * t) : 0.0;
+    const Eigen::Vector3d f =
+        (kG + shake) * (Eigen::AngleAxisd(tilt, Eigen::Vector3d(1.0, 1.0, 0.0).normalized()) *
+                        Eigen::Vector3d::UnitZ());
+    v.push_back({t, {nan, nan, nan}, f});
+  }
+  return v;
+}
+
+TEST(PeakValleyStepDetector, APhoneHandledWhileStandingCountsOnlyItsFirstSecond) {
+  for (double rate : {50.0, 100.0, 200.0}) {
+    const auto samples = handled_phone(rate);
+    for (double max_tilt : {0.0, PeakValleyStepParams{}.max_tilt_deg}) {
+      PeakValleyStepParams p;
+      p.max_tilt_deg = max_tilt;
+      PeakValleyStepDetector d(p);
+      StepEvent ev;
+      std::size_t n = 0;
+      for (const auto& s : samples) n += d.update(s, ev) ? 1u : 0u;
+      if (max_tilt == 0.0) {
+        EXPECT_EQ(n, 6u) << rate;  // every shake passes for a step without the rule
+      } else {
+        // The rule needs the tilt of a second to see it: the shakes of the handling's first
+        // second (tilted by 15-20 deg on the second's mean) still count, none after.
+        EXPECT_LE(n, 2u) << rate;
+        EXPECT_EQ(d.diagnostics().rejected_handling + n, 6u) << rate;
+      }
+    }
+  }
+}
+
+// A walker moving the phone from the hand to the ear, a pocket and a swinging hand walks on: the
+// steps of a steady walk count however the phone tilts (the rhythm exemption). The same count
+// as with the rule off within 2 steps of ~280 (four switches, each 1.5 s), five people.
+TEST(PeakValleyStepDetector, PoseSwitchesWhileWalkingKeepTheirSteps) {
+  for (int p = 1; p <= 5; ++p) {
+    const auto seed = static_cast<std::uint64_t>(p);
+    const auto run = sim::simulate_gait(*sim::make_gait_scenario("phone-switch", seed),
+                                        sim::random_person(seed), seed);
+    PeakValleyStepParams off;
+    off.max_tilt_deg = 0.0;
+    PeakValleyStepDetector with_rule, without_rule(off);
+    const auto n_with = count(with_rule, run.samples, true);
+    const auto n_without = count(without_rule, run.samples, true);
+    EXPECT_LE(n_without - std::min(n_with, n_without), 2u) << seed;
+    EXPECT_LE(n_with, n_without) << seed;  // the rule only ever refuses
+  }
+}
+
 // The swing detector on the gyro's horizontal part (up from the accelerometer's slow mean, as a
 // phone without a filter would have it).
 std::size_t count_swings(const std::vector<sim::GaitSample>& samples,
@@ -395,7 +492,9 @@ TEST(GaitPhaseStepDetector, FootReportsTheHeelStrike) {
 // --- real phone traces --------------------------------------------------------------------------
 // Oxford step counter traces (CC BY 4.0, see tests/data/oxford_steps/README.md): 24 traces,
 // 7 carrying positions, 3 phones, accelerometer only. Metric of the dataset: mean count accuracy.
-TEST(OxfordTraces, PeakValleyMeanCountAccuracyAtLeast97Percent) {
+// The full traces (../shared/data) give 98.03 %; these 50 Hz copies 97.98 (97.60 before the
+// handled-phone rule, which the bound below would have failed).
+TEST(OxfordTraces, PeakValleyMeanCountAccuracyAtLeast97_9Percent) {
   const std::string dir = std::string(TELLTALE_TEST_DATA_DIR) + "/oxford_steps";
   std::ifstream counts(dir + "/counts.csv");
   ASSERT_TRUE(counts) << dir;
@@ -427,7 +526,7 @@ TEST(OxfordTraces, PeakValleyMeanCountAccuracyAtLeast97Percent) {
   }
   ASSERT_EQ(traces, 24);
   RecordProperty("mean_accuracy_percent", std::to_string(100.0 * sum / traces));
-  EXPECT_GE(sum / traces, 0.97);
+  EXPECT_GE(sum / traces, 0.979);
 }
 
 }  // namespace

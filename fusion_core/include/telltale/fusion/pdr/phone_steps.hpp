@@ -34,7 +34,7 @@ struct StepSource {
 class PhoneSteps {
  public:
   using Params = PhoneStepParams;
-  explicit PhoneSteps(Params params) : params_(params) {}
+  explicit PhoneSteps(Params params) : params_(params), acc_steps_(acc_step_params()) {}
   /// One sample (gyro bias removed); `up` the tracked up direction in the sensor frame. The
   /// PDR's last step time (< 0: none yet) and step interval (0: unknown) and its recent samples
   /// tell a handoff and a stand. True at a step, with its time in `ev` and how it was found.
@@ -43,6 +43,15 @@ class PhoneSteps {
   [[nodiscard]] const StepDiagnostics& diagnostics() const { return acc_steps_.diagnostics(); }
 
  private:
+  /// The peak-valley detector without its handled-phone rule (PeakValleyStepParams::
+  /// max_tilt_deg): here the walk's start hold and the stand decide what a handled phone's events
+  /// are (tested case by case), and the rule on top of them cost the simulated loops' pose
+  /// switches steps (2 of 5682) and closure (90th percentile 1.76 -> 1.98 %).
+  static PeakValleyStepParams acc_step_params() {
+    PeakValleyStepParams p;
+    p.max_tilt_deg = 0.0;
+    return p;
+  }
   Params params_;
   PeakValleyStepDetector acc_steps_;
   SwingStepDetector swing_steps_;  ///< steps while the phone swings (its turns)
