@@ -45,11 +45,13 @@ void run_steps(const StepsOptions& o) {
     ++steps;
   }
   // repeated_stamps: rows whose time stamp repeated the previous row's, merged into it (their
-  // mean: see read_imu_csv); samples: the records after merging.
+  // mean: see read_imu_csv); samples: the records after merging; refused_handling: candidate
+  // steps not counted because the phone was being handled (peak-valley's tilt rule).
   std::printf(
       "{\"steps\": %zu, \"step_times_s\": [%s], \"method\": \"%s\", \"mount\": \"%s\", "
-      "\"samples\": %zu, \"repeated_stamps\": %zu}\n",
-      steps, times.c_str(), method.c_str(), o.mount.c_str(), records.size(), repeated);
+      "\"samples\": %zu, \"repeated_stamps\": %zu, \"refused_handling\": %u}\n",
+      steps, times.c_str(), method.c_str(), o.mount.c_str(), records.size(), repeated,
+      detector->diagnostics().rejected_handling);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -45,6 +46,38 @@ TEST_F(StepsCli, RepeatedTimeStampsAreMergedAndCounted) {
   ASSERT_EQ(run("pdr --in " + path("rep.csv") + " --height-m 1.75 --out " + path("track.csv")), 0)
       << read("err.txt");
   EXPECT_NE(read("out.txt").find("\"repeated_stamps\": 50"), std::string::npos) << read("out.txt");
+}
+
+// A walk (2-8 s, 12 steps), a stand, then the phone taken out and turned up to be read (11-14 s:
+// tilted through 120 deg while the hand shakes at 2 Hz): the shakes after the handling's first
+// second are refused and counted in the summary. With the rule off (a foot's peak-valley) every
+// shake is a step, so the test can fail.
+TEST_F(StepsCli, StepsRefusedWhileThePhoneIsHandledAreCounted) {
+  {
+    std::ofstream out(path("handled.csv"));
+    out << "t_s,ax_m_s2,ay_m_s2,az_m_s2\n";
+    for (int n = 0; n < 800; ++n) {
+      const double t = n * 0.02;
+      const double walking = (t > 2.0 && t < 8.0) ? 1.0 : 0.0;
+      double f = 9.81 - walking * 2.0 * std::cos(2.0 * M_PI * 2.0 * (t - 2.0));
+      const double in_hand = std::clamp(t - 11.0, 0.0, 3.0);
+      if (in_hand > 0.0 && in_hand < 3.0) f += 3.0 * std::sin(2.0 * M_PI * 2.0 * t);
+      const double tilt = (120.0 * M_PI / 180.0) * in_hand / 3.0;
+      out << t << "," << f * std::sin(tilt) << ",0," << f * std::cos(tilt) << "\n";
+    }
+  }
+  ASSERT_EQ(run("steps --in " + path("handled.csv") + " --mount phone"), 0) << read("err.txt");
+  std::string out = read("out.txt");
+  const auto number = [&out](const std::string& key) {
+    const auto at = out.find("\"" + key + "\": ");
+    return at == std::string::npos ? -1 : std::atoi(out.c_str() + at + key.size() + 4);
+  };
+  EXPECT_GE(number("steps"), 12) << out;
+  EXPECT_LE(number("steps"), 14) << out;  // the walk and at most the handling's first second
+  EXPECT_GE(number("refused_handling"), 4) << out;
+  ASSERT_EQ(run("steps --in " + path("handled.csv") + " --mount foot --method peak-valley"), 0);
+  out = read("out.txt");
+  EXPECT_EQ(number("refused_handling"), 0) << out;
 }
 
 TEST_F(StepsCli, TimeGoingBackwardsIsAnErrorNamingFileLineAndColumn) {
