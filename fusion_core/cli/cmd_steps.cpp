@@ -37,13 +37,15 @@ void run_steps(const StepsOptions& o) {
   std::string times;
   std::size_t steps = 0;
   fusion::StepEvent ev;
-  for (const auto& r : records) {
-    if (!detector->update(r.imu, ev)) continue;
+  const auto add = [&] {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%s%.3f", steps ? ", " : "", ev.t_s);
     times += buf;
     ++steps;
-  }
+  };
+  for (const auto& r : records)
+    if (detector->update(r.imu, ev)) add();
+  while (detector->flush(ev)) add();
   // repeated_stamps: rows whose time stamp repeated the previous row's, merged into it (their
   // mean: see read_imu_csv); samples: the records after merging; refused_handling: candidate
   // steps not counted because the phone was being handled (peak-valley's tilt rule).

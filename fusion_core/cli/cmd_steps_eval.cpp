@@ -52,6 +52,7 @@ std::size_t count_steps(fusion::StepDetector& d, const std::vector<fusion::ImuSa
   std::size_t n = 0;
   fusion::StepEvent ev;
   for (const auto& s : samples) n += d.update(s, ev) ? 1u : 0u;
+  while (d.flush(ev)) ++n;
   return n;
 }
 
@@ -499,6 +500,7 @@ void ipin_table(const EvalOptions& o) {
       fusion::StepEvent ev;
       for (const auto& r : records)
         if (r.imu.t_s < handled_until_s && counter->update(r.imu, ev)) ++counter_before;
+      while (counter->flush(ev)) ++counter_before;
     }
     pdr_handled += pdr_before;
     counter_handled += counter_before;

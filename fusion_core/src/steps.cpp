@@ -360,8 +360,56 @@ void PeakValleyStepDetector::reset() { *this = PeakValleyStepDetector(params_); 
 bool PeakValleyStepDetector::update(const ImuSample& s, StepEvent& event) {
   const double dt = gate(s, have_t_, last_t_s_, diag_);
   if (dt < 0.0) return false;
-  const double y = lp_.step(s.acc_body_m_s2.norm(), dt);
   tilt_.add(s.t_s, s.acc_body_m_s2);
+  bool steady = false;
+  StepEvent found;
+  const bool step = detect(s, dt, found, steady);
+  if (!(params_.max_tilt_deg > 0.0)) {  // no handled-phone rule: every step at once
+    if (step) event = found;
+    return step;
+  }
+  // Each step is held for a second, then judged on the tilt across it: the mean specific force
+  // of the second after it against that of the second before (the check in detect() saw only
+  // the two seconds before it, so a handling's first second passed). A step of a steady walk's
+  // rhythm passes as it did there.
+  if (step) {
+    if (n_held_ == kHeldCapacity) {  // cannot happen (steps >= min_interval_s apart); no loss
+      (void)release(event);
+      held_[(held_head_ + n_held_) % kHeldCapacity] = {found, steady};
+      ++n_held_;
+      return true;
+    }
+    held_[(held_head_ + n_held_) % kHeldCapacity] = {found, steady};
+    ++n_held_;
+  }
+  const double max_tilt_rad = params_.max_tilt_deg * (M_PI / 180.0);
+  while (n_held_ > 0 && s.t_s - held_[held_head_].event.t_s >= kHold_s) {
+    if (held_[held_head_].steady || !(tilt_.angle_rad() > max_tilt_rad)) return release(event);
+    ++diag_.rejected_handling;
+    held_head_ = (held_head_ + 1) % kHeldCapacity;
+    --n_held_;
+  }
+  return false;
+}
+
+bool PeakValleyStepDetector::flush(StepEvent& event) {
+  // The stream has ended: the second after a held step is not all there, and the check before
+  // it was made. Release as it is.
+  return n_held_ > 0 && release(event);
+}
+
+bool PeakValleyStepDetector::release(StepEvent& event) {
+  event = held_[held_head_].event;
+  event.interval_s = have_released_ ? event.t_s - last_released_t_s_ : 0.0;
+  have_released_ = true;
+  last_released_t_s_ = event.t_s;
+  held_head_ = (held_head_ + 1) % kHeldCapacity;
+  --n_held_;
+  return true;
+}
+
+bool PeakValleyStepDetector::detect(const ImuSample& s, double dt, StepEvent& event, bool& steady) {
+  const double y = lp_.step(s.acc_body_m_s2.norm(), dt);
   const double k_mean = dt > 0.0 ? dt / (2.0 + dt) : 1.0;
   mean_m_s2_ = n_ == 0 ? y : mean_m_s2_ + k_mean * (y - mean_m_s2_);
   const bool is_max = n_ >= 2 && y1_ > y2_ && y1_ >= y;
@@ -417,8 +465,9 @@ bool PeakValleyStepDetector::update(const ImuSample& s, StepEvent& event) {
     }
     return false;
   }
+  steady = keeps_rhythm(s.t_s);
   if (params_.max_tilt_deg > 0.0 && tilt_.angle_rad() > params_.max_tilt_deg * (M_PI / 180.0) &&
-      !keeps_rhythm(s.t_s)) {
+      !steady) {
     // The phone is being handled: its swing is the hand's, not a step's. Not a step, and
     // nothing learnt from it.
     ++diag_.rejected_handling;

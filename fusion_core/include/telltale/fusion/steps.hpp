@@ -109,8 +109,12 @@ class LowPass2 {
 class StepDetector {
  public:
   virtual ~StepDetector() = default;
-  /// Feeds one sample. Returns true and fills `event` when a step is confirmed at this sample.
+  /// Feeds one sample. Returns true and fills `event` when a step is reported at this sample
+  /// (peak-valley on a phone reports each a second after confirming it: see its Params).
   virtual bool update(const ImuSample& sample, StepEvent& event) = 0;
+  /// The end of the stream: returns true and fills `event` while steps are still held (call
+  /// until false). Only a detector that holds steps has any.
+  virtual bool flush(StepEvent& /*event*/) { return false; }
   virtual void reset() = 0;
   [[nodiscard]] virtual std::string_view name() const = 0;
   [[nodiscard]] virtual const StepDiagnostics& diagnostics() const = 0;
@@ -237,8 +241,12 @@ struct PeakValleyStepParams {
   double initial_interval_s = 0.5;     ///< cadence memory at start and after a pause, s
   double min_swing_m_s2 = 0.6;         ///< smallest peak-to-valley swing that is a step, m/s^2
   double valley_rise_fraction = 0.25;  ///< a valley is confirmed once |f| rises by this x swing
-  /// A step is not counted when the sensor's mean orientation turned by more than this over the
-  /// second before it (TiltWindow): the phone is being handled, not carried. Walking with a phone
+  /// A step is not counted when the sensor's mean orientation turned by more than this in a
+  /// second (TiltWindow): the phone is being handled, not carried. Judged when the step is
+  /// confirmed (the last second against the one before) and again a second later (the second
+  /// after the step against the one before it, which sees a handling's first second): each step
+  /// is reported a second after it is confirmed, with its own time, and flush() releases the
+  /// last ones when the stream ends. Walking with a phone
   /// in the hand, a pocket, a bag, an armband or a swinging hand tilts that mean by 1-5 deg in the
   /// median second (Oxford traces: 90 % of steps under 12, 98 % under 32, the highest a bag's);
   /// handling it turns it by 40-130. A step that keeps a steady walk's rhythm counts however the
@@ -254,6 +262,7 @@ class PeakValleyStepDetector final : public StepDetector {
   using Params = PeakValleyStepParams;
   explicit PeakValleyStepDetector(Params params = {});
   bool update(const ImuSample& sample, StepEvent& event) override;
+  bool flush(StepEvent& event) override;
   void reset() override;
   [[nodiscard]] std::string_view name() const override { return "peak-valley"; }
   [[nodiscard]] const StepDiagnostics& diagnostics() const override { return diag_; }
@@ -277,9 +286,22 @@ class PeakValleyStepDetector final : public StepDetector {
   double y1_ = 0.0, y2_ = 0.0;
   int n_ = 0;
   static constexpr std::size_t kRhythmCapacity = 8;
-  std::array<double, kRhythmCapacity> step_times_{};  ///< the last counted steps, ring
-  std::size_t n_step_times_ = 0;                      ///< counted steps so far (ring index)
+  std::array<double, kRhythmCapacity> step_times_{};  ///< the last confirmed steps, ring
+  std::size_t n_step_times_ = 0;                      ///< confirmed steps so far (ring index)
+  // Steps held a second before they are reported (the handled-phone rule; FIFO ring).
+  static constexpr double kHold_s = 1.0;
+  static constexpr std::size_t kHeldCapacity = 8;  ///< > 1 s / min_interval_s
+  struct Held {
+    StepEvent event;
+    bool steady = false;  ///< it kept a steady walk's rhythm when confirmed
+  };
+  std::array<Held, kHeldCapacity> held_{};
+  std::size_t held_head_ = 0, n_held_ = 0;
+  bool have_released_ = false;
+  double last_released_t_s_ = 0.0;
   [[nodiscard]] bool keeps_rhythm(double t_s) const;
+  bool detect(const ImuSample& s, double dt, StepEvent& event, bool& steady);
+  bool release(StepEvent& event);
 };
 
 /// Gait phases, for real walks that start and stop. The adaptive and peak-valley
