@@ -1,19 +1,24 @@
 #pragma once
 /// \file
 /// Pedestrian dead reckoning for a phone held in front of the walker (the reading / texting pose
-/// of real phone walks), in stages, each with its Params and State:
+/// of real phone walks), in stages, one per file (handheld/), each with its Params and State:
 ///
-///   1. tilt: the up direction in the phone's frame from TelltaleAttitudeFilter (attitude_telltale);
-///   2. StandBiasLearner: the gyro bias from the walker standing still (a hand, not a table);
-///   3. WalkStepDetector: steps from the vertical specific force, counted only once the motion
-///      is a walk (a regular cadence with the phone's tilt steady), so handling the phone,
-///      standing and pausing make no steps and no distance;
-///   4. step length from height and cadence by the walk ratio (walk_ratio_step_length_m);
-///   5. WalkingHeading: the phone's yaw about the vertical, the bias-corrected gyro integrated
-///      about the up direction. A phone held in front keeps a fixed yaw to the walking direction,
-///      so turns of the phone are turns of the walk; the magnetometer (unreliable indoors) only
-///      orients the track once, at the start, and never steers it;
-///   6. the track: each step laid at the heading the phone had at that step.
+///   1. tilt: the up direction in the phone's frame from TelltaleAttitudeFilter
+///      (attitude_telltale.hpp);
+///   2. StandBiasLearner (handheld/stand_bias.hpp): the gyro bias from the walker standing still
+///      (a hand, not a table);
+///   3. WalkStepDetector (handheld/walk_steps.hpp): steps from the vertical specific force,
+///      counted only once the motion is a walk (a regular cadence with the phone's tilt steady),
+///      so handling the phone, standing and pausing make no steps and no distance;
+///   4. step length from height and cadence by the walk ratio (walk_ratio_step_length_m,
+///      handheld/walk_ratio.hpp);
+///   5. WalkingHeading (handheld/walking_yaw.hpp): the phone's yaw about the vertical, the
+///      bias-corrected gyro integrated about the up direction. A phone held in front keeps a
+///      fixed yaw to the walking direction, so turns of the phone are turns of the walk; the
+///      magnetometer (unreliable indoors) only orients the track once, at the start, and never
+///      steers it;
+///   6. the track (here: HandheldPdr, relay_track): each step laid at the heading the phone had
+///      at that step.
 ///
 /// Steps are reported with the time of the step itself (they are confirmed up to a few steps
 /// later): HandheldPdr::update returns the steps it confirmed at this sample.
@@ -28,248 +33,14 @@
 #include <span>
 
 #include "telltale/fusion/attitude_telltale.hpp"
+#include "telltale/fusion/handheld/stand_bias.hpp"
+#include "telltale/fusion/handheld/walk_ratio.hpp"
+#include "telltale/fusion/handheld/walk_steps.hpp"
+#include "telltale/fusion/handheld/walking_yaw.hpp"
 #include "telltale/fusion/imu_sample.hpp"
 #include "telltale/fusion/pdr.hpp"
 
 namespace telltale::fusion {
-
-// ---------------------------------------------------------------------------------------------
-/// Gyro bias from standing. A hand holding a phone is never still (tremor: 0.05-0.25 rad/s rms,
-/// acceleration 0.05-0.4 m/s^2 rms), so no single second gives the bias; but the phone's
-/// orientation stays put while the walker stands, so over a stand of T seconds the mean rate is
-/// the bias plus (net rotation) / T: a few degrees over a 20 s stand, under 0.005 rad/s. Each
-/// stand is weighted by T^2 (its error goes as 1/T) and the current stand counts as it grows.
-struct StandBiasParams {
-  double window_s = 1.0;          ///< quiet test window
-  /// Quiet: |f| rms about its mean and the rate rms below these over the window. A walking step
-  /// moves |f| by 1-3 m/s^2 (heel strike), handling turns the phone at 2-7 rad/s; a hand
-  /// holding it stays below both.
-  double max_acc_sd_m_s2 = 0.4;
-  double max_gyro_rms_rad_s = 0.4;
-  double min_stand_s = 3.0;       ///< shorter quiet stretches are pauses of a moving hand
-  /// A stand's mean rate above this is a slow turn on the spot, not a bias (phone gyros are
-  /// factory- and OS-calibrated to well under 1 deg/s).
-  double max_bias_rad_s = 0.03;
-  /// The bias about the vertical from the magnetometer during stands. A standing walker stays
-  /// on one spot, so the field there is one fixed vector even when indoor iron bends it; the
-  /// phone's yaw change over the stand is then the change of the field's horizontal direction
-  /// seen from the phone (tilt-compensated), and d = (gyro yaw) - (magnetic yaw) grows as
-  /// bias * t whatever the hand's yaw wander does (the wander is in both and cancels). Its slope
-  /// (least squares over the stand's samples) is the bias about the stand's vertical; the other
-  /// two components stay the gyro learner's. Never used while walking: the walker then moves
-  /// through the field's disturbances, and a direction change of the field is not a turn.
-  /// Stands are combined by the inverse variance of their slopes (see StandBiasLearner::State).
-  bool mag_yaw_bias = true;
-  /// The magnetic yaw's noise goes as 1/|B horizontal|: below this (a field nearly along the
-  /// vertical, or a dead sensor) a stand says nothing. Earth's horizontal field is 10-40 uT.
-  double min_mag_horizontal_uT = 5.0;
-  /// |B| is the same at one spot whatever the phone's orientation; a stand whose |B| varies by
-  /// more than this (rms) had the phone moved past a magnetic source (or the walker stepped),
-  /// so its field was not one fixed vector: no estimate from it.
-  double max_mag_norm_sd_uT = 2.0;
-};
-class StandBiasLearner {
- public:
-  using Params = StandBiasParams;
-  struct State {
-    // Window sums.
-    double win_t0_s = 0.0;
-    int win_n = 0;
-    double win_a = 0.0, win_a2 = 0.0, win_w2 = 0.0;
-    Eigen::Vector3d win_w = Eigen::Vector3d::Zero();
-    // The stand in progress (consecutive quiet windows) and the stands before it.
-    double stand_s = 0.0;
-    Eigen::Vector3d stand_w_dt = Eigen::Vector3d::Zero();  ///< integral of the rate
-    double done_weight = 0.0;                              ///< sum of T^2
-    Eigen::Vector3d done_sum = Eigen::Vector3d::Zero();    ///< sum of T^2 * mean
-    Eigen::Vector3d bias = Eigen::Vector3d::Zero();
-    // Magnetic yaw: psi_g = integral of w . up (raw gyro), psi_m = the phone's yaw from the
-    // field (unwrapped, counter-clockwise), d = psi_g - psi_m. Least-squares sums of d against t
-    // (t from the first sample) over the window and over the stand, d^2 for the residual about
-    // the fitted line (the slope's variance); |B| sums for its rms.
-    struct YawSums {
-      double n = 0.0, t = 0.0, d = 0.0, tt = 0.0, td = 0.0, dd = 0.0, b = 0.0, bb = 0.0,
-             bh = 0.0;
-      Eigen::Vector3d up = Eigen::Vector3d::Zero();
-      void add(const YawSums& o) {
-        n += o.n; t += o.t; d += o.d; tt += o.tt; td += o.td; dd += o.dd;
-        b += o.b; bb += o.bb; bh += o.bh; up += o.up;
-      }
-    };
-    double psi_g = 0.0, psi_m = 0.0, psi_m_raw = 0.0;
-    bool have_psi_m = false;
-    double t_origin_s = 0.0;  ///< t origin of the sums (the first sample)
-    YawSums win_yaw, stand_yaw;
-    bool win_yaw_ok = true;    ///< every sample of the window had a usable field
-    bool stand_yaw_ok = true;  ///< and every window of the stand
-    /// The stands with a magnetic slope, each weighted by the inverse variance of its slope,
-    /// T^3 / (rms residual of d about its line)^2 (mag_slope_weight in the source).
-    double mag_weight = 0.0;  ///< sum of the weights
-    double mag_sum = 0.0;     ///< sum of weight * slope (rad/s about that stand's up)
-    Eigen::Vector3d mag_up = Eigen::Vector3d::Zero();  ///< sum of weight * the stand's mean up
-    double vertical_bias = 0.0;  ///< the magnetic estimate about mag_up (valid if mag_weight > 0)
-    bool quiet = false;  ///< the last full window was quiet
-    bool have_bias = false;
-    double last_t_s = 0.0;
-    bool started = false;
-  };
-  explicit StandBiasLearner(Params p = {}) : params_(p) {}
-  /// One sample with the up direction (unit, phone frame) and the field (NaN: none).
-  void update(const ImuSample& s, const Eigen::Vector3d& up, const Eigen::Vector3d& mag_uT);
-  /// The bias: the gyro learner's, its component along the stands' vertical replaced by the
-  /// magnetic estimate once a stand gave one.
-  [[nodiscard]] const Eigen::Vector3d& bias_rad_s() const { return state_.bias; }
-  /// The magnetic estimate of the bias about the vertical (rad/s) and whether there is one.
-  [[nodiscard]] bool has_mag_vertical_bias() const { return state_.mag_weight > 0.0; }
-  [[nodiscard]] double mag_vertical_bias_rad_s() const { return state_.vertical_bias; }
-  [[nodiscard]] bool quiet() const { return state_.quiet; }
-  [[nodiscard]] const State& state() const { return state_; }
-
- private:
-  void close_stand();
-  void clear_window();
-  void update_estimate();
-  /// The stand's magnetic slope into the sums (if it qualifies).
-  void close_mag_stand();
-  Params params_;
-  State state_;
-};
-
-// ---------------------------------------------------------------------------------------------
-/// Steps from the vertical specific force (f . up - its 2 s mean, smoothed over 0.2 s): one step
-/// per peak followed by a valley, the peak-to-valley swing at least `min_swing_m_s2`. Such peaks
-/// also come from handling the phone and from a hand moving while the walker stands, so a peak
-/// is only a candidate: the detector says "walking" once `confirm_steps` candidates in a row have
-/// a walking cadence (intervals in [min_interval_s, max_interval_s], each within
-/// `max_interval_ratio` of the one before: gait is regular, handling is not) with the phone's tilt
-/// steady over them (up moved less than `max_tilt_deg` from their mean, the rate rms below
-/// `max_gyro_rms_rad_s`: a phone held in front while walking; handling turns it). Then the held
-/// candidates become steps, and every further candidate with a walking interval. A gap longer
-/// than `pause_intervals` step intervals (or max_interval_s) ends the walk: a pause.
-struct WalkStepParams {
-  double smooth_s = 0.2;       ///< moving mean: a step's vertical bounce is 1.5-2.5 Hz
-  double mean_s = 2.0;         ///< the specific force's mean over this is taken out (g, scale)
-  double min_swing_m_s2 = 1.0; ///< a hand-held phone's vertical swing per step: 1.5-6 m/s^2
-  double min_interval_s = 0.3; ///< 3.3 steps/s: faster than any walk
-  double max_interval_s = 1.2; ///< 50 steps/min: slower is not a walk
-  double max_interval_ratio = 1.5;
-  int confirm_steps = 4;       ///< two strides
-  double max_tilt_deg = 20.0;
-  double max_gyro_rms_rad_s = 1.5;
-  double pause_intervals = 2.5;
-};
-class WalkStepDetector {
- public:
-  using Params = WalkStepParams;
-  static constexpr int kMaxHeld = 16;
-  struct Candidate {
-    double t_s = 0.0;
-    double interval_s = 0.0;  ///< since the previous candidate (0: first of a run)
-    Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
-    double gyro_ms = 0.0;  ///< mean squared rate since the previous candidate
-  };
-  struct State {
-    // Moving sums (ring of the last mean_s of vertical force).
-    static constexpr std::size_t kRing = 256;
-    std::array<double, kRing> ring_t{}, ring_v{};
-    std::size_t head = 0, size = 0;
-    double sum_v = 0.0;
-    std::array<double, 32> sm_v{};  ///< last smoothing window of centred values
-    std::array<double, 32> sm_t{};
-    std::size_t sm_head = 0, sm_size = 0;
-    double sm_sum = 0.0;
-    double prev_s = 0.0, prev2_s = 0.0, prev_t_s = 0.0;  ///< smoothed signal, two samples
-    int have_prev = 0;
-    // Peak-valley.
-    bool have_peak = false;
-    double peak_t_s = 0.0, peak_v = 0.0;
-    Eigen::Vector3d peak_up = Eigen::Vector3d::UnitZ();
-    double min_since_peak = 0.0;
-    // Rate since the last candidate.
-    double w2_sum = 0.0;
-    int w2_n = 0;
-    // Candidates of a run not yet confirmed.
-    std::array<Candidate, kMaxHeld> held{};
-    int held_n = 0;
-    bool walking = false;
-    double last_cand_t_s = -1e9;
-    double interval_s = 0.0;  ///< the walk's current step interval (0: none yet)
-  };
-  explicit WalkStepDetector(Params p = {}) : params_(p) {}
-  /// Feeds one sample with the up direction (unit, phone frame). Returns how many steps became
-  /// known at this sample; their times are steps()[0..n).
-  int update(const ImuSample& s, const Eigen::Vector3d& up);
-  [[nodiscard]] const std::array<Candidate, kMaxHeld>& steps() const { return out_; }
-  [[nodiscard]] bool walking() const { return state_.walking; }
-  [[nodiscard]] double interval_s() const { return state_.interval_s; }
-  [[nodiscard]] const State& state() const { return state_; }
-
- private:
-  int on_candidate(const Candidate& c);
-  bool run_is_walk() const;
-  Params params_;
-  State state_;
-  std::array<Candidate, kMaxHeld> out_{};
-};
-
-// ---------------------------------------------------------------------------------------------
-/// The phone's yaw about the vertical: d(yaw)/dt = (w - bias) . up (counter-clockwise seen from
-/// above), heading = start - yaw. A short history lets a step confirmed late take the heading
-/// it had when it was walked. Beside the yaw it integrates what relay_track needs to lay the
-/// walk again with another bias: the yaw the bias in use took off, integral of bias . up dt,
-/// and the integral of up dt (the yaw any constant bias b takes off is b . that integral).
-class WalkingHeading {
- public:
-  static constexpr std::size_t kHistory = 1024;  ///< samples: 20 s at 50 Hz
-  /// `gyro_unbiased` = the gyro minus `bias`.
-  void update(double t_s, const Eigen::Vector3d& gyro_unbiased, const Eigen::Vector3d& bias,
-              const Eigen::Vector3d& up);
-  /// Heading (clockwise from north, rad) now.
-  [[nodiscard]] double heading_rad() const { return offset_rad_ - yaw_rad_; }
-  /// The heading and the two integrals at an earlier time within the history (the last sample
-  /// at or before it; the oldest kept if it is older).
-  struct At {
-    double heading_rad = 0.0;
-    double bias_yaw_rad = 0.0;
-    Eigen::Vector3d up_s = Eigen::Vector3d::Zero();
-  };
-  [[nodiscard]] At at(double t_s) const;
-  /// The yaw integrated so far (counter-clockwise, rad) and the offset heading = offset - yaw.
-  [[nodiscard]] double yaw_rad() const { return yaw_rad_; }
-  void set_offset(double offset_rad) { offset_rad_ = offset_rad; }
-
- private:
-  double yaw_rad_ = 0.0, offset_rad_ = 0.0, last_t_s_ = 0.0;
-  double bias_yaw_rad_ = 0.0;
-  Eigen::Vector3d up_s_ = Eigen::Vector3d::Zero();
-  bool started_ = false;
-  std::array<double, kHistory> hist_yaw_{};
-  std::array<double, kHistory> hist_bias_yaw_{};
-  std::array<Eigen::Vector3d, kHistory> hist_up_s_{};
-  std::array<double, kHistory> hist_t_{};
-  std::size_t hist_head_ = 0, hist_size_ = 0;
-};
-
-// ---------------------------------------------------------------------------------------------
-/// Step length from height and cadence, by the walk ratio. People choose, at every walking
-/// speed from a stroll to a brisk walk, nearly the same ratio of step length to cadence (the
-/// "walk ratio": the combination of the two that costs least energy per metre); a faster walk
-/// lengthens the step and quickens the cadence in proportion. The ratio scales with body size.
-/// Anchored on the population norm at the preferred speed, a step of 0.415 x height at
-/// 112 steps/min: ratio / height = 0.415 / 112 = 0.0037 per (step/min), so
-///   L = 0.0037 x height x 60 f = 0.222 x height x f     (L, height in m; f in steps/s).
-/// At 1.75 m: 0.65 m at 100 steps/min, 0.58 m at 90. This replaces seed 003's linear
-/// L = a h + b f + c for the hand-held phone: its coefficients were fitted to our own gait
-/// simulator, whose walkers take a 0.67-0.72 m step at 95-100 steps/min, longer than people do.
-/// Below about 98 steps/min the ratio is known to grow (slow walkers shorten the step less than
-/// the cadence); that is not modelled, so a slow walker's distance comes out a little short.
-struct WalkRatioParams {
-  double ratio_per_height_min = 0.0037;  ///< walk ratio / height, m per (step/min) per m
-};
-[[nodiscard]] inline double walk_ratio_step_length_m(double height_m, double step_hz,
-                                                     const WalkRatioParams& p = {}) {
-  return p.ratio_per_height_min * height_m * 60.0 * step_hz;
-}
 
 struct HandheldPdrParams {
   double height_m = 1.75;

@@ -1,0 +1,94 @@
+#pragma once
+/// \file
+/// Hand-held phone PDR stage (HandheldPdr, handheld_pdr.hpp): steps from the vertical specific
+/// force, counted only once the motion is a walk (a regular cadence with the phone's tilt
+/// steady), so handling the phone, standing and pausing make no steps and no distance. Owns its
+/// moving sums, the peak-valley search and the candidates of a run not yet confirmed.
+///
+/// Memory: fixed-size arrays, no heap.
+
+#include <Eigen/Core>
+#include <array>
+#include <cstddef>
+
+#include "telltale/fusion/imu_sample.hpp"
+
+namespace telltale::fusion {
+
+/// Steps from the vertical specific force (f . up - its 2 s mean, smoothed over 0.2 s): one step
+/// per peak followed by a valley, the peak-to-valley swing at least `min_swing_m_s2`. Such peaks
+/// also come from handling the phone and from a hand moving while the walker stands, so a peak
+/// is only a candidate: the detector says "walking" once `confirm_steps` candidates in a row have
+/// a walking cadence (intervals in [min_interval_s, max_interval_s], each within
+/// `max_interval_ratio` of the one before: gait is regular, handling is not) with the phone's tilt
+/// steady over them (up moved less than `max_tilt_deg` from their mean, the rate rms below
+/// `max_gyro_rms_rad_s`: a phone held in front while walking; handling turns it). Then the held
+/// candidates become steps, and every further candidate with a walking interval. A gap longer
+/// than `pause_intervals` step intervals (or max_interval_s) ends the walk: a pause.
+struct WalkStepParams {
+  double smooth_s = 0.2;        ///< moving mean: a step's vertical bounce is 1.5-2.5 Hz
+  double mean_s = 2.0;          ///< the specific force's mean over this is taken out (g, scale)
+  double min_swing_m_s2 = 1.0;  ///< a hand-held phone's vertical swing per step: 1.5-6 m/s^2
+  double min_interval_s = 0.3;  ///< 3.3 steps/s: faster than any walk
+  double max_interval_s = 1.2;  ///< 50 steps/min: slower is not a walk
+  double max_interval_ratio = 1.5;
+  int confirm_steps = 4;  ///< two strides
+  double max_tilt_deg = 20.0;
+  double max_gyro_rms_rad_s = 1.5;
+  double pause_intervals = 2.5;
+};
+class WalkStepDetector {
+ public:
+  using Params = WalkStepParams;
+  static constexpr int kMaxHeld = 16;
+  struct Candidate {
+    double t_s = 0.0;
+    double interval_s = 0.0;  ///< since the previous candidate (0: first of a run)
+    Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+    double gyro_ms = 0.0;  ///< mean squared rate since the previous candidate
+  };
+  struct State {
+    // Moving sums (ring of the last mean_s of vertical force).
+    static constexpr std::size_t kRing = 256;
+    std::array<double, kRing> ring_t{}, ring_v{};
+    std::size_t head = 0, size = 0;
+    double sum_v = 0.0;
+    std::array<double, 32> sm_v{};  ///< last smoothing window of centred values
+    std::array<double, 32> sm_t{};
+    std::size_t sm_head = 0, sm_size = 0;
+    double sm_sum = 0.0;
+    double prev_s = 0.0, prev2_s = 0.0, prev_t_s = 0.0;  ///< smoothed signal, two samples
+    int have_prev = 0;
+    // Peak-valley.
+    bool have_peak = false;
+    double peak_t_s = 0.0, peak_v = 0.0;
+    Eigen::Vector3d peak_up = Eigen::Vector3d::UnitZ();
+    double min_since_peak = 0.0;
+    // Rate since the last candidate.
+    double w2_sum = 0.0;
+    int w2_n = 0;
+    // Candidates of a run not yet confirmed.
+    std::array<Candidate, kMaxHeld> held{};
+    int held_n = 0;
+    bool walking = false;
+    double last_cand_t_s = -1e9;
+    double interval_s = 0.0;  ///< the walk's current step interval (0: none yet)
+  };
+  explicit WalkStepDetector(Params p = {}) : params_(p) {}
+  /// Feeds one sample with the up direction (unit, phone frame). Returns how many steps became
+  /// known at this sample; their times are steps()[0..n).
+  int update(const ImuSample& s, const Eigen::Vector3d& up);
+  [[nodiscard]] const std::array<Candidate, kMaxHeld>& steps() const { return out_; }
+  [[nodiscard]] bool walking() const { return state_.walking; }
+  [[nodiscard]] double interval_s() const { return state_.interval_s; }
+  [[nodiscard]] const State& state() const { return state_; }
+
+ private:
+  int on_candidate(const Candidate& c);
+  bool run_is_walk() const;
+  Params params_;
+  State state_;
+  std::array<Candidate, kMaxHeld> out_{};
+};
+
+}  // namespace telltale::fusion
