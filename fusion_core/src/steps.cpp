@@ -340,7 +340,7 @@ bool SwingStepDetector::swinging(double t_s) const {
 bool PeakValleyStepDetector::keeps_rhythm(double t_s) const {
   const auto k = static_cast<std::size_t>(std::clamp(params_.rhythm_steps, 1, 7));
   if (n_step_times_ < k + 1) return false;
-  const auto at = [&](std::size_t back) {  // back = 0: the last counted step
+  const auto at = [&](std::size_t back) {  // back = 0: the last confirmed step
     return step_times_[(n_step_times_ - 1 - back) % kRhythmCapacity];
   };
   const double mean = (at(0) - at(k)) / static_cast<double>(k);

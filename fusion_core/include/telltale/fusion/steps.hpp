@@ -242,17 +242,17 @@ struct PeakValleyStepParams {
   double min_swing_m_s2 = 0.6;         ///< smallest peak-to-valley swing that is a step, m/s^2
   double valley_rise_fraction = 0.25;  ///< a valley is confirmed once |f| rises by this x swing
   /// A step is not counted when the sensor's mean orientation turned by more than this in a
-  /// second (TiltWindow): the phone is being handled, not carried. Judged when the step is
-  /// confirmed (the last second against the one before) and again a second later (the second
-  /// after the step against the one before it, which sees a handling's first second): each step
-  /// is reported a second after it is confirmed, with its own time, and flush() releases the
-  /// last ones when the stream ends. Walking with a phone
-  /// in the hand, a pocket, a bag, an armband or a swinging hand tilts that mean by 1-5 deg in the
+  /// second (TiltWindow): the phone is being handled, not carried. Walking with a phone in the
+  /// hand, a pocket, a bag, an armband or a swinging hand tilts that mean by 1-5 deg in the
   /// median second (Oxford traces: 90 % of steps under 12, 98 % under 32, the highest a bag's);
-  /// handling it turns it by 40-130. A step that keeps a steady walk's rhythm counts however the
-  /// phone tilts (a walker moving it from the hand to a pocket walks on): its interval and the
-  /// last `rhythm_steps` intervals each within `rhythm_tolerance` of their mean (a steady pace
-  /// varies by under 10 %; a pocket's left and right steps differ by more). 0 turns it off.
+  /// handling it turns it by 40-130. Judged when the step is confirmed (the last second against
+  /// the one before) and again a second later (the second after the step against the one before
+  /// it, which sees a handling's first second): each step is reported a second after it is
+  /// confirmed, with its own time, and flush() releases the last ones when the stream ends. A
+  /// step that keeps a steady walk's rhythm counts however the phone tilts (a walker moving it
+  /// from the hand to a pocket walks on): its interval and the last `rhythm_steps` intervals
+  /// each within `rhythm_tolerance` of their mean (a steady pace varies by under 10 %; a
+  /// pocket's left and right steps differ by more). 0 turns the rule off (no step held).
   double max_tilt_deg = 30.0;
   int rhythm_steps = 4;
   double rhythm_tolerance = 0.3;
