@@ -498,8 +498,10 @@ void ipin_table(const EvalOptions& o) {
     {
       auto counter = fusion::make_step_detector("peak-valley", fusion::StepMount::kBody);
       fusion::StepEvent ev;
-      for (const auto& r : records)
-        if (r.imu.t_s < handled_until_s && counter->update(r.imu, ev)) ++counter_before;
+      for (const auto& r : records) {  // in time order: read_imu_csv refuses time going back
+        if (r.imu.t_s >= handled_until_s) break;
+        if (counter->update(r.imu, ev)) ++counter_before;
+      }
       while (counter->flush(ev)) ++counter_before;
     }
     pdr_handled += pdr_before;

@@ -360,11 +360,12 @@ void PeakValleyStepDetector::reset() { *this = PeakValleyStepDetector(params_); 
 bool PeakValleyStepDetector::update(const ImuSample& s, StepEvent& event) {
   const double dt = gate(s, have_t_, last_t_s_, diag_);
   if (dt < 0.0) return false;
-  tilt_.add(s.t_s, s.acc_body_m_s2);
+  const bool rule = params_.max_tilt_deg > 0.0;
+  if (rule) tilt_.add(s.t_s, s.acc_body_m_s2);
   bool steady = false;
   StepEvent found;
   const bool step = detect(s, dt, found, steady);
-  if (!(params_.max_tilt_deg > 0.0)) {  // no handled-phone rule: every step at once
+  if (!rule) {  // no handled-phone rule: every step at once
     if (step) event = found;
     return step;
   }
@@ -373,14 +374,12 @@ bool PeakValleyStepDetector::update(const ImuSample& s, StepEvent& event) {
   // the two seconds before it, so a handling's first second passed). A step of a steady walk's
   // rhythm passes as it did there.
   if (step) {
-    if (n_held_ == kHeldCapacity) {  // cannot happen (steps >= min_interval_s apart); no loss
-      (void)release(event);
-      held_[(held_head_ + n_held_) % kHeldCapacity] = {found, steady};
-      ++n_held_;
-      return true;
-    }
+    // Full cannot happen (steps are >= min_interval_s apart); if it did, the oldest goes out
+    // unchecked rather than lost.
+    const bool reported = n_held_ == kHeldCapacity && release(event);
     held_[(held_head_ + n_held_) % kHeldCapacity] = {found, steady};
     ++n_held_;
+    if (reported) return true;
   }
   const double max_tilt_rad = params_.max_tilt_deg * (M_PI / 180.0);
   while (n_held_ > 0 && s.t_s - held_[held_head_].event.t_s >= kHold_s) {
@@ -465,22 +464,23 @@ bool PeakValleyStepDetector::detect(const ImuSample& s, double dt, StepEvent& ev
     }
     return false;
   }
-  steady = keeps_rhythm(s.t_s);
-  if (params_.max_tilt_deg > 0.0 && tilt_.angle_rad() > params_.max_tilt_deg * (M_PI / 180.0) &&
-      !steady) {
-    // The phone is being handled: its swing is the hand's, not a step's. Not a step, and
-    // nothing learnt from it.
-    ++diag_.rejected_handling;
-    phase_ = Phase::kSeekPeak;
-    return false;
+  if (params_.max_tilt_deg > 0.0) {  // the handled-phone rule (its state kept only with it)
+    steady = keeps_rhythm(s.t_s);
+    if (!steady && tilt_.angle_rad() > params_.max_tilt_deg * (M_PI / 180.0)) {
+      // The phone is being handled: its swing is the hand's, not a step's. Not a step, and
+      // nothing learnt from it.
+      ++diag_.rejected_handling;
+      phase_ = Phase::kSeekPeak;
+      return false;
+    }
+    step_times_[n_step_times_ % kRhythmCapacity] = s.t_s;
+    ++n_step_times_;
   }
   const double since = cand_peak_t_s_ - last_peak_t_s_;
   if (have_prev_ && since > 0.0 && since < params_.max_interval_s)
     interval_ema_s_ += 0.3 * (since - interval_ema_s_);
   event.t_s = s.t_s;
   event.interval_s = have_prev_ ? s.t_s - last_step_t_s_ : 0.0;
-  step_times_[n_step_times_ % kRhythmCapacity] = s.t_s;
-  ++n_step_times_;
   prev_peak_ = cand_peak_;
   prev_valley_ = valley_;
   have_prev_ = true;

@@ -58,7 +58,6 @@ class FootPdr {
   struct Diagnostics : ImuGateCounts {
     unsigned still_windows = 0;  ///< still windows that set the gyro bias
   };
-  /// `lengths` defaults to the built-in model (pdr.hpp); it is copied.
   explicit FootPdr(Params params = {});
   FootPdr(Params params, const StepLengthModel& lengths);
   /// Feeds one sample; `mag_uT` may be NaN. Returns the state after it (also `output()`); its
