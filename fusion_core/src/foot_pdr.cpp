@@ -20,7 +20,7 @@ FootPdr::FootPdr(Params params, const StepLengthModel& lengths)
     : params_(params),
       step_length_(params.step_length, lengths),
       steps_(params.steps),
-      cadence_(StepGapParams{.min_interval_s = params.min_step_interval_s}),
+      cadence_(params.min_step_interval_s),
       heading_(params.heading),
       mag_cal_(params.hard_iron),
       gyro_bias_(params.gyro_bias),
@@ -28,7 +28,7 @@ FootPdr::FootPdr(Params params, const StepLengthModel& lengths)
 
 void FootPdr::on_stride(double t_s) {
   track_.begin_step();
-  cadence_.learn_cadence(t_s, kStepsPerStride);
+  cadence_.at_step(t_s, kStepsPerStride, true);
   out_.steps += static_cast<std::size_t>(kStepsPerStride);
   if (cadence_.interval_s() > 0.0) {
     out_.step_hz = 1.0 / cadence_.interval_s();

@@ -103,11 +103,10 @@ const StepLengthModel& builtin_step_length_model() { return builtin().len; }
 Pdr::Pdr(Params params, const PoseNetwork& net, const StepLengthModel& lengths)
     : params_(params),
       step_length_(params.step_length, lengths),
-      phone_steps_(params.phone_steps),
+      clock_(params.step_clock),
       pose_(params.pose, net),
       recent_(StandLimits{params.stand_still_s, params.stand_gyro_rad_s,
                           params.gyro_bias.acc_std_m_s2}),
-      gaps_(params.gaps),
       heading_(params.heading),
       walking_(params.walking_direction),
       mag_cal_(params.hard_iron),
@@ -118,18 +117,16 @@ Pdr::Pdr(Params params, const PoseNetwork& net, const StepLengthModel& lengths)
 
 const StepDiagnostics& Pdr::step_diagnostics() const { return phone_steps_.diagnostics(); }
 
-int Pdr::count_steps(double t_s, const StepSource& source) {
-  int missed = gaps_.at_step(t_s, source, pose_.window().features().acc_energy, recent_);
-  missed += source.backfill;  // the start of a swinging walk (PhoneSteps)
-  diag_.filled_steps += static_cast<unsigned>(missed);
-  out_.steps += static_cast<std::size_t>(missed) + 1;
-  if (gaps_.interval_s() > 0.0) {
-    out_.step_hz = 1.0 / gaps_.interval_s();
+void Pdr::count_steps(const ClockStep& step) {
+  diag_.filled_steps += static_cast<unsigned>(step.extra);
+  out_.steps += static_cast<std::size_t>(step.extra) + 1;
+  const double interval_s = clock_.cadence().interval_s();
+  if (interval_s > 0.0) {
+    out_.step_hz = 1.0 / interval_s;
     out_.cadence_spm = 60.0 * out_.step_hz;
   }
   const double f = out_.step_hz;
   out_.gait = f < 1.6 ? 0 : f < 1.95 ? 1 : f < 2.35 ? 2 : f < 2.75 ? 3 : 4;
-  return missed;
 }
 
 void Pdr::detect_switch(double t_prev, double t_s,
@@ -164,7 +161,7 @@ void Pdr::classify_pose(double t_s) {
     if (!r.isIdentity(1e-9)) {
       heading_.change_frame(r);  // new walking frame: heading again from the magnetometer
       sum_sin_ = sum_cos_ = 0.0;
-      gaps_.new_frame(t_s);
+      headings_.new_frame(t_s);
     }
     if (change->to != change->from) {
       if (!change->first) ++diag_.pose_changes;
@@ -185,17 +182,17 @@ double Pdr::walked_heading() {
   return wrap_2pi(heading - yaw_corr);
 }
 
-void Pdr::on_step(double t_s, StepSource source) {
+void Pdr::on_step(const ClockStep& step) {
+  const double t_s = step.t_s, t_prev = step.prev_t_s;
   track_.begin_step();
   const std::array<Eigen::Vector3d, 2> ups_before = switch_.ups();
-  const double t_prev = gaps_.last_step_t_s();
-  const int missed = count_steps(t_s, source);
+  count_steps(step);
   acc_bias_.at_step(t_s, mag_cal_.offset_uT());
   if (t_prev >= 0.0) detect_switch(t_prev, t_s, ups_before);
   switch_.end_step();
   classify_pose(t_s);
   const double walked_rad = walked_heading();
-  lay_step(t_s, t_prev, missed, walked_rad, ups_before);
+  lay_step(t_s, t_prev, step.extra, walked_rad, ups_before);
 }
 
 void Pdr::lay_step(double t_s, double t_prev, int missed, double walked_rad,
@@ -222,7 +219,7 @@ void Pdr::lay_step(double t_s, double t_prev, int missed, double walked_rad,
   if (missed > 0 && !replaced) {
     // The steps a gap held are laid along the heading the gap had part by part (a corner walked
     // while the detector was blind is a corner, not a diagonal): one displacement, the chord.
-    const Eigen::Vector2d turn = gaps_.gap_turn(t_prev, t_s, 1 + missed);
+    const Eigen::Vector2d turn = headings_.gap_turn(t_prev, t_s, 1 + missed);
     heading = wrap_2pi(heading + std::atan2(turn.y(), turn.x()));
     len *= turn.norm();
   }
@@ -337,21 +334,24 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
     const Eigen::Vector2d unit(std::cos(heading_.heading_rad()), std::sin(heading_.heading_rad()));
     sum_sin_ += unit.y();
     sum_cos_ += unit.x();
-    gaps_.add_heading(s.t_s, unit);
+    headings_.add(s.t_s, unit);
     switch_.add_up(m.transpose() * heading_.state().up);
     if (!out_.step)
       out_.heading_deg = switch_.switching() && switch_.stand_in_rad()
                              ? *switch_.stand_in_rad() * 180.0 / M_PI
                              : heading_.heading_rad() * 180.0 / M_PI;
   }
-  StepEvent ev;
-  StepSource source;
-  if (phone_steps_.update(s, m.transpose() * heading_.state().up, gaps_.last_step_t_s(),
-                          gaps_.interval_s(), recent_, ev, source)) {
-    on_step(ev.t_s, source);
-    out_.x_m = track_.x_m();
-    out_.y_m = track_.y_m();
-    out_.step = true;
+  // The detectors' events, and the steps the clock reads in them (the pose window's energy
+  // tells a gap walked from a stop).
+  const PhoneEvents events = phone_steps_.update(s, m.transpose() * heading_.state().up);
+  if (events.any()) {
+    const auto step = clock_.at_events(events, recent_, pose_.window().features().acc_energy);
+    if (step) {
+      on_step(*step);
+      out_.x_m = track_.x_m();
+      out_.y_m = track_.y_m();
+      out_.step = true;
+    }
   }
   out_.pose = pose_.pose();
   out_.switching = switch_.switching();

@@ -38,8 +38,8 @@
 ///
 /// Structure: Pdr orders the work of a sample and of a step; each stage it calls owns its state
 /// and its Params (a member of PdrParams), one file pair each in pdr/ (docs/pdr.md lists them):
-/// phone_steps, recent_samples, step_gaps, pose_classifier, pose_switch, step_length,
-/// walking_heading, bias_learners, track.
+/// phone_steps, step_clock, recent_samples, recent_headings, pose_classifier, pose_switch,
+/// step_length, walking_heading, bias_learners, track.
 ///
 /// Memory: fixed-size buffers and Eigen fixed-size types, no heap in update().
 
@@ -57,8 +57,9 @@
 #include "telltale/fusion/pdr/phone_steps.hpp"
 #include "telltale/fusion/pdr/pose_classifier.hpp"
 #include "telltale/fusion/pdr/pose_switch.hpp"
+#include "telltale/fusion/pdr/recent_headings.hpp"
 #include "telltale/fusion/pdr/recent_samples.hpp"
-#include "telltale/fusion/pdr/step_gaps.hpp"
+#include "telltale/fusion/pdr/step_clock.hpp"
 #include "telltale/fusion/pdr/step_length.hpp"
 #include "telltale/fusion/pdr/track.hpp"
 #include "telltale/fusion/pdr/walking_heading.hpp"
@@ -80,14 +81,13 @@ namespace telltale::fusion {
 struct PdrParams {
   /// A stand: the phone still (|f| within gyro_bias.acc_std_m_s2, rotating at less than
   /// stand_gyro_rad_s rms) for stand_still_s. A gap that held one has no missed steps
-  /// (StepGaps), and a walk after one must confirm its start (PhoneSteps).
+  /// and a walk after one must confirm its start (StepClock).
   /// A walker who stops and then moves the phone (puts it away, lifts it to the ear) makes
   /// events after a gap that held no steps (2-3 steps too many on 10 of 400 loops). 0: off.
   double stand_still_s = 0.6;
   /// A stand's rotation rate, rms: a still hand (0.05 rad/s), not a swinging arm (1-3 rad/s).
   double stand_gyro_rad_s = 0.2;
-  StepGapParams gaps;
-  PhoneStepParams phone_steps;
+  StepClockParams step_clock;
   GyroBiasParams gyro_bias;
   AccBiasParams acc_bias;
   PoseClassifierParams pose;
@@ -129,10 +129,9 @@ class Pdr {
   /// `output().step_hz` at every step in the caller.
 
  private:
-  void on_step(double t_s, StepSource source);
-  /// Counts the step (and the steps a gap held, the cadence learnt from it); returns how many
-  /// more than one this event stands for.
-  int count_steps(double t_s, const StepSource& source);
+  void on_step(const ClockStep& step);
+  /// Counts the step and the ones the clock counted with it; the cadence it learnt.
+  void count_steps(const ClockStep& step);
   /// Compares the step [t_prev, t_s]'s waveform with the same foot's last: a pose switch
   /// begins (its steps gathered; `ups_before` each foot's up before this step) or settles.
   void detect_switch(double t_prev, double t_s, const std::array<Eigen::Vector3d, 2>& ups_before);
@@ -161,9 +160,10 @@ class Pdr {
   Params params_;
   StepLength step_length_;
   PhoneSteps phone_steps_;
+  StepClock clock_;
   PoseClassifier pose_;
   RecentSamples recent_;
-  StepGaps gaps_;
+  RecentHeadings headings_;  ///< the heading a gap's steps are laid along
   HeadingFilter heading_;
   WalkingDirection walking_;
   HardIronCalibrator mag_cal_;
