@@ -277,11 +277,13 @@ void ipol_table(const EvalOptions& o, bool foot) {
         std::size_t n = 0;
         std::vector<double> found;
         fusion::StepEvent ev;
-        for (const auto& r : records) {
-          if (!d->update(r.imu, ev)) continue;
+        const auto add = [&] {
           found.push_back(ev.t_s);
           n += outside(ev.t_s) ? 1u : 0u;
-        }
+        };
+        for (const auto& r : records)
+          if (d->update(r.imu, ev)) add();
+        while (d->flush(ev)) add();
         const double a = count_accuracy(n, truth_out), b = count_accuracy(n, hs.size());
         sum_readme[m] += a;
         sum_all[m] += b;

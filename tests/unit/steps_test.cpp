@@ -448,10 +448,16 @@ std::vector<ImuSample> foot_walk(double rate_hz, int normal) {
 }
 
 /// A lower-back IMU: standing, then `normal` steps at 1.8 Hz whose vertical acceleration swings
-/// +-1.5 m/s^2 between a first and a last step of +-0.5 m/s^2 (starting and stopping), standing.
-std::vector<ImuSample> trunk_walk(double rate_hz, int normal) {
+/// +-1.5 m/s^2 between a first step of +-`first` m/s^2 (starting: the IPOL lower-back trials'
+/// first heel strikes load the trunk 0.47-1.1 times the walk's) and a last step of +-0.5 m/s^2
+/// (stopping), standing. With `push`, the step is preceded by the first toe-off's push of gait
+/// initiation, +-`push` m/s^2 (0.07-0.39 of the walk's there). The raw signal's peaks (the
+/// loading after each heel strike) are at t0 + (i + 0.5) / 1.8 s, i = 0 .. normal + 1.
+constexpr double kTrunkT0 = 2.0, kTrunkHz = 1.8;
+std::vector<ImuSample> trunk_walk(double rate_hz, int normal, double first = 0.8,
+                                  double push = 0.0) {
   const int steps = normal + 2;
-  const double f_hz = 1.8, t0 = 2.0, t1 = t0 + steps / f_hz;
+  const double f_hz = kTrunkHz, t0 = kTrunkT0, t1 = t0 + steps / f_hz;
   std::vector<ImuSample> out;
   for (int n = 0; n * (1.0 / rate_hz) < t1 + 2.0; ++n) {
     const double ts = n / rate_hz;
@@ -460,8 +466,10 @@ std::vector<ImuSample> trunk_walk(double rate_hz, int normal) {
     double a = 0.03 * std::sin(31.0 * ts);
     if (ts >= t0 && ts < t1) {
       const int i = static_cast<int>((ts - t0) * f_hz);
-      const double amp = (i == 0 || i == steps - 1) ? 0.5 : 1.5;
+      const double amp = i == 0 ? first : i == steps - 1 ? 0.5 : 1.5;
       a += -amp * std::cos(2.0 * M_PI * f_hz * (ts - t0));
+    } else if (ts >= t0 - 1.0 / f_hz && ts < t0) {
+      a += -push * std::cos(2.0 * M_PI * f_hz * (ts - t0));
     }
     ImuSample s{ts, Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()),
                 (kG + a) * up + Eigen::Vector3d(0.0, 0.2 * a, 0.0)};
@@ -490,6 +498,52 @@ TEST(GaitPhaseStepDetector, TrunkCountsTheFirstAndLastStepOfAWalk) {
   for (double rate : {50.0, 100.0, 200.0}) {
     auto d = make_step_detector("gait-phase", StepMount::kBody);
     EXPECT_EQ(count_samples(*d, trunk_walk(rate, 10)), 12u) << rate << " Hz";
+  }
+}
+
+// Given a walk from standing that begins with the push of its first toe-off (the trunk lifted
+// by a third of the walk's loading), when gait-phase counts a lower-back sensor's steps, then
+// the push is no step: the walk's first step is held until the next three show what a step's
+// loading is, and the push reaches less than 0.4 of it. Without the rule (first_step_fraction
+// 0) the push counts. A walk of two steps keeps both (one to compare with, of the same size),
+// and a stream ending while the first step is judged loses nothing (flush).
+TEST(GaitPhaseStepDetector, TrunkDoesNotCountTheGaitInitiationPush) {
+  for (double rate : {50.0, 100.0, 200.0}) {
+    GaitPhaseStepParams p;
+    p.mount = StepMount::kBody;
+    GaitPhaseStepDetector d(p);
+    EXPECT_EQ(count_samples(d, trunk_walk(rate, 10, 0.8, 0.5)), 12u) << rate << " Hz";
+    EXPECT_EQ(d.diagnostics().rejected_amplitude, 1u) << rate << " Hz";
+    p.first_step_fraction = 0.0;
+    GaitPhaseStepDetector off(p);
+    EXPECT_EQ(count_samples(off, trunk_walk(rate, 10, 0.8, 0.5)), 13u) << rate << " Hz";
+    EXPECT_EQ(count_samples(d, trunk_walk(rate, 0, 1.5)), 2u) << rate << " Hz";
+    // A stream that ends 0.3 s after a walk's third step: the first is still being judged, and
+    // flush() judges it and releases all three.
+    auto cut = trunk_walk(rate, 1, 1.5);
+    std::erase_if(cut, [](const ImuSample& s) { return s.t_s > kTrunkT0 + 2.5 / kTrunkHz + 0.3; });
+    EXPECT_EQ(count_samples(d, cut), 3u) << rate << " Hz";
+  }
+}
+
+// Given a trunk whose loading peaks are known, when gait-phase reports a lower-back sensor's
+// steps, then each is reported at its raw peak (the heel strike's loading): the 3 Hz low-pass's
+// delay at the step frequency (0.09 s) taken off, within one sample interval and 0.01 s (a peak
+// is found at a sample). In order, every step out once flush() has released the last held ones.
+TEST(GaitPhaseStepDetector, TrunkReportsTheStepAtTheRawPeak) {
+  for (double rate : {50.0, 100.0, 200.0}) {
+    auto d = make_step_detector("gait-phase", StepMount::kBody);
+    const auto samples = trunk_walk(rate, 10, 1.5);
+    std::vector<double> times;
+    StepEvent ev;
+    for (const auto& s : samples)
+      if (d->update(s, ev)) times.push_back(ev.t_s);
+    while (d->flush(ev)) times.push_back(ev.t_s);
+    ASSERT_EQ(times.size(), 12u) << rate << " Hz";
+    for (std::size_t i = 0; i < times.size(); ++i) {
+      const double peak = kTrunkT0 + (static_cast<double>(i) + 0.5) / kTrunkHz;
+      EXPECT_NEAR(times[i], peak, 0.01 + 1.0 / rate) << rate << " Hz, step " << i;
+    }
   }
 }
 
