@@ -16,7 +16,7 @@
 /// bias read a trunk's or a hand's motion, which a foot does not make.
 ///
 /// Structure: FootPdr orders the work of a sample and of a stride; the stages it calls are the
-/// phone's (pdr/: step_clock's Cadence, step_length, walking_heading's HeadingFilter,
+/// phone's (pdr/: cadence, step_length, walking_heading's HeadingFilter,
 /// bias_learners' GyroBiasLearner, track), each with its Params a member of FootPdrParams.
 /// Frames and units as Pdr: position x east, y north (m) from the start; heading clockwise from
 /// north.
@@ -28,7 +28,7 @@
 #include "telltale/fusion/hard_iron.hpp"
 #include "telltale/fusion/imu_sample.hpp"
 #include "telltale/fusion/pdr/bias_learners.hpp"
-#include "telltale/fusion/pdr/step_clock.hpp"
+#include "telltale/fusion/pdr/cadence.hpp"
 #include "telltale/fusion/pdr/step_length.hpp"
 #include "telltale/fusion/pdr/track.hpp"
 #include "telltale/fusion/pdr/walking_heading.hpp"
@@ -39,8 +39,8 @@ namespace telltale::fusion {
 
 struct FootPdrParams {
   AdaptiveStepParams steps;  ///< the stride detector (its defaults are the foot's)
-  /// Shorter step intervals are no cadence (StepClockParams::min_interval_s).
-  double min_step_interval_s = StepClockParams{}.min_interval_s;
+  /// Shorter step intervals are no cadence (Cadence::kMinIntervalS).
+  double min_step_interval_s = Cadence::kMinIntervalS;
   GyroBiasParams gyro_bias;
   /// Height and personal factor; the model's hand-held row and its `scale` are the foot's (it
   /// has no pose): the seed's line, fitted to our gait simulator.

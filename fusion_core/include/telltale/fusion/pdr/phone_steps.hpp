@@ -8,10 +8,22 @@
 /// Memory: the detectors' fixed-size buffers, no heap.
 
 #include "telltale/fusion/imu_sample.hpp"
-#include "telltale/fusion/pdr/step_clock.hpp"
 #include "telltale/fusion/steps.hpp"
 
 namespace telltale::fusion {
+
+/// What the phone's two detectors saw at one sample (PhoneSteps::update).
+struct PhoneEvents {
+  double t_s = 0.0;       ///< the sample's time
+  bool by_acc = false;    ///< the acceleration's peak and valley closed a step
+  bool by_swing = false;  ///< the arm turned
+  /// The phone swings (gyro present): the arm's turns speak for the steps, else the
+  /// acceleration does.
+  bool swing = false;
+  double swing_step_t_s = 0.0;  ///< the arm's last turn's step time
+  double half_swing_s = 0.0;    ///< the arm's recent half swing, s
+  [[nodiscard]] bool any() const { return by_acc || by_swing; }
+};
 
 class PhoneSteps {
  public:

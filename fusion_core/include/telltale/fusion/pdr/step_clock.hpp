@@ -10,44 +10,18 @@
 ///   - one and n before it: the held first event of a walk, now confirmed; the arm's turns of a
 ///     walk that began swinging before the swing was recognised; the steps in a gap of about
 ///     n + 1 intervals while the phone kept moving like a walk.
-/// The cadence it learns (Cadence: the median of the last measured intervals) is the clock's
-/// period. The foot pipeline (FootPdr) keeps a Cadence alone: its detector sees every stride.
+/// The cadence it learns (cadence.hpp: the median of the last measured intervals) is the
+/// clock's period.
 ///
 /// Memory: fixed-size arrays, no heap.
 
-#include <array>
-#include <cstddef>
 #include <optional>
 
+#include "telltale/fusion/pdr/cadence.hpp"
+#include "telltale/fusion/pdr/phone_steps.hpp"
 #include "telltale/fusion/pdr/recent_samples.hpp"
 
 namespace telltale::fusion {
-
-/// The step interval: the median of the last measured ones, and the last step's time.
-class Cadence {
- public:
-  /// Shorter intervals are no cadence (5 steps/s is a sprinter's).
-  explicit Cadence(double min_interval_s = 0.2) : min_interval_s_(min_interval_s) {}
-  /// A step event at t_s standing for `per_event` steps (a foot's stride: 2). With `learn`, the
-  /// interval since the last, per step, is a cadence measurement; either way t_s is the last
-  /// step's time from now on.
-  void at_step(double t_s, double per_event, bool learn);
-  /// The cadence is unknown again (the last step's time is kept).
-  void forget();
-  /// The step interval, s (0 until one is measured).
-  [[nodiscard]] double interval_s() const { return interval_s_; }
-  /// The last step's time (< 0: none yet).
-  [[nodiscard]] double last_step_t_s() const { return last_step_t_s_; }
-
- private:
-  void learn_interval(double interval_s);
-  double min_interval_s_;
-  double last_step_t_s_ = -1.0;
-  double interval_s_ = 0.0;
-  static constexpr std::size_t kIntervals = 5;
-  std::array<double, kIntervals> intervals_{};
-  std::size_t interval_count_ = 0;
-};
 
 struct StepClockParams {
   double walk_pause_s = 2.0;  ///< no event for this long: the next is a new walk
@@ -58,20 +32,7 @@ struct StepClockParams {
   double gap_max_s = 4.0;       ///< ...if shorter than this...
   double gap_min_energy = 0.5;  ///< ...and the phone's acceleration energy says walking
                                 ///< (and it held no stand)
-  double min_interval_s = 0.2;  ///< 5 steps/s, a sprinter's: shorter is no cadence
-};
-
-/// What the phone's two detectors saw at one sample (PhoneSteps::update).
-struct PhoneEvents {
-  double t_s = 0.0;       ///< the sample's time
-  bool by_acc = false;    ///< the acceleration's peak and valley closed a step
-  bool by_swing = false;  ///< the arm turned
-  /// The phone swings (gyro present): the arm's turns speak for the steps, else the
-  /// acceleration does.
-  bool swing = false;
-  double swing_step_t_s = 0.0;  ///< the arm's last turn's step time
-  double half_swing_s = 0.0;    ///< the arm's recent half swing, s
-  [[nodiscard]] bool any() const { return by_acc || by_swing; }
+  double min_interval_s = Cadence::kMinIntervalS;  ///< shorter is no cadence
 };
 
 /// A step the clock counts.
