@@ -707,13 +707,17 @@ void GaitPhaseStepDetector::hold_body_step(double t_s, double peak_m_s2, bool fi
 
 void GaitPhaseStepDetector::judge_first_body_step() {
   judging_first_ = false;
-  // The median peak of the steps after it (at most first_step_followers, all in the held ring).
+  // The median peak of the steps after it (at most first_step_followers, all in the held ring),
+  // sorted as they are inserted.
   std::array<double, kBodyHeld> peaks{};
-  const std::size_t n = body_size_ - 1;
-  for (std::size_t i = 0; i < n; ++i)
-    peaks[i] = body_held_[(body_head_ + 1 + i) % kBodyHeld].peak_m_s2;
+  std::size_t n = 0;
+  for (std::size_t i = 1; i < body_size_ && n < kBodyHeld; ++i) {
+    const double v = body_held_[(body_head_ + i) % kBodyHeld].peak_m_s2;
+    std::size_t j = n++;
+    for (; j > 0 && peaks[j - 1] > v; --j) peaks[j] = peaks[j - 1];
+    peaks[j] = v;
+  }
   if (n == 0) return;  // a lone step: nothing to compare it with
-  std::sort(peaks.begin(), peaks.begin() + static_cast<std::ptrdiff_t>(n));
   const double median = n % 2 ? peaks[n / 2] : 0.5 * (peaks[n / 2 - 1] + peaks[n / 2]);
   if (body_held_[body_head_].peak_m_s2 < params_.first_step_fraction * median) {
     ++diag_.rejected_amplitude;
