@@ -1,5 +1,6 @@
 // fusion_cli steps: IMU.csv -> step count and times as JSON (SPEC section 6).
 #include <cstdio>
+#include <ranges>
 #include <string>
 
 #include "commands.hpp"
@@ -36,16 +37,13 @@ void run_steps(const StepsOptions& o) {
   const auto records = read_imu_csv(o.in, false, nullptr, nullptr, &repeated);
   std::string times;
   std::size_t steps = 0;
-  fusion::StepEvent ev;
-  const auto add = [&] {
+  const auto add = [&](const fusion::StepEvent& ev) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%s%.3f", steps ? ", " : "", ev.t_s);
     times += buf;
     ++steps;
   };
-  for (const auto& r : records)
-    if (detector->update(r.imu, ev)) add();
-  while (detector->flush(ev)) add();
+  fusion::for_each_step(*detector, records | std::views::transform(&ImuRecord::imu), add);
   // repeated_stamps: rows whose time stamp repeated the previous row's, merged into it (their
   // mean: see read_imu_csv); samples: the records after merging; refused_handling: candidate
   // steps not counted because the phone was being handled (peak-valley's tilt rule).

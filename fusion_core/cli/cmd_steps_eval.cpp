@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <ranges>
 #include <set>
 #include <sstream>
 #include <string>
@@ -50,9 +51,7 @@ double count_accuracy(std::size_t counted, std::size_t truth) {
 std::size_t count_steps(fusion::StepDetector& d, const std::vector<fusion::ImuSample>& samples) {
   d.reset();
   std::size_t n = 0;
-  fusion::StepEvent ev;
-  for (const auto& s : samples) n += d.update(s, ev) ? 1u : 0u;
-  while (d.flush(ev)) ++n;
+  fusion::for_each_step(d, samples, [&n](const fusion::StepEvent&) { ++n; });
   return n;
 }
 
@@ -276,14 +275,11 @@ void ipol_table(const EvalOptions& o, bool foot) {
         auto d = fusion::make_step_detector(names[m], mount);
         std::size_t n = 0;
         std::vector<double> found;
-        fusion::StepEvent ev;
-        const auto add = [&] {
-          found.push_back(ev.t_s);
-          n += outside(ev.t_s) ? 1u : 0u;
-        };
-        for (const auto& r : records)
-          if (d->update(r.imu, ev)) add();
-        while (d->flush(ev)) add();
+        fusion::for_each_step(*d, records | std::views::transform(&ImuRecord::imu),
+                              [&](const fusion::StepEvent& ev) {
+                                found.push_back(ev.t_s);
+                                n += outside(ev.t_s) ? 1u : 0u;
+                              });
         const double a = count_accuracy(n, truth_out), b = count_accuracy(n, hs.size());
         sum_readme[m] += a;
         sum_all[m] += b;
@@ -499,12 +495,14 @@ void ipin_table(const EvalOptions& o) {
     for (const auto& r : track) pdr_before += r[0] < handled_until_s ? 1u : 0u;
     {
       auto counter = fusion::make_step_detector("peak-valley", fusion::StepMount::kBody);
-      fusion::StepEvent ev;
-      for (const auto& r : records) {  // in time order: read_imu_csv refuses time going back
-        if (r.imu.t_s >= handled_until_s) break;
-        if (counter->update(r.imu, ev)) ++counter_before;
-      }
-      while (counter->flush(ev)) ++counter_before;
+      // In time order (read_imu_csv refuses time going back): read up to the cut.
+      const auto before = [handled_until_s](const fusion::ImuSample& s) {
+        return s.t_s < handled_until_s;
+      };
+      fusion::for_each_step(
+          *counter,
+          records | std::views::transform(&ImuRecord::imu) | std::views::take_while(before),
+          [&counter_before](const fusion::StepEvent&) { ++counter_before; });
     }
     pdr_handled += pdr_before;
     counter_handled += counter_before;

@@ -3,6 +3,9 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <span>
+
+#include "telltale/fusion/small_median.hpp"
 
 namespace telltale::fusion {
 namespace {
@@ -376,17 +379,19 @@ bool PeakValleyStepDetector::update(const ImuSample& s, StepEvent& event) {
   if (step) {
     // Full cannot happen (steps are >= min_interval_s apart); if it did, the oldest goes out
     // unchecked rather than lost.
-    const bool reported = n_held_ == kHeldCapacity && release(event);
-    held_[(held_head_ + n_held_) % kHeldCapacity] = {found, steady};
-    ++n_held_;
+    const bool reported = held_.full();
+    if (reported) held_.release(event);
+    held_.push(found.t_s, steady);
     if (reported) return true;
   }
   const double max_tilt_rad = params_.max_tilt_deg * (M_PI / 180.0);
-  while (n_held_ > 0 && s.t_s - held_[held_head_].event.t_s >= kHold_s) {
-    if (held_[held_head_].steady || !(tilt_.angle_rad() > max_tilt_rad)) return release(event);
+  while (held_.size() > 0 && s.t_s - held_.t_s(0) >= kHold_s) {
+    if (held_.note(0) || !(tilt_.angle_rad() > max_tilt_rad)) {
+      held_.release(event);
+      return true;
+    }
     ++diag_.rejected_handling;
-    held_head_ = (held_head_ + 1) % kHeldCapacity;
-    --n_held_;
+    held_.drop_oldest();
   }
   return false;
 }
@@ -394,16 +399,8 @@ bool PeakValleyStepDetector::update(const ImuSample& s, StepEvent& event) {
 bool PeakValleyStepDetector::flush(StepEvent& event) {
   // The stream has ended: the second after a held step is not all there, and the check before
   // it was made. Release as it is.
-  return n_held_ > 0 && release(event);
-}
-
-bool PeakValleyStepDetector::release(StepEvent& event) {
-  event = held_[held_head_].event;
-  event.interval_s = have_released_ ? event.t_s - last_released_t_s_ : 0.0;
-  have_released_ = true;
-  last_released_t_s_ = event.t_s;
-  held_head_ = (held_head_ + 1) % kHeldCapacity;
-  --n_held_;
+  if (held_.size() == 0) return false;
+  held_.release(event);
   return true;
 }
 
@@ -699,30 +696,22 @@ void GaitPhaseStepDetector::hold_body_step(double t_s, double peak_m_s2, bool fi
   // most first_step_followers + 1 <= kBodyHeld - 1 steps in, and steps are 0.25 s apart.
   // The walk before is over: its first step is judged on what it had.
   if (first_of_walk && judging_first_) judge_first_body_step();
-  body_held_[(body_head_ + body_size_) % kBodyHeld] = {t_s, peak_m_s2};
-  ++body_size_;
+  body_held_.push(t_s, peak_m_s2);
   if (first_of_walk && params_.mount == StepMount::kBody && params_.first_step_fraction > 0.0)
     judging_first_ = true;
 }
 
 void GaitPhaseStepDetector::judge_first_body_step() {
   judging_first_ = false;
-  // The median peak of the steps after it (at most first_step_followers, all in the held ring),
-  // sorted as they are inserted.
-  std::array<double, kBodyHeld> peaks{};
-  std::size_t n = 0;
-  for (std::size_t i = 1; i < body_size_ && n < kBodyHeld; ++i) {
-    const double v = body_held_[(body_head_ + i) % kBodyHeld].peak_m_s2;
-    std::size_t j = n++;
-    for (; j > 0 && peaks[j - 1] > v; --j) peaks[j] = peaks[j - 1];
-    peaks[j] = v;
-  }
+  // The median peak of the steps after it (at most first_step_followers, all held).
+  const std::size_t n = body_held_.size() - 1;
   if (n == 0) return;  // a lone step: nothing to compare it with
-  const double median = n % 2 ? peaks[n / 2] : 0.5 * (peaks[n / 2 - 1] + peaks[n / 2]);
-  if (body_held_[body_head_].peak_m_s2 < params_.first_step_fraction * median) {
+  std::array<double, kBodyHeld> peaks{};
+  for (std::size_t i = 0; i < n && i < kBodyHeld; ++i) peaks[i] = body_held_.note(i + 1);
+  const double median = small_median<kBodyHeld>(std::span<const double>(peaks.data(), n));
+  if (body_held_.note(0) < params_.first_step_fraction * median) {
     ++diag_.rejected_amplitude;
-    body_head_ = (body_head_ + 1) % kBodyHeld;
-    --body_size_;
+    body_held_.drop_oldest();
   }
 }
 
@@ -732,18 +721,12 @@ bool GaitPhaseStepDetector::release_body_step(StepEvent& event) {
     // step): a walk of two or three steps is judged on those.
     const auto followers = static_cast<std::size_t>(
         std::clamp(params_.first_step_followers, 1, static_cast<int>(kBodyHeld) - 2));
-    if (body_size_ > followers || last_t_s_ - last_step_t_s_ > params_.pause_s)
+    if (body_held_.size() > followers || last_t_s_ - last_step_t_s_ > params_.pause_s)
       judge_first_body_step();
     if (judging_first_) return false;
   }
-  if (body_size_ == 0) return false;
-  const BodyStep step = body_held_[body_head_];
-  body_head_ = (body_head_ + 1) % kBodyHeld;
-  --body_size_;
-  event.t_s = step.t_s;
-  event.interval_s = have_reported_ ? step.t_s - last_reported_t_s_ : 0.0;
-  last_reported_t_s_ = step.t_s;
-  have_reported_ = true;
+  if (body_held_.size() == 0) return false;
+  body_held_.release(event);
   return true;
 }
 

@@ -1,6 +1,9 @@
 #include "telltale/fusion/pdr/cadence.hpp"
 
 #include <algorithm>
+#include <span>
+
+#include "telltale/fusion/small_median.hpp"
 
 namespace telltale::fusion {
 
@@ -23,17 +26,8 @@ void Cadence::learn_interval(double interval_s) {
   for (std::size_t i = 0; i + 1 < kIntervals; ++i) intervals_[i] = intervals_[i + 1];
   intervals_.back() = interval_s;
   interval_count_ = std::min(interval_count_ + 1, kIntervals);
-  // The newest interval_count_ of them, sorted by insertion (at most 5).
-  std::array<double, kIntervals> sorted{};
-  const std::size_t n = interval_count_;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double v = intervals_[kIntervals - n + i];
-    std::size_t j = i;
-    for (; j > 0 && sorted[j - 1] > v; --j) sorted[j] = sorted[j - 1];
-    sorted[j] = v;
-  }
-  const std::size_t mid = n / 2;
-  interval_s_ = n % 2 ? sorted[mid] : 0.5 * (sorted[mid - 1] + sorted[mid]);
+  // The newest interval_count_ of them.
+  interval_s_ = small_median<kIntervals>(std::span<const double>(intervals_).last(interval_count_));
 }
 
 }  // namespace telltale::fusion

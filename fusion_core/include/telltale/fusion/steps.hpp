@@ -18,6 +18,7 @@
 #include <array>
 #include <cstddef>
 #include <memory>
+#include <ranges>
 #include <span>
 #include <string_view>
 
@@ -29,8 +30,49 @@ enum class StepMount { kFoot, kBody };
 
 /// One detected step.
 struct StepEvent {
-  double t_s = 0.0;         ///< time of the sample at which the step was confirmed
+  double t_s = 0.0;         ///< when the step happened (each detector's update() says which moment)
   double interval_s = 0.0;  ///< time since the previous step (0 for the first one)
+};
+
+/// Steps a detector holds before it reports them: a fixed ring, oldest first, each with the
+/// detector's own note about it. Released in order, each with its interval from the last one
+/// released.
+template <class Note, std::size_t N>
+class HeldSteps {
+ public:
+  [[nodiscard]] std::size_t size() const { return size_; }
+  [[nodiscard]] bool full() const { return size_ == N; }
+  /// The i-th oldest (i < size()).
+  [[nodiscard]] double t_s(std::size_t i) const { return ring_[(head_ + i) % N].t_s; }
+  [[nodiscard]] const Note& note(std::size_t i) const { return ring_[(head_ + i) % N].note; }
+  /// Holds a step (not when full(): the caller releases one first).
+  void push(double t_s, const Note& note) {
+    ring_[(head_ + size_) % N] = {t_s, note};
+    ++size_;
+  }
+  /// The oldest is not a step after all.
+  void drop_oldest() {
+    head_ = (head_ + 1) % N;
+    --size_;
+  }
+  /// The oldest out, as `event`.
+  void release(StepEvent& event) {
+    event.t_s = ring_[head_].t_s;
+    event.interval_s = have_released_ ? event.t_s - last_released_t_s_ : 0.0;
+    have_released_ = true;
+    last_released_t_s_ = event.t_s;
+    drop_oldest();
+  }
+
+ private:
+  struct Entry {
+    double t_s = 0.0;
+    Note note{};
+  };
+  std::array<Entry, N> ring_{};
+  std::size_t head_ = 0, size_ = 0;
+  bool have_released_ = false;
+  double last_released_t_s_ = 0.0;
 };
 
 /// The gate's counts (gate_imu_sample: NaN/Inf time or accelerometer, time not advancing; a
@@ -76,6 +118,9 @@ class SignedMeanWindow {
 class TiltWindow {
  public:
   static constexpr std::size_t kBlocksPerSecond = 4;
+  /// (Eigen's vectors are not zeroed by `{}`: the ring is, so that copying a fresh window (a
+  /// detector's reset) copies values.)
+  TiltWindow() { blocks_.fill(Eigen::Vector3d::Zero()); }
   void add(double t_s, const Eigen::Vector3d& f);
   /// The angle (rad) between the two seconds' mean directions (before two seconds are in: the
   /// two halves of what is there); 0 before two blocks.
@@ -83,7 +128,7 @@ class TiltWindow {
 
  private:
   static constexpr std::size_t kBlocks = 2 * kBlocksPerSecond;
-  std::array<Eigen::Vector3d, kBlocks> blocks_{};  ///< sum of f per block, ring
+  std::array<Eigen::Vector3d, kBlocks> blocks_;    ///< sum of f per block, ring
   std::size_t head_ = 0;                           ///< the oldest block
   std::size_t filled_ = 0;
   Eigen::Vector3d current_ = Eigen::Vector3d::Zero();
@@ -119,6 +164,17 @@ class StepDetector {
   [[nodiscard]] virtual std::string_view name() const = 0;
   [[nodiscard]] virtual const StepDiagnostics& diagnostics() const = 0;
 };
+
+/// Runs `detector` over a whole stream of samples and its end: `on_step(event)` for every step
+/// it reports, in order, the ones flush() releases at the end included. The one way to read a
+/// recording through a detector (a loop without the flush loses the steps still held).
+template <std::ranges::input_range Samples, class OnStep>
+void for_each_step(StepDetector& detector, Samples&& samples, OnStep&& on_step) {
+  StepEvent event;
+  for (const ImuSample& s : samples)
+    if (detector.update(s, event)) on_step(event);
+  while (detector.flush(event)) on_step(event);
+}
 
 /// Seed 004: multi-source adaptive thresholds. Over a sliding window, upper/lower acceleration
 /// thresholds are the means of the positive/negative samples of the dynamic specific-force
@@ -290,18 +346,10 @@ class PeakValleyStepDetector final : public StepDetector {
   std::size_t n_step_times_ = 0;                      ///< confirmed steps so far (ring index)
   // Steps held a second before they are reported (the handled-phone rule; FIFO ring).
   static constexpr double kHold_s = 1.0;
-  static constexpr std::size_t kHeldCapacity = 8;  ///< > 1 s / min_interval_s
-  struct Held {
-    StepEvent event;
-    bool steady = false;  ///< it kept a steady walk's rhythm when confirmed
-  };
-  std::array<Held, kHeldCapacity> held_{};
-  std::size_t held_head_ = 0, n_held_ = 0;
-  bool have_released_ = false;
-  double last_released_t_s_ = 0.0;
+  /// Each with whether it kept a steady walk's rhythm when confirmed; 8 > 1 s / min_interval_s.
+  HeldSteps<bool, 8> held_;
   [[nodiscard]] bool keeps_rhythm(double t_s) const;
   bool detect(const ImuSample& s, double dt, StepEvent& event, bool& steady);
-  bool release(StepEvent& event);
 };
 
 /// Gait phases, for real walks that start and stop. The adaptive and peak-valley
@@ -444,18 +492,11 @@ class GaitPhaseStepDetector final : public StepDetector {
   double peak_m_s2_ = -1e9;
   double peak_t_s_ = 0.0;
   double amplitude_m_s2_ = 0.0;  ///< recent peak-to-valley (0: none since the last pause)
-  /// Body: steps found and not yet reported, in order (time, peak); the oldest is a walk's
-  /// first under judgement while judging_first_.
-  struct BodyStep {
-    double t_s = 0.0;
-    double peak_m_s2 = 0.0;
-  };
+  /// Body: steps found and not yet reported, in order, each with its peak (m/s^2); the oldest
+  /// is a walk's first under judgement while judging_first_.
   static constexpr std::size_t kBodyHeld = 8;
-  std::array<BodyStep, kBodyHeld> body_held_{};
-  std::size_t body_head_ = 0, body_size_ = 0;
+  HeldSteps<double, kBodyHeld> body_held_;
   bool judging_first_ = false;
-  double last_reported_t_s_ = 0.0;
-  bool have_reported_ = false;
 };
 
 /// Steps from a swinging arm (a phone carried in the hand, arm swinging): the arm turns forward
