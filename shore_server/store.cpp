@@ -537,11 +537,16 @@ void Store::writer_loop() {
   std::vector<WearableSample> wearable;
   std::vector<FixSample> fixes;
   std::vector<WindSample> wind;
+  // Commits keep a fixed rate: each is due one interval after the previous one was due, not after
+  // it finished. A sample then waits at most the interval plus the commit that takes it, whatever
+  // the one before took (a WAL checkpoint, a slow disk); one that overran is followed at once.
+  auto due = std::chrono::steady_clock::now() + config_.commit_interval;
   for (;;) {
     bool stop = false;
     {
       std::unique_lock lock(mutex_);
-      cv_.wait_for(lock, config_.commit_interval, [this] { return stopping_; });
+      cv_.wait_until(lock, due, [this] { return stopping_; });
+      due = std::max(due + config_.commit_interval, std::chrono::steady_clock::now());
       stop = stopping_;
       // While commits fail, wait out the backoff (the queue keeps what came): retrying the whole
       // backlog every commit interval only burns CPU. At stop, one last attempt regardless.

@@ -6,11 +6,12 @@
 /// record is stored, from which the boats backfill what is missing.
 ///
 /// Writes: the DDS listener queues samples (never blocks on disk); one writer thread commits them
-/// in batches. Durability window: a sample is on disk at most `commit_interval` after it arrived
-/// (default 250 ms); a crash loses at most that window, which the boats' backfill refills. A
-/// sample already stored (same boat, same UTC time) is kept once (INSERT OR IGNORE), so re-sent
-/// samples merge without duplicates. Alarm rules and events are written synchronously: an
-/// acknowledgement is on disk before the request that made it is answered.
+/// in batches at a fixed rate. Durability window: a sample is on disk at most `commit_interval`
+/// (default 250 ms) plus the commit's own time after it arrived; a crash loses at most that
+/// window, which the boats' backfill refills. A sample already stored (same boat, same UTC time)
+/// is kept once (INSERT OR IGNORE), so re-sent samples merge without duplicates. Alarm rules and
+/// events are written synchronously: an acknowledgement is on disk before the request that made
+/// it is answered.
 ///
 /// Sessions: continuous activity of one boat. A sample within `session_gap` of a boat's session
 /// extends it; otherwise it starts a new one.
