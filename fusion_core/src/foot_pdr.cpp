@@ -22,8 +22,7 @@ FootPdr::FootPdr(Params params, const StepLengthModel& lengths)
       steps_(params.steps),
       cadence_(params.min_step_interval_s),
       heading_(params.heading),
-      mag_cal_(params.hard_iron),
-      gyro_bias_(params.gyro_bias),
+      sensors_(params.gyro_bias, params.calibrate_mag, params.hard_iron),
       track_(params.track, params.calibrate_mag) {}
 
 void FootPdr::on_stride(double t_s) {
@@ -48,30 +47,17 @@ void FootPdr::on_stride(double t_s) {
   out_.last_step_length_m = len;
   heading_.set_speed(step_m * hz);
   out_.distance_m += len;
-  track_.lay(len, heading, true, mag_cal_.offset_uT());
+  track_.lay(len, heading, true, sensors_.mag_calibration().offset_uT());
   out_.heading_deg = heading * 180.0 / M_PI;
 }
 
 const PdrOutput& FootPdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT) {
   out_.step = false;
-  static constexpr ImuGateParams kGate{.gyro_required = false};
-  if (gate_imu_sample(raw, kGate, have_t_, last_t_s_, diag_).verdict == ImuVerdict::kReject) {
-    return out_;
-  }
-  ImuSample s = raw;
-  if (s.gyro_body_rad_s.allFinite()) {
-    gyro_bias_.add(s);
-    diag_.still_windows = gyro_bias_.windows();
-    s.gyro_body_rad_s -= gyro_bias_.bias_rad_s();
-  }
+  ImuSample s;
+  Eigen::Vector3d mag;
+  if (!sensors_.prepare(raw, mag_uT, diag_, s, mag)) return out_;
+  diag_.still_windows = sensors_.still_windows();
   out_.t_s = s.t_s;
-  Eigen::Vector3d mag = mag_uT;
-  if (params_.calibrate_mag && mag.allFinite()) {
-    // The hard-iron residual rotates with the foot, so its heading error changes with the
-    // walking direction and does not cancel around a loop: remove it before the heading.
-    mag_cal_.update(s.t_s, s.gyro_body_rad_s, mag);
-    mag = mag_cal_.corrected(mag);
-  }
   // The sensor's frame is the walking frame: a foot carries it one way.
   heading_.update(s.t_s, s.gyro_body_rad_s, s.acc_body_m_s2, mag);
   if (heading_.initialised()) {

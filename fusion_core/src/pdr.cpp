@@ -109,8 +109,7 @@ Pdr::Pdr(Params params, const PoseNetwork& net, const StepLengthModel& lengths)
                           params.gyro_bias.acc_std_m_s2}),
       heading_(params.heading),
       walking_(params.walking_direction),
-      mag_cal_(params.hard_iron),
-      gyro_bias_(params.gyro_bias),
+      sensors_(params.gyro_bias, params.calibrate_mag, params.hard_iron),
       acc_bias_(params.acc_bias),
       track_(params.track, params.calibrate_mag),
       switch_(params.pose_switch) {}
@@ -187,7 +186,7 @@ void Pdr::on_step(const ClockStep& step) {
   track_.begin_step();
   const std::array<Eigen::Vector3d, 2> ups_before = switch_.ups();
   count_steps(step);
-  acc_bias_.at_step(t_s, mag_cal_.offset_uT());
+  acc_bias_.at_step(t_s, sensors_.mag_calibration().offset_uT());
   if (t_prev >= 0.0) detect_switch(t_prev, t_s, ups_before);
   switch_.end_step();
   classify_pose(t_s);
@@ -229,7 +228,7 @@ void Pdr::lay_step(double t_s, double t_prev, int missed, double walked_rad,
     track_.hold(len);
     return;
   }
-  track_.lay(len, heading, !switch_.switching(), mag_cal_.offset_uT());
+  track_.lay(len, heading, !switch_.switching(), sensors_.mag_calibration().offset_uT());
   SwitchStep laid;  // what a later re-laying of this step needs
   laid.length_m = len;
   laid.laid_rad = heading;
@@ -258,7 +257,9 @@ void Pdr::book_laid_step(const SwitchStep& laid, double heading,
   if (!switching) relay_.keep_last(laid, ups_before);
 }
 
-void Pdr::forget_vertical_field() { acc_bias_.forget(last_t_s_ + 3.0 * params_.heading.up_tau_s); }
+void Pdr::forget_vertical_field() {
+  acc_bias_.forget(sensors_.last_t_s() + 3.0 * params_.heading.up_tau_s);
+}
 
 void Pdr::reset_walking_direction() {
   walking_.reset();
@@ -278,28 +279,15 @@ void Pdr::relay_switch_steps(std::optional<double> heading_after, PhonePose pose
 
 const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT) {
   out_.step = false;
-  static constexpr ImuGateParams kGate{.gyro_required = false};
-  if (gate_imu_sample(raw, kGate, have_t_, last_t_s_, diag_).verdict == ImuVerdict::kReject) {
-    return out_;
-  }
-  ImuSample s = raw;
-  if (gyro_ok(s)) {
-    gyro_bias_.add(s);
-    diag_.still_windows = gyro_bias_.windows();
-    s.gyro_body_rad_s -= gyro_bias_.bias_rad_s();
-  }
+  ImuSample s;
+  Eigen::Vector3d mag;
+  if (!sensors_.prepare(raw, mag_uT, diag_, s, mag)) return out_;
+  diag_.still_windows = sensors_.still_windows();
   out_.t_s = s.t_s;
   pose_.push(s);
   recent_.push(s);
   // Into the walking frame of the pose in force (eqs. (14)-(15)).
   const Eigen::Matrix3d m = pose_rotation(pose_.pose());
-  Eigen::Vector3d mag = mag_uT;
-  if (params_.calibrate_mag && mag.allFinite()) {
-    // The hard-iron residual rotates with the phone, so its heading error changes with the
-    // walking direction and does not cancel around a loop: remove it before the heading.
-    mag_cal_.update(s.t_s, s.gyro_body_rad_s, mag);
-    mag = mag_cal_.corrected(mag);
-  }
   heading_.update(s.t_s, m * s.gyro_body_rad_s, m * (s.acc_body_m_s2 - acc_bias_.bias_m_s2()),
                   m * mag);
   if (!switch_.switching() && params_.acc_bias.learn && mag.allFinite() && heading_.initialised() &&

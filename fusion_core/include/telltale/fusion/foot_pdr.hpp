@@ -3,11 +3,11 @@
 /// Pedestrian dead reckoning with an IMU on the foot (seed 004): `fusion_cli pdr --mount foot`,
 /// `wearable_node --mount foot`.
 ///
-/// Pipeline per sample (FootPdr::update): gyro bias learnt while standing -> hard-iron offset ->
-/// heading of the sensor's x axis from gyro + magnetometer (the two-state Kalman filter of seed
-/// 004, Fig. 2) -> strides of the adaptive detector (seed 004) -> at each stride: the cadence,
-/// the heading's circular mean over the stride, two steps of the step-length model laid along
-/// it -> position.
+/// Pipeline per sample (FootPdr::update): gyro bias learnt while standing and hard-iron offset
+/// (SensorPrep) -> heading of the sensor's x axis from gyro + magnetometer (the two-state Kalman
+/// filter of seed 004, Fig. 2) -> strides of the adaptive detector (seed 004) -> at each stride:
+/// the cadence, the heading's circular mean over the stride, two steps of the step-length model
+/// laid along it -> position.
 ///
 /// What the phone's pipeline (Pdr, pdr.hpp) has and this one has not, and why: a foot sensor
 /// is strapped on, so there is no pose to classify and no switch between poses, and its frame
@@ -17,7 +17,7 @@
 ///
 /// Structure: FootPdr orders the work of a sample and of a stride; the stages it calls are the
 /// phone's (pdr/: cadence, step_length, walking_heading's HeadingFilter,
-/// bias_learners' GyroBiasLearner, track), each with its Params a member of FootPdrParams.
+/// sensor_prep, track), each with its Params a member of FootPdrParams.
 /// Frames and units as Pdr: position x east, y north (m) from the start; heading clockwise from
 /// north.
 ///
@@ -29,6 +29,7 @@
 #include "telltale/fusion/imu_sample.hpp"
 #include "telltale/fusion/pdr/bias_learners.hpp"
 #include "telltale/fusion/pdr/cadence.hpp"
+#include "telltale/fusion/pdr/sensor_prep.hpp"
 #include "telltale/fusion/pdr/step_length.hpp"
 #include "telltale/fusion/pdr/track.hpp"
 #include "telltale/fusion/pdr/walking_heading.hpp"
@@ -66,9 +67,13 @@ class FootPdr {
   [[nodiscard]] const PdrOutput& output() const { return out_; }
   [[nodiscard]] const Diagnostics& diagnostics() const { return diag_; }
   [[nodiscard]] const StepDiagnostics& step_diagnostics() const { return steps_.diagnostics(); }
-  [[nodiscard]] const HardIronCalibrator& mag_calibration() const { return mag_cal_; }
+  [[nodiscard]] const HardIronCalibrator& mag_calibration() const {
+    return sensors_.mag_calibration();
+  }
   /// Gyro bias learnt while still (sensor frame, rad/s; subtracted from every sample).
-  [[nodiscard]] const Eigen::Vector3d& gyro_bias_rad_s() const { return gyro_bias_.bias_rad_s(); }
+  [[nodiscard]] const Eigen::Vector3d& gyro_bias_rad_s() const {
+    return sensors_.gyro_bias_rad_s();
+  }
 
  private:
   /// A stride ended at t_s: counts its two steps and lays them.
@@ -79,14 +84,11 @@ class FootPdr {
   AdaptiveStepDetector steps_;
   Cadence cadence_;  ///< the cadence only: the detector sees every stride, no gap is filled
   HeadingFilter heading_;
-  HardIronCalibrator mag_cal_;
-  GyroBiasLearner gyro_bias_;
+  SensorPrep sensors_;
   Track track_;
   Diagnostics diag_;
   PdrOutput out_;
   double sum_sin_ = 0.0, sum_cos_ = 0.0;  ///< heading over the current stride (circular mean)
-  bool have_t_ = false;
-  double last_t_s_ = 0.0;
 };
 
 }  // namespace telltale::fusion

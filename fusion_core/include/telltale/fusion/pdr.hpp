@@ -38,8 +38,8 @@
 ///
 /// Structure: Pdr orders the work of a sample and of a step; each stage it calls owns its state
 /// and its Params (a member of PdrParams), one file pair each in pdr/ (docs/pdr.md lists them):
-/// phone_steps, step_clock, recent_samples, recent_headings, pose_classifier, pose_switch,
-/// step_length, walking_heading, bias_learners, track.
+/// sensor_prep (shared with FootPdr), phone_steps, step_clock, recent_samples, recent_headings,
+/// pose_classifier, pose_switch, step_length, walking_heading, bias_learners, track.
 ///
 /// Memory: fixed-size buffers and Eigen fixed-size types, no heap in update().
 
@@ -59,6 +59,7 @@
 #include "telltale/fusion/pdr/pose_switch.hpp"
 #include "telltale/fusion/pdr/recent_headings.hpp"
 #include "telltale/fusion/pdr/recent_samples.hpp"
+#include "telltale/fusion/pdr/sensor_prep.hpp"
 #include "telltale/fusion/pdr/step_clock.hpp"
 #include "telltale/fusion/pdr/step_length.hpp"
 #include "telltale/fusion/pdr/track.hpp"
@@ -119,9 +120,13 @@ class Pdr {
   [[nodiscard]] const PdrOutput& output() const { return out_; }
   [[nodiscard]] const Diagnostics& diagnostics() const { return diag_; }
   [[nodiscard]] const StepDiagnostics& step_diagnostics() const;
-  [[nodiscard]] const HardIronCalibrator& mag_calibration() const { return mag_cal_; }
+  [[nodiscard]] const HardIronCalibrator& mag_calibration() const {
+    return sensors_.mag_calibration();
+  }
   /// Gyro bias learnt while still (sensor frame, rad/s; subtracted from every sample).
-  [[nodiscard]] const Eigen::Vector3d& gyro_bias_rad_s() const { return gyro_bias_.bias_rad_s(); }
+  [[nodiscard]] const Eigen::Vector3d& gyro_bias_rad_s() const {
+    return sensors_.gyro_bias_rad_s();
+  }
   /// Accelerometer bias learnt from the vertical field (sensor frame, m/s^2; removed from the
   /// accelerometer before the heading filter).
   [[nodiscard]] const Eigen::Vector3d& acc_bias_m_s2() const { return acc_bias_.bias_m_s2(); }
@@ -166,8 +171,7 @@ class Pdr {
   RecentHeadings headings_;  ///< the heading a gap's steps are laid along
   HeadingFilter heading_;
   WalkingDirection walking_;
-  HardIronCalibrator mag_cal_;
-  GyroBiasLearner gyro_bias_;
+  SensorPrep sensors_;
   AccBiasLearner acc_bias_;
   Track track_;
   Diagnostics diag_;
@@ -178,8 +182,6 @@ class Pdr {
   /// -z axes: the walking direction if the pose's forward axis is that one.
   std::array<Eigen::Vector2d, 2> axis_sum_{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
   double sum_sin_ = 0.0, sum_cos_ = 0.0;  ///< heading over the current step (circular mean)
-  bool have_t_ = false;
-  double last_t_s_ = 0.0;
 };
 
 }  // namespace telltale::fusion

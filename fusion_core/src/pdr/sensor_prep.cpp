@@ -1,0 +1,23 @@
+#include "telltale/fusion/pdr/sensor_prep.hpp"
+
+namespace telltale::fusion {
+
+bool SensorPrep::prepare(const ImuSample& raw, const Eigen::Vector3d& mag_uT, ImuGateCounts& counts,
+                         ImuSample& s, Eigen::Vector3d& mag) {
+  static constexpr ImuGateParams kGate{.gyro_required = false};
+  if (gate_imu_sample(raw, kGate, have_t_, last_t_s_, counts).verdict == ImuVerdict::kReject)
+    return false;
+  s = raw;
+  if (s.gyro_body_rad_s.allFinite()) {
+    gyro_bias_.add(s);
+    s.gyro_body_rad_s -= gyro_bias_.bias_rad_s();
+  }
+  mag = mag_uT;
+  if (calibrate_mag_ && mag.allFinite()) {
+    mag_cal_.update(s.t_s, s.gyro_body_rad_s, mag);
+    mag = mag_cal_.corrected(mag);
+  }
+  return true;
+}
+
+}  // namespace telltale::fusion
