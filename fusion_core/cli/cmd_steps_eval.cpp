@@ -21,6 +21,7 @@
 #include "gait_io.hpp"
 #include "telltale/fusion/handheld_pdr.hpp"
 #include "telltale/fusion/sim/gait_sim.hpp"
+#include "telltale/fusion/sim/phone_walk.hpp"
 #include "telltale/fusion/sim/pose_dataset.hpp"
 #include "telltale/fusion/steps.hpp"
 
@@ -436,6 +437,68 @@ void pdr_table(int loops, int first_seed) {
   }
 }
 
+/// The IPIN walks' simulated counterpart (sim::ipin_like_plan: handling, standing, a rectangle
+/// walked with the phone held in front, pauses at corners), through the same run as the real
+/// walks (run_handheld_walk, height 1.75 m, no calibration walk). Against the simulator's truth:
+/// the track's length between the walk's start and end over the true distance; the loop error,
+/// the track's end-minus-start against the truth's, in % of the distance; the steps counted while
+/// the phone was handled or the walker stood before the walk.
+void phone_sim_table(int walks, int first_seed) {
+  std::printf(
+      "\n## Simulated IPIN-like phone walks (%d walks, seeds %d-%d; sim/phone_walk.hpp): the "
+      "same run as the real walks below\n\n| walks | length ratio mean (min-max) | loop error "
+      "median / 90th pct %% | walks <= 2 %% | steps counted / true | steps before the walk |\n"
+      "|---|---|---|---|---|---|\n",
+      walks, first_seed, first_seed + walks - 1);
+  std::vector<double> ratios, errors;
+  double counted = 0.0, truth = 0.0;
+  std::size_t before = 0;
+  for (int i = 0; i < walks; ++i) {
+    const auto seed = static_cast<std::uint64_t>(first_seed + i);
+    fusion::sim::PhoneWalkParams p;
+    const auto plan = fusion::sim::ipin_like_plan(seed, 1.75, p);
+    const auto w = fusion::sim::simulate_phone_walk(plan, p, seed);
+    std::vector<ImuRecord> records(w.samples.size());
+    for (std::size_t k = 0; k < records.size(); ++k) records[k] = {w.samples[k], w.mag_uT[k]};
+    fusion::HandheldPdrParams params;
+    params.height_m = 1.75;
+    const auto run = run_handheld_walk(records, params);
+    // Positions at the walk's start and end: the last step at or before each.
+    std::array<double, 2> a{0.0, 0.0}, b{0.0, 0.0}, prev{0.0, 0.0};
+    double walked = 0.0;
+    std::size_t steps = 0;
+    for (const auto& st : run.steps) {
+      if (st.t_s <= w.truth.walk_start_s) {
+        a = {st.x_m, st.y_m};
+        ++before;
+      }
+      if (st.t_s <= w.truth.walk_end_s) b = {st.x_m, st.y_m};
+      if (st.t_s > w.truth.walk_start_s && st.t_s <= w.truth.walk_end_s + 1.0) {
+        walked += std::hypot(st.x_m - prev[0], st.y_m - prev[1]);
+        ++steps;
+      }
+      prev = {st.x_m, st.y_m};
+    }
+    ratios.push_back(walked / w.truth.distance_m);
+    errors.push_back(100.0 * std::hypot((b[0] - a[0]) - w.truth.x_m, (b[1] - a[1]) - w.truth.y_m) /
+                     w.truth.distance_m);
+    counted += static_cast<double>(steps);
+    truth += w.truth.steps;
+  }
+  std::vector<double> sorted = errors;
+  std::sort(sorted.begin(), sorted.end());
+  double sum = 0.0;
+  for (const double r : ratios) sum += r;
+  const auto within =
+      std::count_if(errors.begin(), errors.end(), [](double e) { return e <= 2.0; });
+  std::printf("| %d | %.3f (%.3f-%.3f) | %.2f / %.2f | %ld / %d | %.0f / %.0f | %zu |\n", walks,
+              sum / static_cast<double>(walks), *std::min_element(ratios.begin(), ratios.end()),
+              *std::max_element(ratios.begin(), ratios.end()), sorted[sorted.size() / 2],
+              sorted[(sorted.size() * 9) / 10 - 1], static_cast<long>(within), walks, counted,
+              truth, before);
+  std::fflush(stdout);
+}
+
 /// IPIN 2023 phone walks (DATA/ipin_pdr/, README.md there), scored as that README says: the
 /// track of `fusion_cli pdr --height-m 1.75` (HandheldPdr, no calibration walk) between the first
 /// and last landmark times; (a) the distance walked (the track's polyline from its position at
@@ -570,7 +633,10 @@ void run_eval(const EvalOptions& o) {
   if (o.tables.find("oxford") != std::string::npos) oxford_table(o);
   if (o.tables.find("pose") != std::string::npos) pose_table();
   if (o.tables.find("pdr") != std::string::npos) pdr_table(o.loops, o.first_seed);
-  if (o.tables.find("ipin") != std::string::npos) ipin_table(o);
+  if (o.tables.find("ipin") != std::string::npos) {
+    phone_sim_table(o.loops, o.first_seed);
+    ipin_table(o);
+  }
 }
 
 }  // namespace
@@ -586,7 +652,9 @@ void register_steps_eval(CLI::App& app) {
                   "$TELLTALE_DATA, else ../shared/data (relative to the working directory)");
   cmd->add_option("--oxford", opts->oxford_dir,
                   "Oxford step traces (default: DATA/oxford_steps, then tests/data/oxford_steps)");
-  cmd->add_option("--loops", opts->loops, "simulated closed-loop PDR walks")->capture_default_str();
+  cmd->add_option("--loops", opts->loops,
+                  "simulated closed-loop PDR walks (and as many simulated IPIN-like phone walks)")
+      ->capture_default_str();
   cmd->add_option("--first-seed", opts->first_seed,
                   "seed of the first loop walk (2001: the report set; 100, 3001-3200, "
                   "4001-4400: sets the PDR was tuned on; 5001-5400: never tuned on; people "
