@@ -646,7 +646,10 @@ void register_steps_eval(CLI::App& app) {
   auto* cmd = app.add_subcommand("steps-eval",
                                  "Accuracy tables: gaits x step methods, Oxford "
                                  "traces, pose classifier, PDR closed loops");
-  cmd->add_option("--people", opts->people, "simulated people per gait")->capture_default_str();
+  // At least one of each (the tables' medians and percentiles read the first element).
+  cmd->add_option("--people", opts->people, "simulated people per gait")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
   cmd->add_option("--data", opts->data_dir,
                   "folder of the real recordings (ipol_gait/, oxford_steps/, ipin_pdr/); default: "
                   "$TELLTALE_DATA, else ../shared/data (relative to the working directory)");
@@ -654,6 +657,7 @@ void register_steps_eval(CLI::App& app) {
                   "Oxford step traces (default: DATA/oxford_steps, then tests/data/oxford_steps)");
   cmd->add_option("--loops", opts->loops,
                   "simulated closed-loop PDR walks (and as many simulated IPIN-like phone walks)")
+      ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   cmd->add_option("--first-seed", opts->first_seed,
                   "seed of the first loop walk (2001: the report set; 100, 3001-3200, "

@@ -167,7 +167,7 @@ TEST_F(CrashTest, TwentyKillsDuringIngest) {
     cycle_losses.push_back(cycle_loss);
     // A writer that stalls: the newest stored sample is older than the durability window
     // (--commit-ms, one publish period of 40 ms) by more than a second of scheduling, which a
-    // loaded machine under the sanitizers can cost any process (once 0.28 s over the window).
+    // loaded machine under the sanitizers can cost any process (CI once saw 533 ms against 290).
     EXPECT_LE(cycle_loss, kCommitMs + 40 + 1000)
         << "cycle " << cycle << ": newest stored sample " << cycle_loss << " ms before the kill";
     std::printf(

@@ -128,4 +128,18 @@ TEST_F(StepsCli, IpolReadmeRuleLeavesTheUTurnOutOfTheAnnotationsToo) {
   EXPECT_NE(line.find("| 10 (100 / 83) |", line.size() - 20), std::string::npos) << line;
 }
 
+// No simulated walk to score is a usage error, not a table that reads its first element.
+// Seen failing before the check: `steps-eval --loops 0 --tables pdr` ended in a segmentation
+// fault (status -1 here), `--people 0` printed -nan.
+TEST_F(StepsCli, EvalRefusesNoSimulatedWalks) {
+  for (const char* args :
+       {"--loops 0 --tables pdr", "--loops -3 --tables ipin", "--people 0 --tables gait"}) {
+    const int rc = run(std::string("steps-eval --data ") + path("none") + " " + args);
+    EXPECT_NE(rc, 0) << args;
+    EXPECT_NE(rc, -1) << args << ": did not exit";
+    EXPECT_NE(read("err.txt").find(std::string(args).substr(0, 7)), std::string::npos)
+        << args << ": " << read("err.txt");
+  }
+}
+
 }  // namespace

@@ -106,6 +106,7 @@ PhoneWalk simulate_phone_walk(const std::vector<PhoneSegment>& plan, const Phone
     }
   }
   w.truth.heading_rad = heading;
+  if (rot.size() < 2) return w;  // no rate without two orientations
   const Eigen::Vector3d earth_uT(0.0, 20.0, -44.0);
   w.samples.reserve(rot.size());
   w.mag_uT.reserve(rot.size());
