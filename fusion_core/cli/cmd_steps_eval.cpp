@@ -384,6 +384,40 @@ void pose_table() {
   }
 }
 
+/// The upper median and the 90th percentile of a set of results, as the simulated tables report
+/// them (the element at n / 2, and at 9 n / 10 - 1, of the sorted values; n >= 1).
+struct Spread {
+  double median = 0.0, p90 = 0.0;
+};
+Spread spread(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return {v[v.size() / 2], v[(v.size() * 9) / 10 - 1]};
+}
+
+/// A phone track between two times, as both IPIN tables score it: the positions at t0 and t1
+/// (each that of the last step at or before it; the start before any), and the distance and the
+/// steps walked between them (every step in [t0, t1], from the position at t0).
+struct TrackSpan {
+  std::array<double, 2> start{0.0, 0.0}, end{0.0, 0.0};
+  double walked_m = 0.0;
+  std::size_t steps = 0;
+};
+TrackSpan track_span(const std::vector<fusion::HandheldStep>& track, double t0, double t1) {
+  TrackSpan span;
+  for (const auto& st : track) {
+    if (st.t_s <= t0) span.start = {st.x_m, st.y_m};
+    if (st.t_s <= t1) span.end = {st.x_m, st.y_m};
+  }
+  std::array<double, 2> prev = span.start;
+  for (const auto& st : track) {
+    if (st.t_s < t0 || st.t_s > t1) continue;
+    span.walked_m += std::hypot(st.x_m - prev[0], st.y_m - prev[1]);
+    prev = {st.x_m, st.y_m};
+    ++span.steps;
+  }
+  return span;
+}
+
 void pdr_table(int loops, int first_seed) {
   std::printf(
       "\n## PDR closed loops (%d walks, seeds %d-%d, people held out of training): end-point "
@@ -425,14 +459,11 @@ void pdr_table(int loops, int first_seed) {
       counted += r.steps_counted;
       truth += r.steps_true;
     }
-    std::sort(err.begin(), err.end());
-    std::sort(dist.begin(), dist.end());
     const auto within = std::count_if(err.begin(), err.end(), [](double e) { return e <= 2.0; });
-    const auto p90 = (err.size() * 9) / 10 - 1;
+    const Spread e = spread(err), d = spread(dist);
     std::printf("| %s | %.2f | %.2f | %ld / %d (%.0f %%) | %zu / %zu | %.2f / %.2f |\n",
-                row.name.c_str(), err[err.size() / 2], err[p90], static_cast<long>(within), loops,
-                100.0 * static_cast<double>(within) / loops, counted, truth, dist[dist.size() / 2],
-                dist[p90]);
+                row.name.c_str(), e.median, e.p90, static_cast<long>(within), loops,
+                100.0 * static_cast<double>(within) / loops, counted, truth, d.median, d.p90);
     std::fflush(stdout);
   }
 }
@@ -463,39 +494,25 @@ void phone_sim_table(int walks, int first_seed) {
     fusion::HandheldPdrParams params;
     params.height_m = 1.75;
     const auto run = run_handheld_walk(records, params);
-    // Positions at the walk's start and end: the last step at or before each.
-    std::array<double, 2> a{0.0, 0.0}, b{0.0, 0.0}, prev{0.0, 0.0};
-    double walked = 0.0;
-    std::size_t steps = 0;
-    for (const auto& st : run.steps) {
-      if (st.t_s <= w.truth.walk_start_s) {
-        a = {st.x_m, st.y_m};
-        ++before;
-      }
-      if (st.t_s <= w.truth.walk_end_s) b = {st.x_m, st.y_m};
-      if (st.t_s > w.truth.walk_start_s && st.t_s <= w.truth.walk_end_s + 1.0) {
-        walked += std::hypot(st.x_m - prev[0], st.y_m - prev[1]);
-        ++steps;
-      }
-      prev = {st.x_m, st.y_m};
-    }
-    ratios.push_back(walked / w.truth.distance_m);
-    errors.push_back(100.0 * std::hypot((b[0] - a[0]) - w.truth.x_m, (b[1] - a[1]) - w.truth.y_m) /
+    const TrackSpan span = track_span(run.steps, w.truth.walk_start_s, w.truth.walk_end_s);
+    for (const auto& st : run.steps) before += st.t_s < w.truth.walk_start_s ? 1u : 0u;
+    ratios.push_back(span.walked_m / w.truth.distance_m);
+    errors.push_back(100.0 *
+                     std::hypot((span.end[0] - span.start[0]) - w.truth.x_m,
+                                (span.end[1] - span.start[1]) - w.truth.y_m) /
                      w.truth.distance_m);
-    counted += static_cast<double>(steps);
+    counted += static_cast<double>(span.steps);
     truth += w.truth.steps;
   }
-  std::vector<double> sorted = errors;
-  std::sort(sorted.begin(), sorted.end());
+  const Spread loop = spread(errors);
   double sum = 0.0;
   for (const double r : ratios) sum += r;
   const auto within =
       std::count_if(errors.begin(), errors.end(), [](double e) { return e <= 2.0; });
   std::printf("| %d | %.3f (%.3f-%.3f) | %.2f / %.2f | %ld / %d | %.0f / %.0f | %zu |\n", walks,
               sum / static_cast<double>(walks), *std::min_element(ratios.begin(), ratios.end()),
-              *std::max_element(ratios.begin(), ratios.end()), sorted[sorted.size() / 2],
-              sorted[(sorted.size() * 9) / 10 - 1], static_cast<long>(within), walks, counted,
-              truth, before);
+              *std::max_element(ratios.begin(), ratios.end()), loop.median, loop.p90,
+              static_cast<long>(within), walks, counted, truth, before);
   std::fflush(stdout);
 }
 
@@ -548,14 +565,12 @@ void ipin_table(const EvalOptions& o) {
     const auto records = read_imu_csv(dir + "/" + name + ".imu.csv", false);
     fusion::HandheldPdrParams params;
     params.height_m = 1.75;
-    std::vector<std::array<double, 3>> track;  // t, x, y: one row per step
-    for (const auto& st : run_handheld_walk(records, params).steps)
-      track.push_back({st.t_s, st.x_m, st.y_m});
+    const auto track = run_handheld_walk(records, params).steps;
     const double t0 = marks.front()[0], t1 = marks.back()[0];
     // No walking before t0 - 20 s: the phone handled, then at least 20 s standing (README).
     const double handled_until_s = t0 - 20.0;
     std::size_t pdr_before = 0, counter_before = 0;
-    for (const auto& r : track) pdr_before += r[0] < handled_until_s ? 1u : 0u;
+    for (const auto& st : track) pdr_before += st.t_s < handled_until_s ? 1u : 0u;
     {
       auto counter = fusion::make_step_detector("peak-valley", fusion::StepMount::kBody);
       // In time order (read_imu_csv refuses time going back): read up to the cut.
@@ -572,30 +587,14 @@ void ipin_table(const EvalOptions& o) {
     double poly = 0.0;
     for (std::size_t i = 1; i < marks.size(); ++i)
       poly += std::hypot(marks[i][1] - marks[i - 1][1], marks[i][2] - marks[i - 1][2]);
-    auto pos_at = [&track](double t) {
-      std::array<double, 2> p{0.0, 0.0};
-      for (const auto& r : track) {
-        if (r[0] > t) break;
-        p = {r[1], r[2]};
-      }
-      return p;
-    };
-    const auto a = pos_at(t0), b = pos_at(t1);
-    double walked = 0.0;
-    std::array<double, 2> prev = a;
-    std::size_t steps = 0;
-    for (const auto& r : track) {
-      if (r[0] < t0 || r[0] > t1) continue;
-      walked += std::hypot(r[1] - prev[0], r[2] - prev[1]);
-      prev = {r[1], r[2]};
-      ++steps;
-    }
-    const double ratio = walked / poly;
-    const double closure = 100.0 * std::hypot(b[0] - a[0], b[1] - a[1]) / poly;
+    const TrackSpan span = track_span(track, t0, t1);
+    const double ratio = span.walked_m / poly;
+    const double closure =
+        100.0 * std::hypot(span.end[0] - span.start[0], span.end[1] - span.start[1]) / poly;
     ratios.push_back(ratio);
     closures.push_back(closure);
     std::printf("| %s | %.1f | %.1f | %.3f | %.2f | %zu | %zu / %zu |\n", name.c_str(), poly,
-                walked, ratio, closure, steps, pdr_before, counter_before);
+                span.walked_m, ratio, closure, span.steps, pdr_before, counter_before);
     std::fflush(stdout);
   }
   if (ratios.empty()) return;
