@@ -643,6 +643,42 @@ bool GaitPhaseStepDetector::update_body(const ImuSample& s, double dt, StepEvent
   // swing) but not so closely that the closing step of a walk, whose trunk swings a third of
   // the walk's as it stops, is taken for a ripple; after a pause only the floor applies.
   if (s.t_s - last_step_t_s_ > params_.pause_s) amplitude_m_s2_ = 0.0;
+  // The closing step (GaitPhaseStepParams): the rise since the lowest point after the last step
+  // (its size, its steepest slope and when), as it was when the vertical last entered the band
+  // it has stayed in since.
+  if (v < rise_.valley_m_s2) {
+    rise_ = {.valley_m_s2 = v, .valley_t_s = s.t_s, .top_m_s2 = v};
+  } else {
+    rise_.top_m_s2 = std::max(rise_.top_m_s2, v);
+    const double slope = dt > 0.0 ? (v - last_v_m_s2_) / dt : 0.0;
+    if (slope > rise_.steepest_m_s3) {
+      rise_.steepest_m_s3 = slope;
+      rise_.steepest_t_s = s.t_s;
+    }
+  }
+  last_v_m_s2_ = v;
+  if (v < rest_lo_m_s2_ || v > rest_hi_m_s2_) {
+    rest_lo_m_s2_ = std::min(rest_lo_m_s2_, v);
+    rest_hi_m_s2_ = std::max(rest_hi_m_s2_, v);
+    if (rest_hi_m_s2_ - rest_lo_m_s2_ > params_.rest_band_m_s2) {
+      rest_lo_m_s2_ = rest_hi_m_s2_ = v;
+      rest_since_t_s_ = s.t_s;
+      rise_before_rest_ = rise_;
+    }
+  }
+  if (closing_step_due(s.t_s)) {
+    // Counted as the trunk comes to rest, rest_s after the heel strike; a walk resumed before
+    // that (the trunk never at rest) goes on under the rules below. The heel strike ended the
+    // fall: it is the lowest point, less the low-pass's delay at the walk's step frequency.
+    const BodyRise r = rise_before_rest_;
+    rising_ = false;
+    valley_m_s2_ = v;
+    rise_ = rise_before_rest_ = {.valley_m_s2 = v, .valley_t_s = s.t_s, .top_m_s2 = v};
+    closed_ = true;
+    last_step_t_s_ = r.valley_t_s;
+    hold_body_step(r.valley_t_s - vertical_delay_s(step_interval_s_), r.top_m_s2, false);
+    return release_body_step(event);
+  }
   const double h =
       std::max(params_.hysteresis_abs_m_s2, params_.hysteresis_fraction * amplitude_m_s2_);
   if (!rising_) {
@@ -663,6 +699,7 @@ bool GaitPhaseStepDetector::update_body(const ImuSample& s, double dt, StepEvent
   const double swing = peak_m_s2_ - valley_m_s2_;
   rising_ = false;
   valley_m_s2_ = v;
+  rise_ = rise_before_rest_ = {.valley_m_s2 = v, .valley_t_s = s.t_s, .top_m_s2 = v};
   if (have_step_ && peak_t_s_ - last_step_t_s_ < params_.min_body_interval_s) {
     ++diag_.rejected_timing;
     return release_body_step(event);
@@ -675,10 +712,21 @@ bool GaitPhaseStepDetector::update_body(const ImuSample& s, double dt, StepEvent
   // +0.18 s per file, -0.04 to +0.08 s with the delay taken off).
   const bool first = !have_step_ || peak_t_s_ - last_step_t_s_ > params_.pause_s;
   const double interval = first ? 0.0 : peak_t_s_ - last_step_t_s_;
+  step_interval_s_ = interval;
   last_step_t_s_ = peak_t_s_;
   have_step_ = true;
+  closed_ = false;
   hold_body_step(peak_t_s_ - vertical_delay_s(interval), peak_m_s2_, first);
   return release_body_step(event);
+}
+
+bool GaitPhaseStepDetector::closing_step_due(double t_s) const {
+  const BodyRise& r = rise_before_rest_;
+  return params_.closing_rise_m_s2 > 0.0 && have_step_ && !closed_ &&
+         t_s - last_step_t_s_ <= params_.pause_s && t_s - rest_since_t_s_ >= params_.rest_s &&
+         r.top_m_s2 - r.valley_m_s2 >= params_.closing_rise_m_s2 &&
+         r.steepest_m_s3 >= params_.closing_rise_m_s2 / params_.closing_rise_s &&
+         r.steepest_t_s - last_step_t_s_ >= params_.min_body_interval_s;
 }
 
 double GaitPhaseStepDetector::vertical_delay_s(double interval_s) const {
@@ -695,13 +743,15 @@ void GaitPhaseStepDetector::hold_body_step(double t_s, double peak_m_s2, bool fi
   // The ring never fills: every update releases a step once the first is judged, which is at
   // most first_step_followers + 1 <= kBodyHeld - 1 steps in, and steps are 0.25 s apart.
   // The walk before is over: its first step is judged on what it had.
-  if (first_of_walk && judging_first_) judge_first_body_step();
+  if (first_of_walk && judging_first_) judge_first_body_step(false);
   body_held_.push(t_s, peak_m_s2);
-  if (first_of_walk && params_.mount == StepMount::kBody && params_.first_step_fraction > 0.0)
+  if (first_of_walk && params_.mount == StepMount::kBody && params_.first_step_fraction > 0.0) {
     judging_first_ = true;
+    first_drops_ = 0;
+  }
 }
 
-void GaitPhaseStepDetector::judge_first_body_step() {
+void GaitPhaseStepDetector::judge_first_body_step(bool again) {
   judging_first_ = false;
   // The median peak of the steps after it (at most first_step_followers, all held).
   const std::size_t n = body_held_.size() - 1;
@@ -712,6 +762,10 @@ void GaitPhaseStepDetector::judge_first_body_step() {
   if (body_held_.note(0) < params_.first_step_fraction * median) {
     ++diag_.rejected_amplitude;
     body_held_.drop_oldest();
+    // The walk's next step is judged as its first was (the push after the weight shift), once
+    // it has its followers, unless a new walk forced this judgement (`again` false).
+    if (again && ++first_drops_ < params_.first_steps_judged && body_held_.size() > 1)
+      judging_first_ = true;
   }
 }
 
@@ -722,7 +776,7 @@ bool GaitPhaseStepDetector::release_body_step(StepEvent& event) {
     const auto followers = static_cast<std::size_t>(
         std::clamp(params_.first_step_followers, 1, static_cast<int>(kBodyHeld) - 2));
     if (body_held_.size() > followers || last_t_s_ - last_step_t_s_ > params_.pause_s)
-      judge_first_body_step();
+      judge_first_body_step(true);
     if (judging_first_) return false;
   }
   if (body_held_.size() == 0) return false;
@@ -731,7 +785,7 @@ bool GaitPhaseStepDetector::release_body_step(StepEvent& event) {
 }
 
 bool GaitPhaseStepDetector::flush(StepEvent& event) {
-  if (judging_first_) judge_first_body_step();
+  while (judging_first_) judge_first_body_step(true);
   return release_body_step(event);
 }
 

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 
 namespace telltale::fusion::sim {
 namespace {
@@ -57,8 +58,9 @@ TEST(GaitSim, AtRestTheSensorsSeeGravityAndTheEarthField) {
 TEST(GaitSim, PhoneRateStaysPhysicalWhenTheWalkStartsAndStops) {
   for (const char* name : {"phone-hand-held-walk", "phone-call-walk", "phone-pocket-walk"}) {
     for (std::uint64_t seed = 1; seed <= 5; ++seed) {
-      const auto run = simulate_gait(*make_gait_scenario(name, seed), random_person(seed), seed);
-      const double t_start = run.step_times_s.front();
+      const auto sc = make_gait_scenario(name, seed);
+      const auto run = simulate_gait(*sc, random_person(seed), seed);
+      const double t_start = sc->standing_s;  // the walk starts (its first heel strike is later)
       const double t_stop = run.samples.back().imu.t_s - 2.0;  // standing 2 s after the walk
       double worst = 0.0;
       for (const auto& s : run.samples)
@@ -83,6 +85,42 @@ TEST(GaitSim, TruthBookkeepingAddsUp) {
     for (const auto& s : run.samples) mean_mag += s.imu.acc_body_m_s2.norm();
     mean_mag /= static_cast<double>(run.samples.size());
     EXPECT_GT(mean_mag, kG - 0.2) << name;
+  }
+}
+
+// A walk starts and ends as a real one does (the IPOL lower-back trials): at its start no heel
+// strike loads the trunk, only the push of the first toe-off lifts it, by a quarter of a
+// loading (the truth's first heel strike is a step later); it ends at the closing heel strike,
+// whose loading brings the trunk to rest, in a walk and a run alike (a run cannot stop in
+// mid-flight). Measured on the trunk's specific force |f| - g, at 100 Hz, without sensor noise.
+TEST(GaitSim, AWalkStartsWithAPushAndEndsAtAClosingHeelStrike) {
+  for (const char* gait : {"slow-walk", "walk", "fast-walk", "jog", "run"}) {
+    for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+      auto sc = make_gait_scenario(std::string("body-") + gait, seed);
+      ASSERT_TRUE(sc);
+      sc->errors = {.acc_noise_m_s2 = 0.0,
+                    .acc_bias_m_s2 = 0.0,
+                    .gyro_noise_rad_s = 0.0,
+                    .gyro_bias_rad_s = 0.0,
+                    .mag_noise_uT = 0.0,
+                    .mag_bias_uT = 0.0};
+      const auto run = simulate_gait(*sc, random_person(seed), seed);
+      const double start = sc->standing_s, first_hs = run.step_times_s.front();
+      const double closing = run.step_times_s.back();
+      const double step = first_hs - start;  // step 0's period
+      EXPECT_GT(step, 0.25) << gait << " seed " << seed;
+      double push = 0, walk = 0, after_closing = 0, standing = 0;
+      for (const auto& s : run.samples) {
+        const double t = s.imu.t_s, f = s.imu.acc_body_m_s2.norm() - kG;
+        if (t >= start && t < start + 0.25 * step) push = std::max(push, f);
+        if (t > first_hs + 2.0 && t < closing - 2.0) walk = std::max(walk, f);
+        if (t >= closing && t < closing + 0.15) after_closing = std::max(after_closing, f);
+        if (t > closing + 0.5) standing = std::max(standing, std::abs(f));
+      }
+      EXPECT_LT(push, 0.4 * walk) << gait << " seed " << seed;
+      EXPECT_GT(after_closing, 0.5 * walk) << gait << " seed " << seed;
+      EXPECT_LT(standing, 0.05) << gait << " seed " << seed;
+    }
   }
 }
 

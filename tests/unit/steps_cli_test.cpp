@@ -99,11 +99,13 @@ TEST_F(StepsCli, IpolReadmeRuleLeavesTheUTurnOutOfTheAnnotationsToo) {
   fs::create_directories(path("data/ipol_gait"));
   std::ofstream csv(path("data/ipol_gait/9-1_lb.imu.csv"));
   csv << "t_s,ax_m_s2,ay_m_s2,az_m_s2,gx_rad_s,gy_rad_s,gz_rad_s\n";
-  // Walking from 2 s to 8 s: the trunk's vertical force -1.5 cos(2 pi 2 t) peaks once a step,
-  // at the loading after each heel strike: 2.25, 2.75, ..., 7.75 s.
+  // Walking from 2 s to 7.875 s: the trunk's vertical force -1.5 cos(2 pi 2 t) peaks once a
+  // step, at the loading after each heel strike: 2.25, 2.75, ..., 7.75 s; the last loading
+  // settles into standing (a walk that stopped in mid-fall, at a valley, would end with the
+  // closing heel strike that catches it: one more step).
   for (int n = 0; n < 1000; ++n) {
     const double t = n / 100.0;
-    const double walking = (t >= 2.0 && t < 8.0) ? 1.0 : 0.0;
+    const double walking = (t >= 2.0 && t < 7.875) ? 1.0 : 0.0;
     const double az = 9.81 - walking * 1.5 * std::cos(2.0 * M_PI * 2.0 * (t - 2.0));
     csv << t << ",0.1,0.2," << az << ",0,0,0\n";
   }

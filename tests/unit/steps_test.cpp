@@ -124,13 +124,19 @@ std::string case_name(const testing::TestParamInfo<GaitCase>& info) {
 class GaitAccuracy : public testing::TestWithParam<GaitCase> {};
 
 // Given 10 simulated people (1.55-1.95 m, own cadence and step length) in one gait, when each
-// detector counts, then the seed-004 adaptive detector is >= 99 % accurate for every person's
-// mean, never worse than the baselines, and the baselines' figures are reported beside it.
-TEST_P(GaitAccuracy, AdaptiveDetectorAtLeast99PercentAndBaselinesBeside) {
+// detector counts, then the mount's lead detector is >= 99 % accurate for every person's mean
+// (>= 97 % for the worst person) and never worse than the peak and fixed-threshold baselines,
+// and every detector's figure is reported beside it. The lead is the seed-004 adaptive detector
+// on the foot; on the trunk it is gait-phase (`fusion_cli steps --mount body`): since the
+// simulated walk starts from standing with the push of its first toe-off and ends at a closing
+// heel strike (sim/gait_sim.cpp), adaptive misses the first step after standing, as it does on
+// the IPOL lower-back trials (docs/steps.md). Seed 004 claims 98 % for it: asserted too.
+TEST_P(GaitAccuracy, LeadDetectorAtLeast99PercentAndBaselinesBeside) {
   const auto& c = GetParam();
   const auto mount = c.site == "foot" ? StepMount::kFoot : StepMount::kBody;
+  const std::string lead = mount == StepMount::kFoot ? "adaptive" : "gait-phase";
   std::map<std::string, double> mean;
-  double worst_adaptive = 1.0;
+  double worst_lead = 1.0;
   for (int p = 1; p <= 10; ++p) {
     const auto seed = static_cast<std::uint64_t>(p);
     const auto sc = sim::make_gait_scenario(c.site + "-" + c.gait, seed);
@@ -143,14 +149,15 @@ TEST_P(GaitAccuracy, AdaptiveDetectorAtLeast99PercentAndBaselinesBeside) {
       auto d = make_step_detector(name, mount);
       const double acc = accuracy(count(*d, run.samples), truth);
       mean[std::string(name)] += acc / 10.0;
-      if (name == "adaptive") worst_adaptive = std::min(worst_adaptive, acc);
+      if (name == lead) worst_lead = std::min(worst_lead, acc);
     }
   }
   for (const auto& [name, acc] : mean) RecordProperty(name, std::to_string(100.0 * acc));
-  EXPECT_GE(mean["adaptive"], 0.99);
-  EXPECT_GE(worst_adaptive, 0.97);
-  EXPECT_GE(mean["adaptive"] + 1e-12, mean["peak"]);
-  EXPECT_GE(mean["adaptive"] + 1e-12, mean["fixed-threshold"]);
+  EXPECT_GE(mean[lead], 0.99);
+  EXPECT_GE(worst_lead, 0.97);
+  EXPECT_GE(mean[lead] + 1e-12, mean["peak"]);
+  EXPECT_GE(mean[lead] + 1e-12, mean["fixed-threshold"]);
+  EXPECT_GE(mean["adaptive"], 0.98);
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryGait, GaitAccuracy,
@@ -451,25 +458,32 @@ std::vector<ImuSample> foot_walk(double rate_hz, int normal) {
 /// +-1.5 m/s^2 between a first step of +-`first` m/s^2 (starting: the IPOL lower-back trials'
 /// first heel strikes load the trunk 0.47-1.1 times the walk's) and a last step of +-0.5 m/s^2
 /// (stopping), standing. With `push`, the step is preceded by the first toe-off's push of gait
-/// initiation, +-`push` m/s^2 (0.07-0.39 of the walk's there). The raw signal's peaks (the
-/// loading after each heel strike) are at t0 + (i + 0.5) / 1.8 s, i = 0 .. normal + 1.
+/// initiation, +-`push` m/s^2 (0.07-0.39 of the walk's there), and with `shift` that by the weight
+/// shifted onto the stance leg, +-`shift`. The raw signal's peaks (the loading after each heel
+/// strike) are at t0 + (i + 0.5) / 1.8 s, i = 0 .. normal + 1. The walk ends as the last loading
+/// settles into standing, or, with `closing`, a quarter step later: at the last step's lowest
+/// point, from which the closing heel strike's loading lifts the trunk to standing (by 0.5 m/s^2,
+/// less than the walk's hysteresis, and without a fall after it).
 constexpr double kTrunkT0 = 2.0, kTrunkHz = 1.8;
-std::vector<ImuSample> trunk_walk(double rate_hz, int normal, double first = 0.8,
-                                  double push = 0.0) {
+std::vector<ImuSample> trunk_walk(double rate_hz, int normal, double first = 0.8, double push = 0.0,
+                                  double shift = 0.0, bool closing = false) {
   const int steps = normal + 2;
   const double f_hz = kTrunkHz, t0 = kTrunkT0, t1 = t0 + steps / f_hz;
+  const double t_end = closing ? t1 + 0.25 / f_hz : t1 - 0.25 / f_hz;
   std::vector<ImuSample> out;
   for (int n = 0; n * (1.0 / rate_hz) < t1 + 2.0; ++n) {
     const double ts = n / rate_hz;
     // Tilted 20 deg: the vertical is not a sensor axis.
     const Eigen::Vector3d up(std::sin(0.35), 0.0, std::cos(0.35));
     double a = 0.03 * std::sin(31.0 * ts);
-    if (ts >= t0 && ts < t1) {
-      const int i = static_cast<int>((ts - t0) * f_hz);
+    if (ts >= t0 && ts < t_end) {
+      const int i = std::min(static_cast<int>((ts - t0) * f_hz), steps - 1);
       const double amp = i == 0 ? first : i == steps - 1 ? 0.5 : 1.5;
       a += -amp * std::cos(2.0 * M_PI * f_hz * (ts - t0));
     } else if (ts >= t0 - 1.0 / f_hz && ts < t0) {
       a += -push * std::cos(2.0 * M_PI * f_hz * (ts - t0));
+    } else if (ts >= t0 - 2.0 / f_hz && ts < t0 - 1.0 / f_hz) {
+      a += -shift * std::cos(2.0 * M_PI * f_hz * (ts - t0));
     }
     ImuSample s{ts, Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()),
                 (kG + a) * up + Eigen::Vector3d(0.0, 0.2 * a, 0.0)};
@@ -520,28 +534,72 @@ TEST(GaitPhaseStepDetector, TrunkDoesNotCountTheGaitInitiationPush) {
     EXPECT_EQ(count_samples(d, trunk_walk(rate, 0, 1.5)), 2u) << rate << " Hz";
     // A stream that ends 0.3 s after a walk's third step: the first is still being judged, and
     // flush() judges it and releases all three.
-    auto cut = trunk_walk(rate, 1, 1.5);
+    auto cut = trunk_walk(rate, 2, 1.5);
     std::erase_if(cut, [](const ImuSample& s) { return s.t_s > kTrunkT0 + 2.5 / kTrunkHz + 0.3; });
     EXPECT_EQ(count_samples(d, cut), 3u) << rate << " Hz";
+  }
+}
+
+// Given a walk from standing that begins with two rises, the weight shifted onto the stance leg
+// and then the push of the first toe-off (0.27 and 0.33 of the walk's loading), when gait-phase
+// counts a lower-back sensor's steps, then neither is a step: the first is judged against the
+// steps after it and dropped, and so is the next. Judging one only (first_steps_judged 1), the
+// push counts.
+TEST(GaitPhaseStepDetector, TrunkDoesNotCountTheWeightShiftBeforeThePush) {
+  for (double rate : {50.0, 100.0, 200.0}) {
+    GaitPhaseStepParams p;
+    p.mount = StepMount::kBody;
+    GaitPhaseStepDetector d(p);
+    EXPECT_EQ(count_samples(d, trunk_walk(rate, 10, 1.5, 0.5, 0.4)), 12u) << rate << " Hz";
+    EXPECT_EQ(d.diagnostics().rejected_amplitude, 2u) << rate << " Hz";
+    p.first_steps_judged = 1;
+    GaitPhaseStepDetector once(p);
+    EXPECT_EQ(count_samples(once, trunk_walk(rate, 10, 1.5, 0.5, 0.4)), 13u) << rate << " Hz";
+  }
+}
+
+// Given a walk that ends at the last step's lowest point, when gait-phase counts a lower-back
+// sensor's steps, then the closing heel strike, whose loading lifts the trunk to standing by less
+// than the walk's hysteresis and is followed by no fall, is a step (the IPOL lower-back trials
+// missed it in 14 of 22 files); off (closing_rise_m_s2 0) it is lost. A trunk that comes to rest
+// slowly after a walk (the vertical drifting back by 0.4 m/s^2 over a second, as the gravity
+// estimate settles) makes no step, nor does standing on after the closing step.
+TEST(GaitPhaseStepDetector, TrunkCountsTheClosingStepOfAWalk) {
+  for (double rate : {50.0, 100.0, 200.0}) {
+    GaitPhaseStepParams p;
+    p.mount = StepMount::kBody;
+    GaitPhaseStepDetector d(p);
+    EXPECT_EQ(count_samples(d, trunk_walk(rate, 10, 0.8, 0.0, 0.0, true)), 13u) << rate << " Hz";
+    p.closing_rise_m_s2 = 0.0;
+    GaitPhaseStepDetector off(p);
+    EXPECT_EQ(count_samples(off, trunk_walk(rate, 10, 0.8, 0.0, 0.0, true)), 12u) << rate << " Hz";
+    auto drift = trunk_walk(rate, 10);
+    const Eigen::Vector3d up(std::sin(0.35), 0.0, std::cos(0.35));
+    const double settled = kTrunkT0 + 11.75 / kTrunkHz;
+    for (auto& s : drift)
+      if (s.t_s >= settled) s.acc_body_m_s2 -= 0.4 * std::exp(-(s.t_s - settled)) * up;
+    EXPECT_EQ(count_samples(d, drift), 12u) << rate << " Hz";
   }
 }
 
 // Given a trunk whose loading peaks are known, when gait-phase reports a lower-back sensor's
 // steps, then each is reported at its raw peak (the heel strike's loading): the 3 Hz low-pass's
 // delay at the step frequency (0.09 s) taken off, within one sample interval and 0.01 s (a peak
-// is found at a sample). In order, every step out once flush() has released the last held ones.
+// is found at a sample); the closing step, which has no peak, at the lowest point its heel strike
+// ended, with the same delay taken off. In order, every step out once flush() has released the
+// last held ones.
 TEST(GaitPhaseStepDetector, TrunkReportsTheStepAtTheRawPeak) {
   for (double rate : {50.0, 100.0, 200.0}) {
     auto d = make_step_detector("gait-phase", StepMount::kBody);
-    const auto samples = trunk_walk(rate, 10, 1.5);
+    const auto samples = trunk_walk(rate, 10, 1.5, 0.0, 0.0, true);
     std::vector<double> times;
     StepEvent ev;
     for (const auto& s : samples)
       if (d->update(s, ev)) times.push_back(ev.t_s);
     while (d->flush(ev)) times.push_back(ev.t_s);
-    ASSERT_EQ(times.size(), 12u) << rate << " Hz";
+    ASSERT_EQ(times.size(), 13u) << rate << " Hz";
     for (std::size_t i = 0; i < times.size(); ++i) {
-      const double peak = kTrunkT0 + (static_cast<double>(i) + 0.5) / kTrunkHz;
+      const double peak = kTrunkT0 + (static_cast<double>(i) + (i < 12 ? 0.5 : 0.0)) / kTrunkHz;
       EXPECT_NEAR(times[i], peak, 0.01 + 1.0 / rate) << rate << " Hz, step " << i;
     }
   }

@@ -34,6 +34,9 @@ constexpr std::array<GaitRow, kGaitCount> kGaitTable = {{
     {2.90, 0.75, 0.35, 0.14, true},   // run ~3.8 m/s
 }};
 
+/// Gait initiation: the trunk's rise at the first toe-off, as a fraction of a step's loading.
+constexpr double kInitiationPush = 0.25;
+
 double minjerk(double x) {
   x = std::clamp(x, 0.0, 1.0);
   return x * x * x * (10.0 + x * (-15.0 + 6.0 * x));
@@ -188,10 +191,12 @@ class Simulator {
     const auto n = static_cast<std::size_t>(std::floor(t_stop / dt)) + 1;
     out.samples.reserve(n);
     for (std::size_t i = 0; i < n; ++i) out.samples.push_back(sample(static_cast<double>(i) * dt));
-    for (std::size_t k = 0; k < steps_.size(); ++k) {
+    // Heel strikes: step 0 starts from a standing foot (none), the closing one ends the walk.
+    for (std::size_t k = 1; k < steps_.size(); ++k) {
       out.step_times_s.push_back(steps_[k].t0);
-      if (k >= 2 && k % 2 == 0) out.foot_step_times_s.push_back(steps_[k].t0);
+      if (k % 2 == 0) out.foot_step_times_s.push_back(steps_[k].t0);
     }
+    out.step_times_s.push_back(t_end_);
     out.foot_step_times_s.push_back(t_end_);  // the final left heel strike closes the last swing
     out.distance_m = s_end_;
     return out;
@@ -293,6 +298,49 @@ class Simulator {
     b.arm_amp_dd = (a1 - a0) * (6.0 - 12.0 * u) / (T * T);
   }
 
+  /// The trunk's vertical acceleration (m/s^2, up) t_in seconds into step k; k = steps_.size():
+  /// after the walk, t_in seconds after its closing heel strike.
+  ///
+  /// Walking, an inverted pendulum: the centre of mass drops over half a step, lowest at the
+  /// heel strike, whose loading lifts it again. Running, a spring-mass: the vertical force a half
+  /// sine over the contact, mean g over the step. A walk starts and ends as a real one does
+  /// (IPOL lower-back trials, docs/steps.md): step 0 begins with no heel strike, only the push
+  /// of the swing leg's toe-off, which lifts the trunk by a fraction of a loading
+  /// (`kInitiationPush`: 0.07-0.39 of the walk's loading peaks on the real trials); the last
+  /// step ends at the closing heel strike, whose loading brings the trunk to rest (walking) or
+  /// is the landing that ends the last flight (running) -- the trunk cannot stop in mid-air.
+  [[nodiscard]] double trunk_up(std::size_t k, double t_in) const {
+    const bool closing = k >= steps_.size();
+    const Step& st = steps_[closing ? steps_.size() - 1 : k];
+    const GaitRow& row = kGaitTable[static_cast<std::size_t>(st.gait)];
+    const double T = st.period_s, L = st.length_m;
+    const double w2 = (kTwoPi / T) * (kTwoPi / T);
+    const double ph = t_in / T;
+    if (!row.running) {
+      const double leg = 0.53 * p_.height_m;
+      const double half = std::asin(std::min(0.9, L / (2.0 * leg)));
+      const double amp = 0.3 * p_.bounce_scale * leg * (1.0 - std::cos(half)) * w2;
+      const double impact = 0.35 * amp * std::exp(-t_in / 0.03) * std::sin(kTwoPi * 12.0 * t_in);
+      // The closing heel strike's loading, a quarter step down to standing.
+      if (closing) return ph < 0.25 ? amp * std::cos(kTwoPi * ph) + impact : 0.0;
+      // The push: a rise and fall over the quarter step a loading would take (net zero: the
+      // trunk leaves and returns to its standing height).
+      if (k == 0 && ph < 0.25) return kInitiationPush * amp * std::sin(4.0 * kTwoPi * ph);
+      return amp * std::cos(kTwoPi * ph) + (k == 0 ? 0.0 : impact);
+    }
+    const double beta = st.gait == Gait::kJog ? 0.72 : 0.62;
+    const double peak = p_.bounce_scale * 0.5 * M_PI * kG / beta;
+    const double g = p_.bounce_scale * kG;
+    const double impact = 4.0 * std::exp(-t_in / 0.02) * std::sin(kTwoPi * 15.0 * t_in);
+    // The landing: the contact's force rises as in a stride and leaves the runner standing.
+    if (closing)
+      return ph < beta ? peak * std::sin(M_PI * ph / beta) - g * (1.0 - ph / beta) + impact : 0.0;
+    const double contact = ph < beta ? peak * std::sin(M_PI * ph / beta) : 0.0;
+    // From standing the first contact is a push, not a landing.
+    if (k == 0) return ph < beta ? kInitiationPush * (contact - g) * (ph / beta) : -g;
+    return contact - g + impact;
+  }
+
   [[nodiscard]] Body body(double t) const {
     Body b;
     const auto k = step_index(t);
@@ -303,6 +351,7 @@ class Simulator {
     if (k >= static_cast<std::ptrdiff_t>(steps_.size())) {
       b.s = s_end_;
       b.gait = steps_.back().gait;
+      b.acc_w.z() = trunk_up(steps_.size(), t - t_end_);
       return b;
     }
     const Step& st = steps_[static_cast<std::size_t>(k)];
@@ -318,23 +367,7 @@ class Simulator {
     b.s = st.s0 + L * (ph + e * std::sin(kTwoPi * ph) / kTwoPi);
     b.v = L / T * (1.0 + e * std::cos(kTwoPi * ph));
     const double a_fwd = -(L / (T * T)) * e * kTwoPi * std::sin(kTwoPi * ph);
-    double a_up = 0;
-    const double leg = 0.53 * p_.height_m;
-    const double t_in = t - st.t0;
-    if (!row.running) {
-      // Inverted pendulum: COM drop over half a step, lowest at heel strike.
-      const double half = std::asin(std::min(0.9, L / (2.0 * leg)));
-      const double amp = 0.3 * p_.bounce_scale * leg * (1.0 - std::cos(half));
-      a_up = amp * (kTwoPi * f) * (kTwoPi * f) * std::cos(kTwoPi * ph);
-      a_up += 0.35 * amp * (kTwoPi * f) * (kTwoPi * f) * std::exp(-t_in / 0.03) *
-              std::sin(kTwoPi * 12.0 * t_in);
-    } else {
-      // Spring-mass: vertical force a half sine over the contact, mean g over the step.
-      const double beta = st.gait == Gait::kJog ? 0.72 : 0.62;
-      const double force = ph < beta ? 0.5 * M_PI * kG / beta * std::sin(M_PI * ph / beta) : 0.0;
-      a_up = p_.bounce_scale * force - kG * p_.bounce_scale;
-      a_up += 4.0 * std::exp(-t_in / 0.02) * std::sin(kTwoPi * 15.0 * t_in);
-    }
+    const double a_up = trunk_up(static_cast<std::size_t>(k), t - st.t0);
     const double sway = row.running ? 0.012 : 0.025;
     const double th = kTwoPi * b.stride_phase, th_d = kTwoPi * b.stride_rate;
     const double a_lat =
@@ -591,9 +624,7 @@ class Simulator {
     out.step_hz = b.step_hz;
     out.step_length_m = b.step_len;
     const auto k = step_index(t);
-    out.steps = k < 0 ? 0
-                      : static_cast<int>(std::min<std::ptrdiff_t>(
-                            k + 1, static_cast<std::ptrdiff_t>(steps_.size())));
+    out.steps = k < 0 ? 0 : static_cast<int>(k);  // heel strikes so far (none at step 0's start)
     int foot = 0;
     for (std::size_t i = 2; i < steps_.size(); i += 2)
       if (steps_[i].t0 <= t) ++foot;

@@ -392,7 +392,20 @@ class PeakValleyStepDetector final : public StepDetector {
 /// floor applies (standing sway: < 0.1 m/s^2); but a walk that starts from standing begins with
 /// the push of its first toe-off, which lifts the trunk too, by a fraction of a step's loading.
 /// So a walk's first step is held until the next `first_step_followers` (or the walk's end) and
-/// counts only if its peak reaches `first_step_fraction` of theirs (their median).
+/// counts only if its peak reaches `first_step_fraction` of theirs (their median). A walk from
+/// standing can begin with two such rises, the weight shifted onto the stance leg and then the
+/// push, 0.3-0.6 s apart (IPOL 2-1, 2-4, 4-1: the first 0.23-0.29 of the walk's peaks, the
+/// second 0.12, 0.35 and 0.65): when the first is dropped, the next is judged the same way, up to
+/// `first_steps_judged`.
+/// The closing step of a walk, the heel strike that brings the trunk to rest, is no such rise
+/// and fall: its loading lifts the vertical from the last fall (the trunk vaulting over the
+/// stance leg) and the trunk then stands, with no fall after it for the rule above, and often
+/// less than its floor (IPOL lower back: 0.12-1.2 m/s^2, missed in 14 of 22 files). So a rise
+/// of `closing_rise_m_s2` since the lowest point after the walk's last step, steep as a heel
+/// strike's loading is (`closing_rise_m_s2` within `closing_rise_s`: the weight accepted in
+/// ~0.1 s; the gravity estimate settling after a walk drifts at under 1 m/s^3), after which the
+/// vertical stays within `rest_band_m_s2` (a standing trunk's sway) for `rest_s`, is the
+/// closing step: one per walk, within `pause_s` of its last step.
 ///
 /// Both hold from 50 to 200 Hz: every filter and duration is in seconds, none in samples.
 struct GaitPhaseStepParams {
@@ -427,6 +440,13 @@ struct GaitPhaseStepParams {
   /// The steps it is compared with: three, so that one odd step (a turn's, one missed) does not
   /// decide (at most kBodyHeld - 2).
   int first_step_followers = 3;
+  /// A walk's leading rises judged so (the weight shift and the push: two).
+  int first_steps_judged = 2;
+  /// Body: the closing step (above). 0: off.
+  double closing_rise_m_s2 = 0.2;  ///< smallest rise of the closing step, m/s^2
+  double closing_rise_s = 0.1;     ///< ...at least as steep as that in this long, s
+  double rest_band_m_s2 = 0.2;     ///< the trunk at rest: the vertical within this band, m/s^2
+  double rest_s = 0.5;             ///< ...for this long, s
 };
 class GaitPhaseStepDetector final : public StepDetector {
  public:
@@ -450,7 +470,9 @@ class GaitPhaseStepDetector final : public StepDetector {
   /// Body: a step found (its time, its peak), the first of a walk or not.
   void hold_body_step(double t_s, double peak_m_s2, bool first_of_walk);
   /// Body: the first step held, judged against the ones after it (dropped or kept).
-  void judge_first_body_step();
+  void judge_first_body_step(bool again);
+  /// Body: the walk's closing step is to be counted now.
+  [[nodiscard]] bool closing_step_due(double t_s) const;
   /// Body: the oldest held step that may go, as `event`.
   bool release_body_step(StepEvent& event);
   /// Foot: the heel strike of the swing just ended, or -1 when the rate about the medio-lateral
@@ -492,11 +514,28 @@ class GaitPhaseStepDetector final : public StepDetector {
   double peak_m_s2_ = -1e9;
   double peak_t_s_ = 0.0;
   double amplitude_m_s2_ = 0.0;  ///< recent peak-to-valley (0: none since the last pause)
+  double step_interval_s_ = 0.0;  ///< the last step's interval (0: a walk's first)
+  /// Body: a rise of the vertical, from the lowest point since the last step.
+  struct BodyRise {
+    double valley_m_s2 = 1e9;
+    double valley_t_s = 0.0;
+    double top_m_s2 = -1e9;
+    double steepest_m_s3 = 0.0;  ///< its steepest slope
+    double steepest_t_s = 0.0;   ///< ...and when
+  };
+  BodyRise rise_;              ///< the rise in progress
+  BodyRise rise_before_rest_;  ///< the rise as the vertical last entered a standing band
+  double last_v_m_s2_ = 0.0;
+  double rest_lo_m_s2_ = 0.0;  ///< the band the vertical has stayed in since rest_since_t_s_
+  double rest_hi_m_s2_ = 0.0;
+  double rest_since_t_s_ = 0.0;
+  bool closed_ = false;  ///< the walk's closing step has been counted
   /// Body: steps found and not yet reported, in order, each with its peak (m/s^2); the oldest
   /// is a walk's first under judgement while judging_first_.
   static constexpr std::size_t kBodyHeld = 8;
   HeldSteps<double, kBodyHeld> body_held_;
   bool judging_first_ = false;
+  int first_drops_ = 0;  ///< a walk's leading steps dropped so far
 };
 
 /// Steps from a swinging arm (a phone carried in the hand, arm swinging): the arm turns forward
