@@ -405,7 +405,10 @@ class PeakValleyStepDetector final : public StepDetector {
 /// strike's loading is (`closing_rise_m_s2` within `closing_rise_s`: the weight accepted in
 /// ~0.1 s; the gravity estimate settling after a walk drifts at under 1 m/s^3), after which the
 /// vertical stays within `rest_band_m_s2` (a standing trunk's sway) for `rest_s`, is the
-/// closing step: one per walk, within `pause_s` of its last step.
+/// closing step: one per walk, within `pause_s` of its last step and, by its steepest rise, at
+/// least `min_body_interval_s` after it (the trunk settling after a closing step the rise-and-fall
+/// rule counted, 0.11-0.18 s after that step's peak, is no second one). It is reported at the
+/// rise's lowest point (the heel strike ended the fall), less the low-pass's delay.
 ///
 /// Both hold from 50 to 200 Hz: every filter and duration is in seconds, none in samples.
 struct GaitPhaseStepParams {
