@@ -647,7 +647,7 @@ bool GaitPhaseStepDetector::update_body(const ImuSample& s, double dt, StepEvent
   // (its size, its steepest slope and when), as it was when the vertical last entered the band
   // it has stayed in since.
   if (v < rise_.valley_m_s2) {
-    rise_ = {.valley_m_s2 = v, .valley_t_s = s.t_s, .top_m_s2 = v};
+    rise_ = BodyRise::at(v, s.t_s);
   } else {
     rise_.top_m_s2 = std::max(rise_.top_m_s2, v);
     const double slope = dt > 0.0 ? (v - last_v_m_s2_) / dt : 0.0;
@@ -671,9 +671,7 @@ bool GaitPhaseStepDetector::update_body(const ImuSample& s, double dt, StepEvent
     // that (the trunk never at rest) goes on under the rules below. The heel strike ended the
     // fall: it is the lowest point, less the low-pass's delay at the walk's step frequency.
     const BodyRise r = rise_before_rest_;
-    rising_ = false;
-    valley_m_s2_ = v;
-    rise_ = rise_before_rest_ = {.valley_m_s2 = v, .valley_t_s = s.t_s, .top_m_s2 = v};
+    restart_after_step(v, s.t_s);
     closed_ = true;
     last_step_t_s_ = r.valley_t_s;
     hold_body_step(r.valley_t_s - vertical_delay_s(step_interval_s_), r.top_m_s2, false);
@@ -697,9 +695,7 @@ bool GaitPhaseStepDetector::update_body(const ImuSample& s, double dt, StepEvent
   if (v >= peak_m_s2_ - h) return release_body_step(event);
   // A rise and a fall of h each: one step, at its peak.
   const double swing = peak_m_s2_ - valley_m_s2_;
-  rising_ = false;
-  valley_m_s2_ = v;
-  rise_ = rise_before_rest_ = {.valley_m_s2 = v, .valley_t_s = s.t_s, .top_m_s2 = v};
+  restart_after_step(v, s.t_s);
   if (have_step_ && peak_t_s_ - last_step_t_s_ < params_.min_body_interval_s) {
     ++diag_.rejected_timing;
     return release_body_step(event);
@@ -718,6 +714,14 @@ bool GaitPhaseStepDetector::update_body(const ImuSample& s, double dt, StepEvent
   closed_ = false;
   hold_body_step(peak_t_s_ - vertical_delay_s(interval), peak_m_s2_, first);
   return release_body_step(event);
+}
+
+void GaitPhaseStepDetector::restart_after_step(double v, double t_s) {
+  rising_ = false;
+  valley_m_s2_ = v;
+  // Both rises start here: a snapshot from before the step would make an old rise this walk's
+  // closing step.
+  rise_ = rise_before_rest_ = BodyRise::at(v, t_s);
 }
 
 bool GaitPhaseStepDetector::closing_step_due(double t_s) const {

@@ -474,6 +474,8 @@ class GaitPhaseStepDetector final : public StepDetector {
   void hold_body_step(double t_s, double peak_m_s2, bool first_of_walk);
   /// Body: the first step held, judged against the ones after it (dropped or kept).
   void judge_first_body_step(bool again);
+  /// Body: a step was counted at the vertical v: the next rise and fall start from here.
+  void restart_after_step(double v, double t_s);
   /// Body: the walk's closing step is to be counted now.
   [[nodiscard]] bool closing_step_due(double t_s) const;
   /// Body: the oldest held step that may go, as `event`.
@@ -525,6 +527,10 @@ class GaitPhaseStepDetector final : public StepDetector {
     double top_m_s2 = -1e9;
     double steepest_m_s3 = 0.0;  ///< its steepest slope
     double steepest_t_s = 0.0;   ///< ...and when
+    /// A rise starting at the vertical v (m/s^2) at t_s.
+    static BodyRise at(double v, double t_s) {
+      return {.valley_m_s2 = v, .valley_t_s = t_s, .top_m_s2 = v};
+    }
   };
   BodyRise rise_;              ///< the rise in progress
   BodyRise rise_before_rest_;  ///< the rise as the vertical last entered a standing band
