@@ -10,7 +10,7 @@
 namespace telltale::fusion {
 namespace {
 
-constexpr double kG = 9.80665;
+constexpr double kG = kStandardGravity_m_s2;
 
 /// The detectors' use of the one IMU gate (gate_imu_sample): finite time and accelerometer,
 /// time advancing; the gyro may be missing (the detectors that use it check gyro_finite).

@@ -8,7 +8,7 @@
 namespace telltale::fusion::sim {
 namespace {
 
-constexpr double kG = 9.80665;
+constexpr double kG = kStandardGravity_m_s2;
 constexpr double kDeg = M_PI / 180.0;
 constexpr double kTwoPi = 2.0 * M_PI;
 

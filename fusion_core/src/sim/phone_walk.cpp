@@ -10,7 +10,7 @@
 namespace telltale::fusion::sim {
 namespace {
 
-constexpr double kG = 9.80665;
+constexpr double kG = kStandardGravity_m_s2;
 constexpr double kTilt = 50.0 * M_PI / 180.0;  // the screen tilted toward the face
 
 Eigen::Vector3d normal3(Rng& rng) { return {rng.normal(), rng.normal(), rng.normal()}; }

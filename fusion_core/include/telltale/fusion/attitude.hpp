@@ -26,8 +26,6 @@
 
 namespace telltale::fusion {
 
-inline constexpr double kStandardGravity_m_s2 = 9.80665;
-
 /// What every attitude filter reports after each update.
 struct AttitudeOutput {
   double heel_rad = 0.0;          ///< + = starboard down

@@ -9,6 +9,9 @@
 
 namespace telltale::fusion {
 
+/// Standard gravity, m/s^2: what an accelerometer at rest reads (specific force, +g up).
+inline constexpr double kStandardGravity_m_s2 = 9.80665;
+
 /// One inertial sample in the body frame (FLU).
 struct ImuSample {
   double t_s = 0.0;                                       ///< sample time, seconds (any epoch)
