@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "csv.hpp"
+#include "telltale/fusion/gait_phase_steps.hpp"
 #include "telltale/fusion/sim/gait_sim.hpp"
 
 namespace telltale::fusion {
