@@ -301,33 +301,22 @@ class Simulator {
   /// The trunk's vertical acceleration (m/s^2, up) t_in seconds into step k; k = steps_.size():
   /// after the walk, t_in seconds after its closing heel strike.
   ///
-  /// Walking, an inverted pendulum: the centre of mass drops over half a step, lowest at the
-  /// heel strike, whose loading lifts it again. Running, a spring-mass: the vertical force a half
-  /// sine over the contact, mean g over the step. A walk starts and ends as a real one does
-  /// (IPOL lower-back trials, docs/steps.md): step 0 begins with no heel strike, only the push
-  /// of the swing leg's toe-off, which lifts the trunk by a fraction of a loading
-  /// (`kInitiationPush`: 0.07-0.39 of the walk's loading peaks on the real trials); the last
-  /// step ends at the closing heel strike, whose loading brings the trunk to rest (walking) or
-  /// is the landing that ends the last flight (running) -- the trunk cannot stop in mid-air.
+  /// Walking: walking_trunk_up (gait_sim.hpp). Running, a spring-mass: the vertical force a
+  /// half sine over the contact, mean g over the step. A run starts and ends as a walk does:
+  /// step 0 begins with the push of the first toe-off (`kInitiationPush` of a contact), and the
+  /// last step ends at the landing that ends the last flight -- the trunk cannot stop in mid-air.
   [[nodiscard]] double trunk_up(std::size_t k, double t_in) const {
     const bool closing = k >= steps_.size();
     const Step& st = steps_[closing ? steps_.size() - 1 : k];
     const GaitRow& row = kGaitTable[static_cast<std::size_t>(st.gait)];
     const double T = st.period_s, L = st.length_m;
-    const double w2 = (kTwoPi / T) * (kTwoPi / T);
-    const double ph = t_in / T;
     if (!row.running) {
-      const double leg = 0.53 * p_.height_m;
-      const double half = std::asin(std::min(0.9, L / (2.0 * leg)));
-      const double amp = 0.3 * p_.bounce_scale * leg * (1.0 - std::cos(half)) * w2;
-      const double impact = 0.35 * amp * std::exp(-t_in / 0.03) * std::sin(kTwoPi * 12.0 * t_in);
-      // The closing heel strike's loading, a quarter step down to standing.
-      if (closing) return ph < 0.25 ? amp * std::cos(kTwoPi * ph) + impact : 0.0;
-      // The push: a rise and fall over the quarter step a loading would take (net zero: the
-      // trunk leaves and returns to its standing height).
-      if (k == 0 && ph < 0.25) return kInitiationPush * amp * std::sin(4.0 * kTwoPi * ph);
-      return amp * std::cos(kTwoPi * ph) + (k == 0 ? 0.0 : impact);
+      const WalkStep which = closing  ? WalkStep::kClosing
+                             : k == 0 ? WalkStep::kFirst
+                                      : WalkStep::kWithin;
+      return walking_trunk_up(which, t_in, T, L, p_.height_m, p_.bounce_scale);
     }
+    const double ph = t_in / T;
     const double beta = st.gait == Gait::kJog ? 0.72 : 0.62;
     const double peak = p_.bounce_scale * 0.5 * M_PI * kG / beta;
     const double g = p_.bounce_scale * kG;
@@ -644,6 +633,24 @@ class Simulator {
 };
 
 }  // namespace
+
+double walking_trunk_up(WalkStep step, double t_in_s, double period_s, double length_m,
+                        double height_m, double bounce_scale) {
+  const double T = period_s;
+  const double w2 = (kTwoPi / T) * (kTwoPi / T);
+  const double ph = t_in_s / T;
+  const double leg = 0.53 * height_m;
+  const double half = std::asin(std::min(0.9, length_m / (2.0 * leg)));
+  const double amp = 0.3 * bounce_scale * leg * (1.0 - std::cos(half)) * w2;
+  const double impact = 0.35 * amp * std::exp(-t_in_s / 0.03) * std::sin(kTwoPi * 12.0 * t_in_s);
+  // The closing heel strike's loading, a quarter step down to standing.
+  if (step == WalkStep::kClosing) return ph < 0.25 ? amp * std::cos(kTwoPi * ph) + impact : 0.0;
+  // The push: a rise and fall over the quarter step a loading would take (net zero: the trunk
+  // leaves and returns to its standing height).
+  const bool first = step == WalkStep::kFirst;
+  if (first && ph < 0.25) return kInitiationPush * amp * std::sin(4.0 * kTwoPi * ph);
+  return amp * std::cos(kTwoPi * ph) + (first ? 0.0 : impact);
+}
 
 double Rng::normal() {
   if (has_spare_) {

@@ -12,6 +12,7 @@ namespace {
 
 constexpr double kG = kStandardGravity_m_s2;
 constexpr double kTilt = 50.0 * M_PI / 180.0;  // the screen tilted toward the face
+constexpr double kPressAfterStop_s = 0.5;      // a walk's end as its walker marks it
 
 Eigen::Vector3d normal3(Rng& rng) { return {rng.normal(), rng.normal(), rng.normal()}; }
 
@@ -36,14 +37,23 @@ PhoneWalk simulate_phone_walk(const std::vector<PhoneSegment>& plan, const Phone
   PhoneWalk w;
   const double dt = 1.0 / p.rate_hz;
   const double speed = p.step_length_m * p.step_hz;
-  double t = 0.0, heading = 0.3, walk_phase = 0.0;
+  const double period = 1.0 / p.step_hz;
+  double t = 0.0, heading = 0.3;
+  double walk_t = 0.0;      // time into the walk in progress (consecutive walking segments)
+  double closing_t = -1.0;  // time since the last walk's closing heel strike (< 0: none)
   bool walked = false;
   // Orientations and world accelerations sampled; the gyro is the rotation between samples.
   std::vector<Eigen::Matrix3d> rot;
   std::vector<Eigen::Vector3d> acc_world;
   std::vector<double> times;
-  for (const auto& seg : plan) {
+  for (std::size_t si = 0; si < plan.size(); ++si) {
+    const PhoneSegment& seg = plan[si];
     const double t_start = t;
+    const bool walking = seg.phase == PhonePhase::kWalking;
+    const bool walk_goes_on =
+        walking && si + 1 < plan.size() && plan[si + 1].phase == PhonePhase::kWalking;
+    if (walking && closing_t >= 0.0) walk_t = 0.0;  // a new walk from standing
+    if (walking) closing_t = -1.0;
     const int n = static_cast<int>(seg.duration_s * p.rate_hz);
     // Handling: a random rotation axis and angle per 1.5 s, in and out smoothly, and the hand's
     // jerks (the angles reach 60-170 deg: rates of 2-7 rad/s).
@@ -75,21 +85,37 @@ PhoneWalk simulate_phone_walk(const std::vector<PhoneSegment>& plan, const Phone
           heading = heading0 + seg.turn_deg * M_PI / 180.0 * std::min(1.0, ts / 2.0);
           r = phone_held_in_front(heading + wander, tremor);
           a = 0.1 * normal3(rng);
+          // The walk before ended at its closing heel strike: the trunk settles over a quarter
+          // step.
+          if (closing_t >= 0.0) {
+            a.z() += walking_trunk_up(WalkStep::kClosing, closing_t, period, p.step_length_m,
+                                      p.height_m, 1.0);
+            closing_t += dt;
+          }
           break;
         case PhonePhase::kWalking: {
           heading = heading0 + seg.turn_deg * M_PI / 180.0 * std::min(1.0, ts / 1.5);
-          walk_phase += 2.0 * M_PI * p.step_hz * dt;
-          const double ramp = std::min(1.0, ts / 0.3);
+          // The trunk's bounce (gait_sim's walker: the first step a push, each after it a heel
+          // strike's loading), the forward surge at the step's rate, the lateral sway at the
+          // stride's, and the hand's pitch with each step. The horizontal motions build up over
+          // the first step and die out over the last, as the walker's speed does.
+          const auto k = std::floor(walk_t / period);
+          const double t_in = walk_t - k * period;
+          const WalkStep which = k == 0.0 ? WalkStep::kFirst : WalkStep::kWithin;
+          const double phase = 2.0 * M_PI * walk_t / period;
+          const double left_in_walk = walk_goes_on ? period : seg.duration_s - ts;
+          const double blend = std::clamp(std::min(walk_t, left_in_walk) / period, 0.0, 1.0);
           const Eigen::Vector3d fwd(std::sin(heading), std::cos(heading), 0.0);
           const Eigen::Vector3d right(std::cos(heading), -std::sin(heading), 0.0);
-          a = ramp * (2.5 * std::sin(walk_phase) * Eigen::Vector3d::UnitZ() +
-                      1.2 * std::cos(walk_phase) * fwd + 0.5 * std::sin(0.5 * walk_phase) * right);
-          r = phone_held_in_front(heading + wander, tremor + 0.035 * std::sin(walk_phase));
-          const double v = speed * ramp;
-          w.truth.x_m += v * dt * std::sin(heading);
-          w.truth.y_m += v * dt * std::cos(heading);
-          w.truth.distance_m += v * dt;
-          w.truth.steps += p.step_hz * dt * ramp;
+          a = walking_trunk_up(which, t_in, period, p.step_length_m, p.height_m, 1.0) *
+                  Eigen::Vector3d::UnitZ() +
+              blend * (1.2 * std::sin(phase) * fwd + 0.5 * std::sin(0.5 * phase) * right);
+          r = phone_held_in_front(heading + wander, tremor + blend * 0.035 * std::sin(phase));
+          w.truth.x_m += speed * dt * std::sin(heading);
+          w.truth.y_m += speed * dt * std::cos(heading);
+          w.truth.distance_m += speed * dt;
+          w.truth.steps += p.step_hz * dt;
+          walk_t += dt;
           break;
         }
       }
@@ -97,10 +123,13 @@ PhoneWalk simulate_phone_walk(const std::vector<PhoneSegment>& plan, const Phone
       acc_world.push_back(a);
       times.push_back(t);
     }
-    if (seg.phase == PhonePhase::kWalking) {
+    if (walking) {
       if (!walked) w.truth.walk_start_s = t_start;
       walked = true;
-      w.truth.walk_end_s = t;
+      // A walker stops, then presses "here": the closing heel strike's loading is over within a
+      // quarter step, and the press comes after it.
+      w.truth.walk_end_s = walk_goes_on ? t : t + kPressAfterStop_s;
+      if (!walk_goes_on) closing_t = 0.0;
     } else {
       w.truth.quiet.emplace_back(t_start, t);
     }
@@ -131,11 +160,13 @@ std::vector<PhoneSegment> ipin_like_plan(std::uint64_t seed, double height_m,
   params.step_hz = rng.uniform(1.6, 2.0);
   params.step_length_m = walk_ratio_step_length_m(height_m, params.step_hz);
   params.gyro_bias_rad_s = 0.003 * normal3(rng);
-  const double speed = params.step_length_m * params.step_hz;
+  params.height_m = height_m;
   const double a = rng.uniform(8.0, 25.0), b = rng.uniform(8.0, 25.0);
   const double turn = rng.uniform() < 0.5 ? 90.0 : -90.0;
-  // The speed ramps up over 0.3 s: a leg lasts its length at speed plus half the ramp.
-  const auto leg = [speed](double len) { return len / speed + 0.15; };
+  // A leg is whole steps (a walk ends at a heel strike), the nearest count to its length.
+  const auto leg = [&params](double len) {
+    return std::max(1.0, std::round(len / params.step_length_m)) / params.step_hz;
+  };
   const int pause_a = static_cast<int>(rng.uniform(0.0, 3.0));  // two of the three inner corners
   std::vector<PhoneSegment> plan = {{PhonePhase::kHandling, rng.uniform(20.0, 40.0)},
                                     {PhonePhase::kStanding, rng.uniform(20.0, 40.0)},

@@ -83,6 +83,22 @@ struct Person {
 /// Draws a person: height uniform in [1.55, 1.95] m, cadence and step scales +-8 %, etc.
 [[nodiscard]] Person random_person(std::uint64_t seed);
 
+/// Which step of a walk: the first from standing, one within the walk, or the closing heel
+/// strike after its last step.
+enum class WalkStep { kFirst, kWithin, kClosing };
+
+/// The trunk's vertical acceleration (m/s^2, up) t_in_s into a walking step of `period_s` and
+/// `length_m`, for a person of `height_m` and `bounce_scale`; for kClosing, t_in_s after the
+/// closing heel strike. An inverted pendulum: the centre of mass drops over half a step, lowest
+/// at the heel strike, whose loading lifts it again (with the impact's 12 Hz ringing). A walk
+/// starts and ends as a real one does (IPOL lower-back trials, docs/steps.md): the first step
+/// begins with no heel strike, only the push of the swing leg's toe-off, which lifts the trunk by
+/// a fraction of a loading (0.25; 0.07-0.39 of the walk's loading peaks on the real trials) and
+/// returns it; the closing heel strike's loading brings the trunk to rest over a quarter step.
+/// The one walk of the simulators: gait_sim's walker and the phone walk (phone_walk.hpp).
+[[nodiscard]] double walking_trunk_up(WalkStep step, double t_in_s, double period_s,
+                                      double length_m, double height_m, double bounce_scale);
+
 /// Population gait table scaled for a person: step frequency (Hz) and step length (m).
 [[nodiscard]] double nominal_step_hz(Gait g, const Person& p);
 [[nodiscard]] double nominal_step_length_m(Gait g, const Person& p);

@@ -10,10 +10,15 @@
 /// Physics, in the world frame (ENU): the phone's orientation is sampled and the gyro is the
 /// rotation between consecutive samples (plus a constant bias and white noise); the specific
 /// force is gravity plus the motion's acceleration, rotated into the phone. A step is the trunk's
-/// bounce seen by a hand held in front: vertical 2.5 m/s^2, forward 1.2, lateral sway at half
-/// the cadence, the phone pitching 2 deg with each step; a corner turns the walker over its
-/// first 1.5 s (walking) or 2 s (standing). Every phase carries the hand's 8 Hz tremor (0.3 deg)
-/// and a +-1.5 deg yaw wander over 20 s. The field: Earth's (0, 20, -44) uT ENU, 0.4 uT of noise.
+/// bounce seen by a hand held in front: vertically gait_sim's walker (`walking_trunk_up`: a walk
+/// from standing begins with the push of its first toe-off and ends at its closing heel strike,
+/// whose loading settles into the stand or pause after it; 1.6-4.0 m/s^2 at 1.75 m and 1.6-2.0
+/// steps/s, the walk-ratio law lengthening the step with the cadence), forward
+/// 1.2 m/s^2 at the step's rate and a lateral sway at the stride's, the phone pitching 2 deg
+/// with each step, the horizontal motions building up over the first step and dying out over
+/// the last; a corner turns the walker over its first 1.5 s (walking) or 2 s (standing). Every
+/// phase carries the hand's 8 Hz tremor (0.3 deg) and a +-1.5 deg yaw wander over 20 s. The
+/// field: Earth's (0, 20, -44) uT ENU, 0.4 uT of noise.
 ///
 /// Deterministic on every platform (sim::Rng).
 
@@ -38,6 +43,7 @@ struct PhoneWalkParams {
   double rate_hz = 50.0;
   double step_hz = 1.8;
   double step_length_m = 0.7;  ///< the walker's step (truth)
+  double height_m = 1.75;      ///< the walker's (the trunk's bounce: sim::walking_trunk_up)
   Eigen::Vector3d gyro_bias_rad_s = Eigen::Vector3d::Zero();
 };
 
@@ -47,8 +53,11 @@ struct PhoneWalkTruth {
   double x_m = 0.0, y_m = 0.0;                   ///< where the walk ends (it starts at 0, 0)
   double heading_rad = 0.0;                      ///< walking direction at the end
   std::vector<std::pair<double, double>> quiet;  ///< [t0, t1] of handling, standing, pauses
-  double walk_start_s = 0.0,
-         walk_end_s = 0.0;  ///< the first walking segment's start, the last's end
+  double walk_start_s = 0.0;                     ///< the first walking segment's start
+  /// The walk's end as its walker would mark it (the IPIN logs' "here" pressed at the last
+  /// landmark): 0.5 s after the last walking segment, whose closing heel strike's loading is
+  /// over within a quarter step of it.
+  double walk_end_s = 0.0;
 };
 
 struct PhoneWalk {
