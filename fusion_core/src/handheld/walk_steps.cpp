@@ -75,6 +75,7 @@ int WalkStepDetector::update(const ImuSample& s, const Eigen::Vector3d& up) {
         Candidate c;
         c.t_s = st.peak_t_s;
         c.up = st.peak_up;
+        c.peak_m_s2 = st.peak_v;
         c.gyro_ms = st.w2_n > 0 ? st.w2_sum / st.w2_n : 0.0;
         st.w2_sum = 0.0;
         st.w2_n = 0;
@@ -114,6 +115,15 @@ int WalkStepDetector::on_candidate(const Candidate& c_in) {
     const double prev = st.held[static_cast<std::size_t>(st.held_n - 1)].interval_s;
     extends = interval <= params_.max_interval_ratio * prev &&
               prev <= params_.max_interval_ratio * interval;
+    if (!extends) {
+      // Out of the rhythm of the candidates before the last one, but a walking interval after
+      // it: a run may begin at the last one (a bounce of the hand while standing, then the
+      // walk's first step a second later, then its steps).
+      st.held[0] = st.held[static_cast<std::size_t>(st.held_n - 1)];
+      st.held[0].interval_s = 0.0;
+      st.held_n = 1;
+      extends = true;
+    }
   }
   if (!extends) {
     st.held_n = 0;
@@ -131,8 +141,18 @@ int WalkStepDetector::on_candidate(const Candidate& c_in) {
     double sum = 0.0;
     for (int i = 1; i < st.held_n; ++i) sum += st.held[static_cast<std::size_t>(i)].interval_s;
     st.interval_s = sum / (st.held_n - 1);
-    const int n = st.held_n;
-    std::copy(st.held.begin(), st.held.begin() + n, out_.begin());
+    // The push of gait initiation (Params): the run's first candidate against the median peak
+    // of the three after it (a run confirmed on fewer is taken whole).
+    int first = 0;
+    if (st.held_n >= 4) {
+      std::array<double, 3> next{};
+      for (std::size_t i = 0; i < next.size(); ++i) next[i] = st.held[i + 1].peak_m_s2;
+      std::sort(next.begin(), next.end());
+      first = st.held[0].peak_m_s2 < params_.first_step_fraction * next[1] ? 1 : 0;
+    }
+    const int n = st.held_n - first;
+    std::copy(st.held.begin() + first, st.held.begin() + st.held_n, out_.begin());
+    if (first == 1) out_[0].interval_s = 0.0;  // the walk's first step now
     st.held_n = 0;
     return n;
   }

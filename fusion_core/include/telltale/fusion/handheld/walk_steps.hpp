@@ -20,11 +20,19 @@ namespace telltale::fusion {
 /// also come from handling the phone and from a hand moving while the walker stands, so a peak
 /// is only a candidate: the detector says "walking" once `confirm_steps` candidates in a row have
 /// a walking cadence (intervals in [min_interval_s, max_interval_s], each within
-/// `max_interval_ratio` of the one before: gait is regular, handling is not) with the phone's tilt
+/// `max_interval_ratio` of the one before: gait is regular, handling is not; a candidate out of
+/// that rhythm begins a new run with the one before it, which may be a walk's first step after a
+/// bounce of the hand while standing) with the phone's tilt
 /// steady over them (up moved less than `max_tilt_deg` from their mean, the rate rms below
 /// `max_gyro_rms_rad_s`: a phone held in front while walking; handling turns it). Then the held
 /// candidates become steps, and every further candidate with a walking interval. A gap longer
 /// than `pause_intervals` step intervals (or max_interval_s) ends the walk: a pause.
+/// A walk from standing begins with the push of its first toe-off, which lifts the trunk, and
+/// the phone with it, about one step interval before the first heel strike: a bounce in the
+/// walk's rhythm, but a fraction of a heel strike's loading (0.07-0.39 of the walk's peaks on
+/// the IPOL lower-back trials, where the first heel strike's is 0.47-1.1). So a run's first
+/// candidate becomes a step only if its peak reaches `first_step_fraction` of the median of
+/// the three after it (IPIN phone walks: the first candidates of 12 runs reach 0.65-1.2).
 struct WalkStepParams {
   double smooth_s = 0.2;        ///< moving mean: a step's vertical bounce is 1.5-2.5 Hz
   double mean_s = 2.0;          ///< the specific force's mean over this is taken out (g, scale)
@@ -36,6 +44,7 @@ struct WalkStepParams {
   double max_tilt_deg = 20.0;
   double max_gyro_rms_rad_s = 1.5;
   double pause_intervals = 2.5;
+  double first_step_fraction = 0.4;  ///< of the next three peaks' median (0: every candidate)
 };
 class WalkStepDetector {
  public:
@@ -45,7 +54,8 @@ class WalkStepDetector {
     double t_s = 0.0;
     double interval_s = 0.0;  ///< since the previous candidate (0: first of a run)
     Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
-    double gyro_ms = 0.0;  ///< mean squared rate since the previous candidate
+    double gyro_ms = 0.0;    ///< mean squared rate since the previous candidate
+    double peak_m_s2 = 0.0;  ///< its peak of the smoothed vertical force, over its 2 s mean
   };
   struct State {
     // Moving sums (ring of the last mean_s of vertical force).
