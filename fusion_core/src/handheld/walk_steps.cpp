@@ -53,8 +53,13 @@ int WalkStepDetector::update(const ImuSample& s, const Eigen::Vector3d& up) {
   int emitted = 0;
   // A pause: no candidate for pause_intervals step intervals.
   if (st.walking) {
-    const double limit = std::min(params_.max_interval_s, params_.pause_intervals * st.interval_s);
-    if (s.t_s - st.last_cand_t_s > std::max(limit, params_.min_interval_s)) {
+    const double limit =
+        std::max(std::min(params_.max_interval_s, params_.pause_intervals * st.interval_s),
+                 params_.min_interval_s);
+    // A peak found in the walk's rhythm and still awaiting its valley keeps the walk going: the
+    // closing step's loading may settle slowly, its valley a second after its peak.
+    const bool pending = st.have_peak && st.peak_t_s - st.last_cand_t_s <= limit;
+    if (s.t_s - st.last_cand_t_s > limit && !pending) {
       st.walking = false;
       st.held_n = 0;
     }

@@ -26,7 +26,9 @@ namespace telltale::fusion {
 /// steady over them (up moved less than `max_tilt_deg` from their mean, the rate rms below
 /// `max_gyro_rms_rad_s`: a phone held in front while walking; handling turns it). Then the held
 /// candidates become steps, and every further candidate with a walking interval. A gap longer
-/// than `pause_intervals` step intervals (or max_interval_s) ends the walk: a pause.
+/// than `pause_intervals` step intervals (or max_interval_s) ends the walk: a pause -- unless a
+/// peak found within it still awaits its valley (a walk's closing step, whose loading may
+/// settle slowly: its valley a second after its peak).
 /// A walk from standing begins with the push of its first toe-off, which lifts the trunk, and
 /// the phone with it, about one step interval before the first heel strike: a bounce in the
 /// walk's rhythm, but a fraction of a heel strike's loading (0.07-0.39 of the walk's peaks on
