@@ -18,7 +18,7 @@ namespace telltale::sensors {
 namespace {
 
 constexpr std::uint8_t kHeader = 0x55;
-constexpr double kG = 9.80665;
+constexpr double kG = telltale::fusion::kStandardGravity_m_s2;
 constexpr double kDegToRad = M_PI / 180.0;
 
 std::int16_t i16(const std::uint8_t* p) {

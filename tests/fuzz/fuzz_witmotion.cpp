@@ -21,7 +21,7 @@ using telltale::sensors::WitMotionParams;
 using telltale::sensors::WitMotionStats;
 using telltale::sensors::WitSample;
 
-constexpr double kG = 9.80665;
+constexpr double kG = telltale::fusion::kStandardGravity_m_s2;
 
 struct Decoded {
   std::vector<WitSample> samples;

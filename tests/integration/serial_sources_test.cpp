@@ -23,7 +23,7 @@ namespace telltale::testing {
 namespace {
 
 using namespace std::chrono_literals;
-constexpr double kG = 9.80665;
+constexpr double kG = telltale::fusion::kStandardGravity_m_s2;
 constexpr double kDeg = M_PI / 180.0;
 
 std::string nmea(const std::string& body) {

@@ -17,7 +17,7 @@
 namespace telltale::fusion {
 namespace {
 
-constexpr double kG = 9.80665;
+constexpr double kG = telltale::fusion::kStandardGravity_m_s2;
 constexpr double kDeg = M_PI / 180.0;
 
 Eigen::Vector3d gravity_in_body(double heel_rad, double pitch_rad) {

@@ -23,7 +23,8 @@ TEST(AttitudeNoHeap, UpdateAllocatesNothing) {
     const double h = 0.3 * std::sin(0.5 * t);
     ImuSample s{t,
                 {0.15 * std::cos(0.5 * t), 0.02, 0.1},
-                {0.1, 9.80665 * std::sin(h), 9.80665 * std::cos(h)}};
+                {0.1, telltale::fusion::kStandardGravity_m_s2 * std::sin(h),
+                 telltale::fusion::kStandardGravity_m_s2 * std::cos(h)}};
     if (k == 700) s.acc_body_m_s2 = {20.0, -20.0, 20.0};
     if (k == 900) s.gyro_body_rad_s.x() = std::nan("");
     if (k == 1100) s.gyro_body_rad_s = {5.0, 5.0, 5.0};

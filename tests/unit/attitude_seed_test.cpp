@@ -10,7 +10,7 @@
 namespace telltale::fusion {
 namespace {
 
-constexpr double kG = 9.80665;
+constexpr double kG = telltale::fusion::kStandardGravity_m_s2;
 constexpr double kRad = M_PI / 180.0;
 
 /// One axis of the paper's filter, written from the equations with scalars (degrees).

@@ -10,7 +10,7 @@
 namespace telltale::fusion::sim {
 namespace {
 
-constexpr double kG = 9.80665;
+constexpr double kG = telltale::fusion::kStandardGravity_m_s2;
 constexpr double kDeg = M_PI / 180.0;
 
 ScenarioOptions ideal() {

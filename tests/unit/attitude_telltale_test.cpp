@@ -17,7 +17,7 @@ namespace telltale::fusion {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
-constexpr double kG = 9.80665;
+constexpr double kG = telltale::fusion::kStandardGravity_m_s2;
 
 struct Target {
   double rms_deg;

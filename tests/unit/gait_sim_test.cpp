@@ -9,7 +9,7 @@
 namespace telltale::fusion::sim {
 namespace {
 
-constexpr double kG = 9.80665;
+constexpr double kG = telltale::fusion::kStandardGravity_m_s2;
 
 TEST(GaitSim, PeopleSpanTheHeightRangeAndGaitsOrderByCadenceAndLength) {
   double lo = 9, hi = 0;

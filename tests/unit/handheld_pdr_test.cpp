@@ -21,7 +21,7 @@ using telltale::fusion::HandheldPdrParams;
 using telltale::fusion::HandheldStep;
 using telltale::fusion::ImuSample;
 
-constexpr double kG = 9.80665;
+constexpr double kG = telltale::fusion::kStandardGravity_m_s2;
 constexpr double kRate = 50.0;
 using telltale::fusion::sim::PhoneSegment;
 using telltale::fusion::sim::PhoneWalk;

@@ -10,7 +10,7 @@
 namespace telltale::fusion {
 namespace {
 
-constexpr double kG = 9.80665;
+constexpr double kG = telltale::fusion::kStandardGravity_m_s2;
 
 /// The phone's recent samples at 50 Hz over [t0, t1): walking (|f| swinging by 2 m/s^2 at
 /// `period_s`, turning at 1 rad/s) or standing (still: g, no rotation).

@@ -22,7 +22,7 @@
 namespace telltale::fusion {
 namespace {
 
-constexpr double kG = 9.80665;
+constexpr double kG = telltale::fusion::kStandardGravity_m_s2;
 
 double accuracy(std::size_t counted, std::size_t truth) {
   return 1.0 - std::abs(static_cast<double>(counted) - static_cast<double>(truth)) /

@@ -15,7 +15,7 @@
 namespace telltale::sensors {
 namespace {
 
-constexpr double kG = 9.80665;
+constexpr double kG = telltale::fusion::kStandardGravity_m_s2;
 
 std::vector<std::uint8_t> bytes(std::initializer_list<int> v) {
   std::vector<std::uint8_t> out;

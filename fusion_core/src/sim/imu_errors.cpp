@@ -27,7 +27,7 @@ double quantise_saturate(double x, double lsb, double full_scale) {
 
 ImuErrorParams ImuErrorParams::uncalibrated() {
   ImuErrorParams p;
-  p.acc_bias_max_m_s2 = 0.020 * 9.80665;  // LA_TyOff +-20 mg
+  p.acc_bias_max_m_s2 = 0.020 * kStandardGravity_m_s2;  // LA_TyOff +-20 mg
   p.acc_scale_max = 0.10;                 // LA_So 0.9..1.1 mg/digit
   p.acc_misalign_max_rad = 0.01;
   p.gyro_scale_max = 0.02;         // sensitivity change vs temperature +-2 % (Table 4)

@@ -226,7 +226,7 @@ class AdaptiveStepDetector final : public StepDetector {
   LowPass2 acc_lp_;
   LowPass2 gyro_lp_;
   Eigen::Vector3d gyro_energy_ = Eigen::Vector3d::Zero();
-  double g_est_m_s2_ = 9.80665;
+  double g_est_m_s2_ = kStandardGravity_m_s2;
   double last_t_s_ = 0.0;
   double last_step_t_s_ = -1e9;
   double interval_ema_s_ = 1.0;
@@ -337,7 +337,7 @@ class PeakValleyStepDetector final : public StepDetector {
   enum class Phase { kSeekPeak, kSeekValley } phase_ = Phase::kSeekPeak;
   bool have_t_ = false;
   double last_t_s_ = 0.0;
-  double mean_m_s2_ = 9.80665;  ///< slow running mean of the filtered |f|
+  double mean_m_s2_ = kStandardGravity_m_s2;  ///< slow running mean of the filtered |f|
   double prev_peak_ = 0.0, prev_valley_ = 0.0;
   bool have_prev_ = false;
   double cand_peak_ = 0.0, cand_peak_t_s_ = 0.0;

@@ -123,7 +123,7 @@ struct SensorErrors {
   double gyro_bias_rad_s = 0.003;
   double mag_noise_uT = 0.4;
   double mag_bias_uT = 1.0;
-  double acc_range_m_s2 = 16.0 * 9.80665;
+  double acc_range_m_s2 = 16.0 * kStandardGravity_m_s2;
   double gyro_range_rad_s = 2000.0 * M_PI / 180.0;
 };
 

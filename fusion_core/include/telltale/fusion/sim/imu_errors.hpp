@@ -14,6 +14,8 @@
 #include <cstdint>
 #include <random>
 
+#include "telltale/fusion/imu_sample.hpp"
+
 namespace telltale::fusion::sim {
 
 struct ImuErrorParams {
@@ -36,14 +38,15 @@ struct ImuErrorParams {
   // (datasheet: zero-g offset +-20 mg typ, sensitivity 1 mg/digit +-10 %): what remains is the
   // calibration residual below (assumed: 3 mg offset, 0.3 % scale, 0.1 deg cross-axis). With the
   // raw +-20 mg offset no filter can do better than atan(0.02) = 1.15 deg, see the closing note.
-  double acc_bias_max_m_s2 = 0.003 * 9.80665;
+  double acc_bias_max_m_s2 = 0.003 * kStandardGravity_m_s2;
   double acc_bias_walk_m_s2_sqrt_s = 1e-5;  ///< 0.1 mg/degC (LA_TCOff) over a few degC/hour
-  double acc_noise_density_m_s2_sqrt_hz = 220e-6 * 9.80665;  ///< 220 ug/sqrt(Hz) (assumed:
-                                                             ///< LSM303DLHC figure, DLH gives none)
+  double acc_noise_density_m_s2_sqrt_hz =
+      220e-6 * kStandardGravity_m_s2;  ///< 220 ug/sqrt(Hz) (assumed:
+                                       ///< LSM303DLHC figure, DLH gives none)
   double acc_scale_max = 0.003;
   double acc_misalign_max_rad = 0.0017;
-  double acc_lsb_m_s2 = 1e-3 * 9.80665;          ///< 1 mg/digit (12 bit at 2 g)
-  double acc_full_scale_m_s2 = 2.048 * 9.80665;  ///< 2048 digits
+  double acc_lsb_m_s2 = 1e-3 * kStandardGravity_m_s2;          ///< 1 mg/digit (12 bit at 2 g)
+  double acc_full_scale_m_s2 = 2.048 * kStandardGravity_m_s2;  ///< 2048 digits
 
   /// The same sensors without the accelerometer calibration (datasheet figures as they are).
   [[nodiscard]] static ImuErrorParams uncalibrated();

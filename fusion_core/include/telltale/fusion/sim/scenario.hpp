@@ -70,7 +70,7 @@ struct ScenarioOptions {
   ImuErrorParams errors{};
   double jitter_s = 0.0;          ///< uniform +- jitter on every time stamp (< 0.5 / rate)
   double drop_probability = 0.0;  ///< chance that a sample is lost (non-uniform sampling)
-  double g_m_s2 = 9.80665;
+  double g_m_s2 = kStandardGravity_m_s2;
   /// The GNSS receiver of the scenarios that have one: epochs per second, the white noise of
   /// its velocity, east and north (a u-blox M8's 0.05 m/s), and the time from its epoch to the
   /// fix's arrival beside the IMU samples (navigation solution and transfer, ~0.1 s).
