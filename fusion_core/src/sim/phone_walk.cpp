@@ -97,8 +97,10 @@ PhoneWalk simulate_phone_walk(const std::vector<PhoneSegment>& plan, const Phone
           heading = heading0 + seg.turn_deg * M_PI / 180.0 * std::min(1.0, ts / 1.5);
           // The trunk's bounce (gait_sim's walker: the first step a push, each after it a heel
           // strike's loading), the forward surge at the step's rate, the lateral sway at the
-          // stride's, and the hand's pitch with each step. The horizontal motions build up over
-          // the first step and die out over the last, as the walker's speed does.
+          // stride's, and the hand's pitch with each step; the horizontal motions build up over
+          // the first step and die out over the last. The truth's speed is the walk's from the
+          // push to the closing heel strike: n heel strikes cover n steps, what a step counter
+          // laying every step at its length lays (the table measures the counting).
           const auto k = std::floor(walk_t / period);
           const double t_in = walk_t - k * period;
           const WalkStep which = k == 0.0 ? WalkStep::kFirst : WalkStep::kWithin;
