@@ -11,7 +11,7 @@
 #include <limits>
 #include <string>
 
-#include "store.hpp"
+#include "store_error.hpp"
 
 namespace telltale::shore {
 

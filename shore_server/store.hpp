@@ -40,20 +40,15 @@
 #include <mutex>
 #include <optional>
 #include <set>
-#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "fleet.hpp"
+#include "store_error.hpp"
 #include "telltale/fusion/alarm_engine.hpp"
 
 namespace telltale::shore {
-
-class StoreError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 struct StoreConfig {
   std::string path;
