@@ -17,6 +17,7 @@
 
 #include "csv.hpp"
 #include "telltale/fusion/gait_phase_steps.hpp"
+#include "telltale/fusion/peak_valley_steps.hpp"
 #include "telltale/fusion/sim/gait_sim.hpp"
 
 namespace telltale::fusion {

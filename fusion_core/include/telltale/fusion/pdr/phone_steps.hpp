@@ -8,6 +8,7 @@
 /// Memory: the detectors' fixed-size buffers, no heap.
 
 #include "telltale/fusion/imu_sample.hpp"
+#include "telltale/fusion/peak_valley_steps.hpp"
 #include "telltale/fusion/steps.hpp"
 
 namespace telltale::fusion {
