@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "telltale/fusion/small_median.hpp"
+
 namespace telltale::fusion {
 
 int WalkStepDetector::update(const ImuSample& s, const Eigen::Vector3d& up) {
@@ -150,10 +152,9 @@ int WalkStepDetector::on_candidate(const Candidate& c_in) {
     // of the three after it (a run confirmed on fewer is taken whole).
     int first = 0;
     if (st.held_n >= 4) {
-      std::array<double, 3> next{};
-      for (std::size_t i = 0; i < next.size(); ++i) next[i] = st.held[i + 1].peak_m_s2;
-      std::sort(next.begin(), next.end());
-      first = st.held[0].peak_m_s2 < params_.first_step_fraction * next[1] ? 1 : 0;
+      const std::array<double, 3> next = {st.held[1].peak_m_s2, st.held[2].peak_m_s2,
+                                          st.held[3].peak_m_s2};
+      first = st.held[0].peak_m_s2 < params_.first_step_fraction * small_median<3>(next) ? 1 : 0;
     }
     const int n = st.held_n - first;
     std::copy(st.held.begin() + first, st.held.begin() + st.held_n, out_.begin());

@@ -105,8 +105,9 @@ PhoneWalk simulate_phone_walk(const std::vector<PhoneSegment>& plan, const Phone
           const double t_in = walk_t - k * period;
           const WalkStep which = k == 0.0 ? WalkStep::kFirst : WalkStep::kWithin;
           const double phase = 2.0 * M_PI * walk_t / period;
-          const double left_in_walk = walk_goes_on ? period : seg.duration_s - ts;
-          const double blend = std::clamp(std::min(walk_t, left_in_walk) / period, 0.0, 1.0);
+          const double ramp_in = walk_t / period;
+          const double ramp_out = walk_goes_on ? 1.0 : (seg.duration_s - ts) / period;
+          const double blend = std::clamp(std::min(ramp_in, ramp_out), 0.0, 1.0);
           const Eigen::Vector3d fwd(std::sin(heading), std::cos(heading), 0.0);
           const Eigen::Vector3d right(std::cos(heading), -std::sin(heading), 0.0);
           a = walking_trunk_up(which, t_in, period, p.step_length_m, p.height_m, 1.0) *
