@@ -87,6 +87,7 @@ HandheldWalk run_handheld_walk(const std::vector<ImuRecord>& records,
     for (int k = 0; k < n; ++k) walk.steps.push_back(pdr.steps()[static_cast<std::size_t>(k)]);
   }
   walk.gyro_bias_rad_s = pdr.gyro_bias_rad_s();
+  walk.live = walk.steps;
   fusion::relay_track(walk.steps, walk.gyro_bias_rad_s);
   if (!records.empty())
     walk.ns_per_sample = static_cast<double>(spent.count()) / static_cast<double>(records.size());

@@ -38,10 +38,12 @@ struct ImuRecord {
                                                   std::size_t* repeated_stamps = nullptr);
 
 /// A phone walk through HandheldPdr, as `fusion_cli pdr --mount phone` writes it and steps-eval
-/// scores it: every step laid as walked, then the whole track re-laid with the gyro bias the
-/// walk ended with (fusion::relay_track says why). `ns_per_sample`: the updates' time only.
+/// scores it: every step laid as walked (`live`, the track `wearable_node` publishes), then the
+/// whole track re-laid with the gyro bias the walk ended with (`steps`; fusion::relay_track says
+/// why). `ns_per_sample`: the updates' time only.
 struct HandheldWalk {
   std::vector<fusion::HandheldStep> steps;
+  std::vector<fusion::HandheldStep> live;
   Eigen::Vector3d gyro_bias_rad_s = Eigen::Vector3d::Zero();
   double ns_per_sample = 0.0;
 };

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "fusion_cli_fixture.hpp"
 
@@ -126,8 +127,26 @@ TEST_F(StepsCli, IpolReadmeRuleLeavesTheUTurnOutOfTheAnnotationsToo) {
   const auto row = out.find("| 9-1_lb | 10 / 12 |");
   ASSERT_NE(row, std::string::npos) << out;
   const std::string line = out.substr(row, out.find('\n', row) - row);
-  // The last column is gait-phase, the lower back's default (fusion_cli steps --mount body).
-  EXPECT_NE(line.find("| 10 (100 / 83) |", line.size() - 20), std::string::npos) << line;
+  // The gait-phase column, the lower back's default (fusion_cli steps --mount body), found by
+  // its header (the table's columns: file, annotated, past the end, then one per method).
+  const auto cells = [](const std::string& l) {
+    std::vector<std::string> c;
+    std::size_t from = l.find('|');
+    while (from != std::string::npos) {
+      const std::size_t to = l.find('|', from + 1);
+      if (to == std::string::npos) break;
+      c.push_back(l.substr(from + 1, to - from - 1));
+      from = to;
+    }
+    return c;
+  };
+  const auto header_at = out.rfind("| file |", row);
+  ASSERT_NE(header_at, std::string::npos) << out;
+  const auto header = cells(out.substr(header_at, out.find('\n', header_at) - header_at));
+  const auto column = std::find(header.begin(), header.end(), " gait-phase ") - header.begin();
+  const auto row_cells = cells(line);
+  ASSERT_LT(static_cast<std::size_t>(column), row_cells.size()) << out;
+  EXPECT_EQ(row_cells[static_cast<std::size_t>(column)], " 10 (100 / 83) ") << line;
 }
 
 // No simulated walk to score is a usage error, not a table that reads its first element.
