@@ -44,35 +44,29 @@ Butterworth butterworth(double dt, double inv_sqrt2_tau) {
   return {k2 * norm, 2.0 * (k2 - 1.0) * norm, (1.0 - M_SQRT2 * k + k2) * norm};
 }
 
-/// One step of the Butterworth on the 15 low-passed values, in transposed direct form II:
+/// One step of the Butterworth on the 18 low-passed values, in transposed direct form II:
 ///   y = b0 x + s0;  s0 = b1 x - a1 y + s1;  s1 = b2 x - a2 y  (b1 = 2 b0, b2 = b0).
 /// The values are independent, so they go two at a time (one SIMD pair each) through all three
 /// lines at once, each read and written once. As three Eigen assignments over the 3x5 blocks
 /// (three passes, b0 x formed twice, the compiler making the assignment loop a call) it cost
 /// ~340 instructions per update; this is ~195 fewer (callgrind). The same operations in the same
 /// order on every value, so the same results bit for bit: b1 x = (2 b0) x is formed as
-/// b0 x + b0 x (doubling is exact), and the odd 15th value takes the scalar form of the same
-/// lines.
-void butterworth_step(const Butterworth& c, const Eigen::Matrix<double, 3, 5>& x,
-                      Eigen::Matrix<double, 3, 5>& y, Eigen::Matrix<double, 3, 5>& s0,
-                      Eigen::Matrix<double, 3, 5>& s1) {
+/// b0 x + b0 x (doubling is exact).
+void butterworth_step(const Butterworth& c, const Eigen::Matrix<double, 3, 6>& x,
+                      Eigen::Matrix<double, 3, 6>& y, Eigen::Matrix<double, 3, 6>& s0,
+                      Eigen::Matrix<double, 3, 6>& s1) {
   using Pair = Eigen::Array2d;
   const double* xd = x.data();
   double* yd = y.data();
   double* s0d = s0.data();
   double* s1d = s1.data();
-  for (int i = 0; i < 14; i += 2) {
+  for (int i = 0; i < 18; i += 2) {
     const Pair bx = c.b0 * Eigen::Map<const Pair>(xd + i);
     const Pair yi = bx + Eigen::Map<const Pair>(s0d + i);
     Eigen::Map<Pair>(s0d + i) = ((bx + bx) - c.a1 * yi) + Eigen::Map<const Pair>(s1d + i);
     Eigen::Map<Pair>(s1d + i) = bx - c.a2 * yi;
     Eigen::Map<Pair>(yd + i) = yi;
   }
-  const double bx = c.b0 * xd[14];
-  const double yi = bx + s0d[14];
-  s0d[14] = ((bx + bx) - c.a1 * yi) + s1d[14];
-  s1d[14] = bx - c.a2 * yi;
-  yd[14] = yi;
 }
 
 /// A unit vector perpendicular to the unit vector u (continuity does not matter: each motion
@@ -90,14 +84,16 @@ void butterworth_step(const Butterworth& c, const Eigen::Matrix<double, 3, 5>& x
 
 /// The end of the start's Kalman filter: the low-pass in its steady state (b0, a2: its
 /// Butterworth's coefficients for this step) at the start's vertical (|lp| = g: only its
-/// direction is read), the rotation and R * bias as they are now; the drift is measured from
-/// here. Once per start: not inlined into the update.
+/// direction is read), the rotation and R * bias as they are now, the rate in I at its mean over
+/// a seaway (0: the hull's rolling and pitching go both ways); the drift is measured from here.
+/// Once per start: not inlined into the update.
 [[gnu::noinline]] void end_start_fit(TelltaleAttitudeFilter::State& st, const Eigen::Matrix3d& r,
                                      double b0, double a2, double tau, double g) {
   st.start_fit = false;
   st.lp.col(0) = g * st.up_i;
   st.lp.block<3, 3>(0, 1) = r;
   st.lp.col(4) = r.lazyProduct(st.bias_rad_s);
+  st.lp.col(5).setZero();
   st.lp_s0 = (1.0 - b0) * st.lp;
   st.lp_s1 = (b0 - a2) * st.lp;
   st.lp_running = true;
@@ -134,10 +130,12 @@ void TelltaleAttitudeFilter::initialise(const ImuSample& s) {
   const Eigen::Matrix3d r = state_.q_gyro.toRotationMatrix();
   state_.lp.col(0) = r * s.acc_body_m_s2;
   state_.lp.block<3, 3>(0, 1) = r;
+  state_.lp.col(5) = r * s.gyro_body_rad_s;
   const double n = state_.lp.col(0).norm();
   state_.up_i = n > 0.0 ? Eigen::Vector3d(state_.lp.col(0) / n) : Eigen::Vector3d::UnitZ();
   const double var0 = params_.bias_sigma_init_rad_s * params_.bias_sigma_init_rad_s;
   state_.bias_cov = var0 * Eigen::Matrix3d::Identity();
+  state_.gyro_scale_var = params_.gyro_scale_sigma_init * params_.gyro_scale_sigma_init;
   state_.tau_scale =
       std::max(1.0, std::cbrt(params_.bias_sigma_init_rad_s / params_.bias_sigma_motion_rad_s));
   state_.gyro_rest_lp_rad_s = s.gyro_body_rad_s;
@@ -175,6 +173,7 @@ void TelltaleAttitudeFilter::start_wait(bool at_rest, bool gap, double dt) {
   st.start_fit = true;
   st.start_elapsed_s = 0.0;
   st.bias_cov = var0 * Eigen::Matrix3d::Identity();
+  st.scale_bias_cov.setZero();  // the start's filter has no scale: nothing ties the two
   st.start_cov.setZero();
   st.start_cov(0, 0) = st.start_cov(1, 1) = a0 * a0;
   st.start_cov.block<3, 3>(2, 2) = st.bias_cov;
@@ -258,6 +257,8 @@ void TelltaleAttitudeFilter::course_update(const Eigen::Vector3d& gyro_raw, bool
   if (st.course_window_s < p.tau_acc_s) return;
   const double span = st.course_window_s;
   const Eigen::Vector3d hb = st.course_up_s / span;
+  // (The gyro's turn is compared unscaled: the scale's share of a tack's 90 deg in 3 s, 0.5 %,
+  // is 0.15 deg/s, under the course rate's error.)
   const double innov = (st.course_gyro_rad - st.course_turn_rad) / span - hb.dot(st.bias_rad_s);
   const double w = p.cog_rate_sigma_rad_s * p.cog_rate_sigma_rad_s;
   if (st.start_fit) {
@@ -272,10 +273,16 @@ void TelltaleAttitudeFilter::course_update(const Eigen::Vector3d& gyro_raw, bool
     st.start_cov -= k * ph.transpose();
     st.bias_cov = st.start_cov.block<3, 3>(2, 2);
   } else {
+    // H = (hb, 0) on (bias, scale): the scale moves with the bias it is correlated with.
     const Eigen::Vector3d ph = st.bias_cov.lazyProduct(hb);
-    const Eigen::Vector3d k = ph / (hb.dot(ph) + w);
+    const double sc = hb.dot(ph) + w;
+    const double chb = st.scale_bias_cov.dot(hb);
+    const Eigen::Vector3d k = ph / sc;
     st.bias_rad_s += innov * k;
+    st.gyro_scale += innov * chb / sc;
     st.bias_cov -= k * ph.transpose();
+    st.gyro_scale_var -= chb * chb / sc;
+    st.scale_bias_cov -= k * chb;
   }
   st.course_window_s = 0.0;
   st.course_gyro_rad = 0.0;
@@ -370,7 +377,8 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // filter, close to the mean rate over the interval that ends at the sample: integrate it over
   // that interval. Over a gap nothing is known about the rotation: not integrated, and the
   // low-pass restarts below (the old vertical in I means nothing any more).
-  const Eigen::Vector3d gyro = s.gyro_body_rad_s - st.bias_rad_s;
+  const Eigen::Vector3d gyro_less_bias = s.gyro_body_rad_s - st.bias_rad_s;
+  const Eigen::Vector3d gyro = (1.0 + st.gyro_scale) * gyro_less_bias;
   if (!gap) st.q_gyro = rotate_by(st.q_gyro, gyro * dt);
   const Eigen::Matrix3d r = st.q_gyro.toRotationMatrix();  // body -> I
 
@@ -520,10 +528,11 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   const Butterworth c = butterworth(dt, inv_sqrt2_tau);
   if (start_ends) end_start_fit(st, r, c.b0, c.a2, tau, p.g_m_s2);
   if (gap) st.lp_running = false;
-  Eigen::Matrix<double, 3, 5> x;
+  Eigen::Matrix<double, 3, 6> x;
   x.col(0) = r * f;
   x.block<3, 3>(0, 1) = r;
   x.col(4) = r * st.bias_rad_s;
+  x.col(5) = r * gyro_less_bias;
   if (!st.lp_running) {
     // Fast start: the mean of everything since the (re)start, weighted by time. The first
     // sample after a restart replaces the mean. Once tau has been covered, the Butterworth takes
@@ -553,6 +562,9 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   for (int i = 0; i < 3; ++i) {
     if (st.bias_cov(i, i) < var0) st.bias_cov(i, i) += v;
   }
+  // The scale's walk: back to its prior over gyro_scale_forgetting_s.
+  const double ks0 = p.gyro_scale_sigma_init * p.gyro_scale_sigma_init;
+  if (st.gyro_scale_var < ks0) st.gyro_scale_var += ks0 * dt / p.gyro_scale_forgetting_s;
   // Measurement noise chosen so that, updated on every sample, the covariance settles at the
   // sigma of that measurement: W = sigma^4 / V + sigma^2 (the fixed point of P' = P + V,
   // P'' = P' - P'^2 / (P' + W) at P'' = sigma^2).
@@ -561,9 +573,16 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
     // At rest the gyro's 0.5 s mean IS the bias (to its noise), all three axes.
     const double sr2 = p.bias_sigma_rest_rad_s * p.bias_sigma_rest_rad_s;
     const double w = sr2 * sr2 / v + sr2;
+    // H = (I, 0) on (bias, scale): the scale is not measured (no rotation), but moves with the
+    // bias it is correlated with, and that correlation shrinks as the bias is pinned down.
     const Eigen::Matrix3d s_inv = (st.bias_cov + w * Eigen::Matrix3d::Identity()).inverse();
     const Eigen::Matrix3d k = st.bias_cov * s_inv;
-    st.bias_rad_s += k * (st.gyro_rest_lp_rad_s - st.bias_rad_s);
+    const Eigen::Vector3d innov = st.gyro_rest_lp_rad_s - st.bias_rad_s;
+    const Eigen::Vector3d sc = s_inv * st.scale_bias_cov;
+    st.bias_rad_s += k * innov;
+    st.gyro_scale += sc.dot(innov);
+    st.gyro_scale_var -= st.scale_bias_cov.dot(sc);
+    st.scale_bias_cov -= st.bias_cov * sc;
     st.bias_cov -= k * st.bias_cov;
   }
   // The motion update runs at most every kBiasPeriod_s (the paper's 25 Hz): the bias changes
@@ -585,6 +604,12 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
     // the low-passed vertical turns at y = up_prev x up / dt ~ LP(R e) across the vertical.
     // With the bias estimate b: LP(R) b_true = y + LP(R b), a measurement of the bias through
     // H = LP(R), of its two horizontal components only (the vertical one moves nothing).
+    // The scale: the integrated rate is (1 + k)(gyro - b) against the true (1 + k_true)(gyro -
+    // b_true), which part by (b_true - b) - (k_true - k)(gyro - b) to first order, so the same
+    // drift is also a measurement of k_true - k through -LP(R (gyro - b)), the low-passed rate in
+    // I. A rotation that goes back and forth (a boat's rolling, a pendulum) leaves that near 0
+    // and teaches nothing; a one-way rotation across the vertical (a hand tumbling the sensor,
+    // a turntable's tilted axis) measures it.
     const double span = st.bias_elapsed_s;
     const Eigen::Vector3d yv = st.bias_up_i.cross(st.up_i) / span;
     st.bias_up_i = st.up_i;
@@ -596,25 +621,34 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
     Eigen::Matrix<double, 2, 3> basis;
     basis.row(0) = h1.transpose();
     basis.row(1) = h2.transpose();
-    const Eigen::Matrix<double, 2, 3> h = basis * h_i;
+    Eigen::Matrix<double, 2, 4> h;
+    h.leftCols<3>() = basis * h_i;
+    h.col(3) = -(basis * st.lp.col(5));
     Eigen::Vector2d e = basis * e_i;
     e = e.cwiseMax(-p.max_bias_rad_s).cwiseMin(p.max_bias_rad_s);
     // The same steady-state rule for one update per span: V over the span.
     const double w = sm2 * p.bias_forgetting_s / span + sm2;
-    const Eigen::Matrix<double, 3, 2> pht = st.bias_cov * h.transpose();
+    Eigen::Matrix4d pc;
+    pc.topLeftCorner<3, 3>() = st.bias_cov;
+    pc.topRightCorner<3, 1>() = st.scale_bias_cov;
+    pc.bottomLeftCorner<1, 3>() = st.scale_bias_cov.transpose();
+    pc(3, 3) = st.gyro_scale_var;
+    const Eigen::Matrix<double, 4, 2> pht = pc * h.transpose();
     Eigen::Matrix2d sm = h * pht;
     sm(0, 0) += w;
     sm(1, 1) += w;
-    const Eigen::Matrix<double, 3, 2> k = pht * sm.inverse();
-    st.bias_rad_s += k * e;
-    // P -= K (P H^T)^T, column by column: the same products and sums as the 3x3 temporary Eigen
-    // would form (k(i, 0) pht(j, 0) + k(i, 1) pht(j, 1), then subtracted), so the same bits;
-    // written out because the compiler made that assignment an out-of-line loop whenever the
-    // update around it changed (40 instructions per motion update, callgrind).
-    for (int j = 0; j < 3; ++j) st.bias_cov.col(j) -= k.col(0) * pht(j, 0) + k.col(1) * pht(j, 1);
+    const Eigen::Matrix<double, 4, 2> k = pht * sm.inverse();
+    const Eigen::Vector4d dx = k * e;
+    st.bias_rad_s += dx.head<3>();
+    st.gyro_scale += dx(3);
+    pc -= k * pht.transpose();
+    st.bias_cov = pc.topLeftCorner<3, 3>();
+    st.scale_bias_cov = pc.topRightCorner<3, 1>();
+    st.gyro_scale_var = pc(3, 3);
   }
   if (course_known || st.course_window_s > 0.0) course_update(s.gyro_body_rad_s, course_known, dt);
   st.bias_rad_s = st.bias_rad_s.cwiseMax(-p.max_bias_rad_s).cwiseMin(p.max_bias_rad_s);
+  st.gyro_scale = std::clamp(st.gyro_scale, -p.max_gyro_scale, p.max_gyro_scale);
 
   // --- What output() needs: the vertical seen in the body, and the body rate.
   st.up_body = r.transpose() * st.up_i;

@@ -19,6 +19,11 @@
 ///     in motion from how fast the low-passed vertical drifts in I (horizontal components only:
 ///     the bias about the vertical does not move the vertical), and about the vertical from the
 ///     GNSS course when it is given (the gyro's turn against the course's over tau_acc_s);
+///   - the gyro's common scale error is a fourth state of that filter, learnt in motion from the
+///     same drift: a gyro reading (1 - k) of the rate turns frame I at k times the rate in I,
+///     so the drift is the bias error through LP(R) plus the scale error through LP(R omega).
+///     It matters where the rotation is fast and one-way (a hand tumbling the sensor at
+///     400 deg/s: 0.5 % of it is 2 deg/s of drift); a boat's rolling back and forth cancels it;
 ///   - start: the low-pass starts as the mean of everything seen since (the best estimate of a
 ///     constant from a growing window) for tau_acc_s, as it does after a gap too long to
 ///     integrate. If within the first start_fit_s (and before any rest or gap) the GNSS speed
@@ -39,7 +44,9 @@
 ///
 /// Call order: update() once per sample, time strictly increasing; read output() afterwards.
 /// Cannot observe: the gyro bias about the vertical without GNSS course (heading drift;
-/// irrelevant to heel/pitch until the boat heels the other way or turns),
+/// irrelevant to heel/pitch until the boat heels the other way or turns), the gyro's scale
+/// without rotation across the vertical (nor does it matter then), its axes' own scales and
+/// cross-axis errors apart from their common part,
 /// an accelerometer offset (it becomes a tilt error of offset/g rad), a linear acceleration that
 /// is sustained in one earth direction for longer than ~tau_acc_s (its mean is a tilt) unless it
 /// is the turn and speed change of a boat whose speed is given.
@@ -83,6 +90,14 @@ struct TelltaleAttitudeParams {
   double bias_sigma_motion_rad_s = 0.1 * M_PI / 180.0;
   double bias_forgetting_s = 100.0;
   double max_bias_rad_s = 20.0 * M_PI / 180.0;     ///< |bias| clamp (twice the L3G4200D spread)
+  /// The gyro's common scale error k (rate = (1 + k)(gyro - bias)), a Kalman state beside the
+  /// bias, learnt in motion only (update says how). Prior sigma: what a calibration leaves of a
+  /// MEMS gyro's sensitivity error common to its axes, and a sample clock's error (every rate is
+  /// integrated over the stamped interval): 0.5 %. Forgotten back to it over
+  /// gyro_scale_forgetting_s (the sensitivity moves with temperature: 0.03 %/degC, L3G4200D).
+  double gyro_scale_sigma_init = 0.005;
+  double gyro_scale_forgetting_s = 3600.0;
+  double max_gyro_scale = 0.05;  ///< |k| clamp: beyond any MEMS sensitivity tolerance
   double gyro_range_rad_s = 250.0 * M_PI / 180.0;  ///< full scale (L3G4200D default 250 dps)
   double acc_range_m_s2 = 2.0 * kStandardGravity_m_s2;  ///< full scale (LSM303DLH default 2 g)
   double saturation_fraction = 0.98;                    ///< |reading| >= this * range -> saturated
@@ -138,11 +153,17 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
     Eigen::Vector3d bias_rad_s = Eigen::Vector3d::Zero();        ///< gyro bias, body
     Eigen::Matrix3d bias_cov = Eigen::Matrix3d::Zero();          ///< its covariance, (rad/s)^2
     /// Low-passed in frame I, as one block: column 0 the specific force (m/s^2), 1..3 the
-    /// rotation matrix body -> I, 4 R * bias (the motion-bias model). Output and two Butterworth
+    /// rotation matrix body -> I, 4 R * bias (the motion-bias model), 5 R * (gyro - bias) (the
+    /// scale's: the rate in I). Output and two Butterworth
     /// (transposed direct form II) states.
-    Eigen::Matrix<double, 3, 5> lp = Eigen::Matrix<double, 3, 5>::Zero();
-    Eigen::Matrix<double, 3, 5> lp_s0 = Eigen::Matrix<double, 3, 5>::Zero();
-    Eigen::Matrix<double, 3, 5> lp_s1 = Eigen::Matrix<double, 3, 5>::Zero();
+    Eigen::Matrix<double, 3, 6> lp = Eigen::Matrix<double, 3, 6>::Zero();
+    Eigen::Matrix<double, 3, 6> lp_s0 = Eigen::Matrix<double, 3, 6>::Zero();
+    Eigen::Matrix<double, 3, 6> lp_s1 = Eigen::Matrix<double, 3, 6>::Zero();
+    /// The gyro's common scale error (Params::gyro_scale_sigma_init), its variance and its
+    /// covariance with the bias (the two are one Kalman filter on 4 states).
+    double gyro_scale = 0.0;
+    double gyro_scale_var = 0.0;
+    Eigen::Vector3d scale_bias_cov = Eigen::Vector3d::Zero();
     double tau_scale = 1.0;     ///< tau_acc_s / the time constant in use (>= 1, see update)
     double lp_elapsed_s = 0.0;  ///< time since the low-pass (re)started
     bool lp_running = false;    ///< false: still the growing mean of the fast start
