@@ -94,7 +94,8 @@ struct TelltaleAttitudeParams {
   /// bias, learnt in motion only (update says how). Prior sigma: what a calibration leaves of a
   /// MEMS gyro's sensitivity error common to its axes, and a sample clock's error (every rate is
   /// integrated over the stamped interval): 0.5 %. Forgotten back to it over
-  /// gyro_scale_forgetting_s (the sensitivity moves with temperature: 0.03 %/degC, L3G4200D).
+  /// gyro_scale_forgetting_s (the sensitivity moves with temperature: +-2 % over -40..85 degC,
+  /// L3G4200D, some 0.02 %/degC).
   double gyro_scale_sigma_init = 0.005;
   double gyro_scale_forgetting_s = 3600.0;
   double max_gyro_scale = 0.05;  ///< |k| clamp: beyond any MEMS sensitivity tolerance
