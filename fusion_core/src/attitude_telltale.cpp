@@ -134,8 +134,8 @@ void TelltaleAttitudeFilter::initialise(const ImuSample& s) {
   const double n = state_.lp.col(0).norm();
   state_.up_i = n > 0.0 ? Eigen::Vector3d(state_.lp.col(0) / n) : Eigen::Vector3d::UnitZ();
   const double var0 = params_.bias_sigma_init_rad_s * params_.bias_sigma_init_rad_s;
-  state_.bias_cov = var0 * Eigen::Matrix3d::Identity();
-  state_.gyro_scale_var = params_.gyro_scale_sigma_init * params_.gyro_scale_sigma_init;
+  state_.cov.topLeftCorner<3, 3>() = var0 * Eigen::Matrix3d::Identity();
+  state_.cov(3, 3) = params_.gyro_scale_sigma_init * params_.gyro_scale_sigma_init;
   state_.tau_scale =
       std::max(1.0, std::cbrt(params_.bias_sigma_init_rad_s / params_.bias_sigma_motion_rad_s));
   state_.gyro_rest_lp_rad_s = s.gyro_body_rad_s;
@@ -172,11 +172,13 @@ void TelltaleAttitudeFilter::start_wait(bool at_rest, bool gap, double dt) {
   st.start_pending = false;
   st.start_fit = true;
   st.start_elapsed_s = 0.0;
-  st.bias_cov = var0 * Eigen::Matrix3d::Identity();
-  st.scale_bias_cov.setZero();  // the start's filter has no scale: nothing ties the two
+  st.cov.topLeftCorner<3, 3>() = var0 * Eigen::Matrix3d::Identity();
+  // The start's filter has no scale: nothing ties the two.
+  st.cov.topRightCorner<3, 1>().setZero();
+  st.cov.bottomLeftCorner<1, 3>().setZero();
   st.start_cov.setZero();
   st.start_cov(0, 0) = st.start_cov(1, 1) = a0 * a0;
-  st.start_cov.block<3, 3>(2, 2) = st.bias_cov;
+  st.start_cov.block<3, 3>(2, 2) = st.cov.topLeftCorner<3, 3>();
   st.start_acc_var = a0 * a0;
 }
 
@@ -225,7 +227,7 @@ void TelltaleAttitudeFilter::start_fit_update(const Eigen::Matrix3d& r, const Ei
   pc -= k * pc.block<2, 5>(0, 0);
   st.up_i = (u + dx(0) * h1 + dx(1) * h2).normalized();
   st.bias_rad_s += dx.tail<3>();
-  st.bias_cov = pc.block<3, 3>(2, 2);
+  st.cov.topLeftCorner<3, 3>() = pc.block<3, 3>(2, 2);
 }
 
 void TelltaleAttitudeFilter::course_update(const Eigen::Vector3d& gyro_raw, bool usable,
@@ -271,18 +273,14 @@ void TelltaleAttitudeFilter::course_update(const Eigen::Vector3d& gyro_raw, bool
     st.up_i = (st.up_i + innov * (k(0) * h1 + k(1) * h2)).normalized();
     st.bias_rad_s += innov * k.tail<3>();
     st.start_cov -= k * ph.transpose();
-    st.bias_cov = st.start_cov.block<3, 3>(2, 2);
+    st.cov.topLeftCorner<3, 3>() = st.start_cov.block<3, 3>(2, 2);
   } else {
     // H = (hb, 0) on (bias, scale): the scale moves with the bias it is correlated with.
-    const Eigen::Vector3d ph = st.bias_cov.lazyProduct(hb);
-    const double sc = hb.dot(ph) + w;
-    const double chb = st.scale_bias_cov.dot(hb);
-    const Eigen::Vector3d k = ph / sc;
-    st.bias_rad_s += innov * k;
-    st.gyro_scale += innov * chb / sc;
-    st.bias_cov -= k * ph.transpose();
-    st.gyro_scale_var -= chb * chb / sc;
-    st.scale_bias_cov -= k * chb;
+    const Eigen::Vector4d ph = st.cov.leftCols<3>() * hb;
+    const Eigen::Vector4d k = ph / (hb.dot(ph.head<3>()) + w);
+    st.bias_rad_s += innov * k.head<3>();
+    st.gyro_scale += innov * k(3);
+    st.cov.noalias() -= k * ph.transpose();
   }
   st.course_window_s = 0.0;
   st.course_gyro_rad = 0.0;
@@ -327,7 +325,7 @@ AttitudeOutput TelltaleAttitudeFilter::output() const {
   // (2/3 of the bias covariance's trace) * tau^2; while the low-pass is still a growing mean,
   // add (6 deg)^2 fading with its length.
   const double tau = params_.tau_acc_s;
-  double var = (2.0 / 3.0) * state_.bias_cov.trace() * tau * tau;
+  double var = (2.0 / 3.0) * state_.cov.topLeftCorner<3, 3>().trace() * tau * tau;
   if (state_.start_fit) {
     var = state_.start_cov(0, 0) + state_.start_cov(1, 1);  // the start's own tilt variance
   } else if (!state_.lp_running) {
@@ -402,7 +400,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
                           p.rest_gyro_rad_s * p.rest_gyro_rad_s &&
                       acc_dev2 < p.rest_acc_m_s2 * p.rest_acc_m_s2 &&
                       ((st.gyro_rest_lp_rad_s - st.bias_rad_s).array().square() <
-                       (9.0 * st.bias_cov.diagonal())
+                       (9.0 * st.cov.diagonal().head<3>())
                            .cwiseMax(p.rest_bias_gate_rad_s * p.rest_bias_gate_rad_s)
                            .array())
                           .all() &&
@@ -449,7 +447,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
         // The gyro's error about the vertical is its bias there (variance u^T P u); the course
         // rate's is cog_rate_sigma. Their variance-weighted mean (the Kalman update of one
         // measurement of the other).
-        const double vg = u.dot(st.bias_cov * u);
+        const double vg = u.dot(st.cov.topLeftCorner<3, 3>() * u);
         const double vc = p.cog_rate_sigma_rad_s * p.cog_rate_sigma_rad_s;
         w_up += vg / (vg + vc) * (st.yaw_rate_cog_rad_s - w_up);
       }
@@ -500,7 +498,8 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // root by one Newton step per sample from the last value (it changes slowly).
   const Eigen::Vector3d up_b_prev = r.transpose() * st.up_i;
   const double sm2 = p.bias_sigma_motion_rad_s * p.bias_sigma_motion_rad_s;
-  const double var_h = 0.5 * (st.bias_cov.trace() - up_b_prev.dot(st.bias_cov * up_b_prev));
+  const auto bias_cov = st.cov.topLeftCorner<3, 3>();
+  const double var_h = 0.5 * (bias_cov.trace() - up_b_prev.dot(bias_cov * up_b_prev));
   // At rest there is no acceleration to average out (that is what rest means): the low-pass may
   // follow the accelerometer faster and wipe out the tilt error the motion left behind.
   // The bias known to sigma_m or better (the usual case once the filter has settled: 98 % of the
@@ -560,11 +559,11 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   const double v = sm2 * dt / p.bias_forgetting_s;
   const double var0 = p.bias_sigma_init_rad_s * p.bias_sigma_init_rad_s;
   for (int i = 0; i < 3; ++i) {
-    if (st.bias_cov(i, i) < var0) st.bias_cov(i, i) += v;
+    if (st.cov(i, i) < var0) st.cov(i, i) += v;
   }
   // The scale's walk: back to its prior over gyro_scale_forgetting_s.
   const double ks0 = p.gyro_scale_sigma_init * p.gyro_scale_sigma_init;
-  if (st.gyro_scale_var < ks0) st.gyro_scale_var += ks0 * dt / p.gyro_scale_forgetting_s;
+  if (st.cov(3, 3) < ks0) st.cov(3, 3) += ks0 * dt / p.gyro_scale_forgetting_s;
   // Measurement noise chosen so that, updated on every sample, the covariance settles at the
   // sigma of that measurement: W = sigma^4 / V + sigma^2 (the fixed point of P' = P + V,
   // P'' = P' - P'^2 / (P' + W) at P'' = sigma^2).
@@ -575,15 +574,13 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
     const double w = sr2 * sr2 / v + sr2;
     // H = (I, 0) on (bias, scale): the scale is not measured (no rotation), but moves with the
     // bias it is correlated with, and that correlation shrinks as the bias is pinned down.
-    const Eigen::Matrix3d s_inv = (st.bias_cov + w * Eigen::Matrix3d::Identity()).inverse();
-    const Eigen::Matrix3d k = st.bias_cov * s_inv;
-    const Eigen::Vector3d innov = st.gyro_rest_lp_rad_s - st.bias_rad_s;
-    const Eigen::Vector3d sc = s_inv * st.scale_bias_cov;
-    st.bias_rad_s += k * innov;
-    st.gyro_scale += sc.dot(innov);
-    st.gyro_scale_var -= st.scale_bias_cov.dot(sc);
-    st.scale_bias_cov -= st.bias_cov * sc;
-    st.bias_cov -= k * st.bias_cov;
+    const Eigen::Matrix3d s_inv =
+        (st.cov.topLeftCorner<3, 3>() + w * Eigen::Matrix3d::Identity()).inverse();
+    const Eigen::Matrix<double, 4, 3> k = st.cov.leftCols<3>() * s_inv;
+    const Eigen::Vector4d dx = k * (st.gyro_rest_lp_rad_s - st.bias_rad_s);
+    st.bias_rad_s += dx.head<3>();
+    st.gyro_scale += dx(3);
+    st.cov -= k * st.cov.topRows<3>();
   }
   // The motion update runs at most every kBiasPeriod_s (the paper's 25 Hz): the bias changes
   // over minutes, and the drift of the vertical over 40 ms is a better-conditioned measurement
@@ -628,12 +625,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
     e = e.cwiseMax(-p.max_bias_rad_s).cwiseMin(p.max_bias_rad_s);
     // The same steady-state rule for one update per span: V over the span.
     const double w = sm2 * p.bias_forgetting_s / span + sm2;
-    Eigen::Matrix4d pc;
-    pc.topLeftCorner<3, 3>() = st.bias_cov;
-    pc.topRightCorner<3, 1>() = st.scale_bias_cov;
-    pc.bottomLeftCorner<1, 3>() = st.scale_bias_cov.transpose();
-    pc(3, 3) = st.gyro_scale_var;
-    const Eigen::Matrix<double, 4, 2> pht = pc * h.transpose();
+    const Eigen::Matrix<double, 4, 2> pht = st.cov * h.transpose();
     Eigen::Matrix2d sm = h * pht;
     sm(0, 0) += w;
     sm(1, 1) += w;
@@ -641,10 +633,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
     const Eigen::Vector4d dx = k * e;
     st.bias_rad_s += dx.head<3>();
     st.gyro_scale += dx(3);
-    pc -= k * pht.transpose();
-    st.bias_cov = pc.topLeftCorner<3, 3>();
-    st.scale_bias_cov = pc.topRightCorner<3, 1>();
-    st.gyro_scale_var = pc(3, 3);
+    st.cov.noalias() -= k * pht.transpose();
   }
   if (course_known || st.course_window_s > 0.0) course_update(s.gyro_body_rad_s, course_known, dt);
   st.bias_rad_s = st.bias_rad_s.cwiseMax(-p.max_bias_rad_s).cwiseMin(p.max_bias_rad_s);

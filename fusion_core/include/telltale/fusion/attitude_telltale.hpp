@@ -152,7 +152,11 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
   struct State {
     Eigen::Quaterniond q_gyro = Eigen::Quaterniond::Identity();  ///< body -> inertial frame I
     Eigen::Vector3d bias_rad_s = Eigen::Vector3d::Zero();        ///< gyro bias, body
-    Eigen::Matrix3d bias_cov = Eigen::Matrix3d::Zero();          ///< its covariance, (rad/s)^2
+    /// The gyro's common scale error (Params::gyro_scale_sigma_init): rate = (1 + k)(gyro - bias).
+    double gyro_scale = 0.0;
+    /// The covariance of (bias, scale), one Kalman filter on 4 states: the bias's 3x3 block in
+    /// (rad/s)^2 top left, the scale's variance at (3, 3), their covariance between.
+    Eigen::Matrix4d cov = Eigen::Matrix4d::Zero();
     /// Low-passed in frame I, as one block: column 0 the specific force (m/s^2), 1..3 the
     /// rotation matrix body -> I, 4 R * bias (the motion-bias model), 5 R * (gyro - bias) (the
     /// scale's: the rate in I). Output and two Butterworth
@@ -160,11 +164,6 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
     Eigen::Matrix<double, 3, 6> lp = Eigen::Matrix<double, 3, 6>::Zero();
     Eigen::Matrix<double, 3, 6> lp_s0 = Eigen::Matrix<double, 3, 6>::Zero();
     Eigen::Matrix<double, 3, 6> lp_s1 = Eigen::Matrix<double, 3, 6>::Zero();
-    /// The gyro's common scale error (Params::gyro_scale_sigma_init), its variance and its
-    /// covariance with the bias (the two are one Kalman filter on 4 states).
-    double gyro_scale = 0.0;
-    double gyro_scale_var = 0.0;
-    Eigen::Vector3d scale_bias_cov = Eigen::Vector3d::Zero();
     double tau_scale = 1.0;     ///< tau_acc_s / the time constant in use (>= 1, see update)
     double lp_elapsed_s = 0.0;  ///< time since the low-pass (re)started
     bool lp_running = false;    ///< false: still the growing mean of the fast start
