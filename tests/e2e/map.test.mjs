@@ -129,8 +129,15 @@ test('fleet cards show SOG in knots and m/s', async () => {
   await page.evaluate(() => { location.hash = '#/fleet'; });
   await page.waitForSelector('.card[data-boat="ILCA-5"] .speed');
   await eventually(async () => /^\d+\.\d$/.test(await page.textContent('.card[data-boat="ILCA-5"] .speed')), { what: 'SOG on the card' });
-  const kn = Number(await page.textContent('.card[data-boat="ILCA-5"] .speed'));
-  const ms = Number((await page.textContent('.card[data-boat="ILCA-5"] .speed-ms')).replace(' m/s', ''));
+  // Both read in one evaluation: the card writes them together on each live update, and two
+  // separate reads can straddle one (failed so once in the sanitized suite: 5.8 kn vs 2.8 m/s,
+  // the boat speeding up between the reads).
+  const [knText, msText] = await page.evaluate(() => {
+    const card = document.querySelector('.card[data-boat="ILCA-5"]');
+    return [card.querySelector('.speed').textContent, card.querySelector('.speed-ms').textContent];
+  });
+  const kn = Number(knText);
+  const ms = Number(msText.replace(' m/s', ''));
   const rest = (await fleet.json('/boats')).find((b) => b.id === 'ILCA-5');
   assert.ok(Math.abs(kn / 1.943844 - ms) < 0.1, `${kn} kn vs ${ms} m/s`);
   assert.ok(Math.abs(ms - rest.sog_m_s) < 1.0, `card ${ms} m/s vs REST ${rest.sog_m_s}`);
