@@ -625,15 +625,37 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
     e = e.cwiseMax(-p.max_bias_rad_s).cwiseMin(p.max_bias_rad_s);
     // The same steady-state rule for one update per span: V over the span.
     const double w = sm2 * p.bias_forgetting_s / span + sm2;
-    const Eigen::Matrix<double, 4, 2> pht = st.cov * h.transpose();
-    Eigen::Matrix2d sm = h * pht;
-    sm(0, 0) += w;
-    sm(1, 1) += w;
-    const Eigen::Matrix<double, 4, 2> k = pht * sm.inverse();
-    const Eigen::Vector4d dx = k * e;
+    // The Kalman step written out on the symmetric P: P H^T (4x2), S = H P H^T + w I (2x2,
+    // symmetric, inverted in closed form), K = P H^T S^-1, and P -= K (P H^T)^T formed on its
+    // upper triangle and mirrored, so P stays exactly symmetric (the full product kept that to
+    // rounding only). As Eigen products GCC left them out-of-line calls per packet: this is
+    // 102 instructions fewer per update on the 25 Hz dinghy (callgrind, attitude_count), the
+    // results the same to rounding (BROAD, the golden file).
+    Eigen::Matrix<double, 4, 2> pht;
+    for (int i = 0; i < 4; ++i) {
+      for (int j = 0; j < 2; ++j) {
+        pht(i, j) = st.cov(i, 0) * h(j, 0) + st.cov(i, 1) * h(j, 1) + st.cov(i, 2) * h(j, 2) +
+                    st.cov(i, 3) * h(j, 3);
+      }
+    }
+    const double s00 = h.row(0).dot(pht.col(0)) + w;
+    const double s01 = h.row(0).dot(pht.col(1));
+    const double s11 = h.row(1).dot(pht.col(1)) + w;
+    const double inv_det = 1.0 / (s00 * s11 - s01 * s01);
+    Eigen::Matrix<double, 4, 2> k;
+    for (int i = 0; i < 4; ++i) {
+      k(i, 0) = (pht(i, 0) * s11 - pht(i, 1) * s01) * inv_det;
+      k(i, 1) = (pht(i, 1) * s00 - pht(i, 0) * s01) * inv_det;
+    }
+    const Eigen::Vector4d dx = k.col(0) * e(0) + k.col(1) * e(1);
     st.bias_rad_s += dx.head<3>();
     st.gyro_scale += dx(3);
-    st.cov.noalias() -= k * pht.transpose();
+    for (int i = 0; i < 4; ++i) {
+      for (int j = i; j < 4; ++j) {
+        st.cov(i, j) -= k(i, 0) * pht(j, 0) + k(i, 1) * pht(j, 1);
+        st.cov(j, i) = st.cov(i, j);
+      }
+    }
   }
   if (course_known || st.course_window_s > 0.0) course_update(s.gyro_body_rad_s, course_known, dt);
   st.bias_rad_s = st.bias_rad_s.cwiseMax(-p.max_bias_rad_s).cwiseMin(p.max_bias_rad_s);
