@@ -69,6 +69,59 @@ void butterworth_step(const Butterworth& c, const Eigen::Matrix<double, 3, 6>& x
   }
 }
 
+/// One Kalman measurement update of the bias filter (state: the bias, then the gyro's scale;
+/// covariance p, symmetric): M independent measurements z = h x + noise, each of variance w,
+/// innov = z - h x. Updates p and returns the state's correction. Written out: P H^T (4xM),
+/// S = H P H^T + w I (MxM, symmetric), K = P H^T S^-1, and P -= K (P H^T)^T formed on its upper
+/// triangle and mirrored, so P stays exactly symmetric (the full product kept that to rounding
+/// only). As Eigen products GCC left them out-of-line calls per SIMD packet: the motion
+/// update's step alone cost 102 instructions more per update on the 25 Hz dinghy (callgrind,
+/// attitude_count). Always inlined: it runs on every sample, and M fixes the loops.
+template <int M>
+[[gnu::always_inline]] inline Eigen::Vector4d kalman_update(
+    Eigen::Matrix4d& p, const Eigen::Matrix<double, M, 4>& h,
+    const Eigen::Matrix<double, M, 1>& innov, double w) {
+  Eigen::Matrix<double, 4, M> pht;
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < M; ++j) {
+      pht(i, j) = p(i, 0) * h(j, 0) + p(i, 1) * h(j, 1) + p(i, 2) * h(j, 2) + p(i, 3) * h(j, 3);
+    }
+  }
+  Eigen::Matrix<double, M, M> sm;
+  for (int a = 0; a < M; ++a) {
+    for (int b = a; b < M; ++b) {
+      sm(a, b) =
+          h(a, 0) * pht(0, b) + h(a, 1) * pht(1, b) + h(a, 2) * pht(2, b) + h(a, 3) * pht(3, b);
+      sm(b, a) = sm(a, b);
+    }
+    sm(a, a) += w;
+  }
+  const Eigen::Matrix<double, M, M> s_inv = sm.inverse();  // closed form for M <= 3
+  Eigen::Matrix<double, 4, M> k;
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < M; ++j) {
+      double v = 0.0;
+      for (int m = 0; m < M; ++m) v += pht(i, m) * s_inv(m, j);
+      k(i, j) = v;
+    }
+  }
+  Eigen::Vector4d dx;
+  for (int i = 0; i < 4; ++i) {
+    double v = 0.0;
+    for (int m = 0; m < M; ++m) v += k(i, m) * innov(m);
+    dx(i) = v;
+  }
+  for (int i = 0; i < 4; ++i) {
+    for (int j = i; j < 4; ++j) {
+      double v = 0.0;
+      for (int m = 0; m < M; ++m) v += k(i, m) * pht(j, m);
+      p(i, j) -= v;
+      p(j, i) = p(i, j);
+    }
+  }
+  return dx;
+}
+
 /// A unit vector perpendicular to the unit vector u (continuity does not matter: each motion
 /// update is a measurement on its own, the covariance lives in the body frame). Always inlined:
 /// with three callers the compiler makes it a call, 27 instructions per update (callgrind).
@@ -276,11 +329,10 @@ void TelltaleAttitudeFilter::course_update(const Eigen::Vector3d& gyro_raw, bool
     st.cov.topLeftCorner<3, 3>() = st.start_cov.block<3, 3>(2, 2);
   } else {
     // H = (hb, 0) on (bias, scale): the scale moves with the bias it is correlated with.
-    const Eigen::Vector4d ph = st.cov.leftCols<3>() * hb;
-    const Eigen::Vector4d k = ph / (hb.dot(ph.head<3>()) + w);
-    st.bias_rad_s += innov * k.head<3>();
-    st.gyro_scale += innov * k(3);
-    st.cov.noalias() -= k * ph.transpose();
+    const Eigen::RowVector4d h(hb.x(), hb.y(), hb.z(), 0.0);
+    const Eigen::Vector4d dx = kalman_update<1>(st.cov, h, Eigen::Matrix<double, 1, 1>(innov), w);
+    st.bias_rad_s += dx.head<3>();
+    st.gyro_scale += dx(3);
   }
   st.course_window_s = 0.0;
   st.course_gyro_rad = 0.0;
@@ -574,13 +626,12 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
     const double w = sr2 * sr2 / v + sr2;
     // H = (I, 0) on (bias, scale): the scale is not measured (no rotation), but moves with the
     // bias it is correlated with, and that correlation shrinks as the bias is pinned down.
-    const Eigen::Matrix3d s_inv =
-        (st.cov.topLeftCorner<3, 3>() + w * Eigen::Matrix3d::Identity()).inverse();
-    const Eigen::Matrix<double, 4, 3> k = st.cov.leftCols<3>() * s_inv;
-    const Eigen::Vector4d dx = k * (st.gyro_rest_lp_rad_s - st.bias_rad_s);
+    Eigen::Matrix<double, 3, 4> h = Eigen::Matrix<double, 3, 4>::Zero();
+    h.leftCols<3>().setIdentity();
+    const Eigen::Vector3d innov = st.gyro_rest_lp_rad_s - st.bias_rad_s;
+    const Eigen::Vector4d dx = kalman_update<3>(st.cov, h, innov, w);
     st.bias_rad_s += dx.head<3>();
     st.gyro_scale += dx(3);
-    st.cov -= k * st.cov.topRows<3>();
   }
   // The motion update runs at most every kBiasPeriod_s (the paper's 25 Hz): the bias changes
   // over minutes, and the drift of the vertical over 40 ms is a better-conditioned measurement
@@ -625,37 +676,9 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
     e = e.cwiseMax(-p.max_bias_rad_s).cwiseMin(p.max_bias_rad_s);
     // The same steady-state rule for one update per span: V over the span.
     const double w = sm2 * p.bias_forgetting_s / span + sm2;
-    // The Kalman step written out on the symmetric P: P H^T (4x2), S = H P H^T + w I (2x2,
-    // symmetric, inverted in closed form), K = P H^T S^-1, and P -= K (P H^T)^T formed on its
-    // upper triangle and mirrored, so P stays exactly symmetric (the full product kept that to
-    // rounding only). As Eigen products GCC left them out-of-line calls per packet: this is
-    // 102 instructions fewer per update on the 25 Hz dinghy (callgrind, attitude_count), the
-    // results the same to rounding (BROAD, the golden file).
-    Eigen::Matrix<double, 4, 2> pht;
-    for (int i = 0; i < 4; ++i) {
-      for (int j = 0; j < 2; ++j) {
-        pht(i, j) = st.cov(i, 0) * h(j, 0) + st.cov(i, 1) * h(j, 1) + st.cov(i, 2) * h(j, 2) +
-                    st.cov(i, 3) * h(j, 3);
-      }
-    }
-    const double s00 = h.row(0).dot(pht.col(0)) + w;
-    const double s01 = h.row(0).dot(pht.col(1));
-    const double s11 = h.row(1).dot(pht.col(1)) + w;
-    const double inv_det = 1.0 / (s00 * s11 - s01 * s01);
-    Eigen::Matrix<double, 4, 2> k;
-    for (int i = 0; i < 4; ++i) {
-      k(i, 0) = (pht(i, 0) * s11 - pht(i, 1) * s01) * inv_det;
-      k(i, 1) = (pht(i, 1) * s00 - pht(i, 0) * s01) * inv_det;
-    }
-    const Eigen::Vector4d dx = k.col(0) * e(0) + k.col(1) * e(1);
+    const Eigen::Vector4d dx = kalman_update<2>(st.cov, h, e, w);
     st.bias_rad_s += dx.head<3>();
     st.gyro_scale += dx(3);
-    for (int i = 0; i < 4; ++i) {
-      for (int j = i; j < 4; ++j) {
-        st.cov(i, j) -= k(i, 0) * pht(j, 0) + k(i, 1) * pht(j, 1);
-        st.cov(j, i) = st.cov(i, j);
-      }
-    }
   }
   if (course_known || st.course_window_s > 0.0) course_update(s.gyro_body_rad_s, course_known, dt);
   st.bias_rad_s = st.bias_rad_s.cwiseMax(-p.max_bias_rad_s).cwiseMin(p.max_bias_rad_s);
