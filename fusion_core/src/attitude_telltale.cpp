@@ -70,17 +70,19 @@ void butterworth_step(const Butterworth& c, const Eigen::Matrix<double, 3, 6>& x
 }
 
 /// One Kalman measurement update of the bias filter (state: the bias, then the gyro's scale;
-/// covariance p, symmetric): M independent measurements z = h x + noise, each of variance w,
-/// innov = z - h x. Updates p and returns the state's correction. Written out: P H^T (4xM),
-/// S = H P H^T + w I (MxM, symmetric), K = P H^T S^-1, and P -= K (P H^T)^T formed on its upper
-/// triangle and mirrored, so P stays exactly symmetric (the full product kept that to rounding
-/// only). As Eigen products GCC left them out-of-line calls per SIMD packet: the motion
+/// covariance st.cov, symmetric): M independent measurements z = h x + noise, each of variance
+/// w, innov = z - h x. Corrects the bias and the scale and updates the covariance. Written out: P
+/// H^T (4xM), S = H P H^T + w I (MxM, symmetric), K = P H^T S^-1, and P -= K (P H^T)^T formed on
+/// its upper triangle and mirrored, so P stays exactly symmetric (the full product kept that to
+/// rounding only). As Eigen products GCC left them out-of-line calls per SIMD packet: the motion
 /// update's step alone cost 102 instructions more per update on the 25 Hz dinghy (callgrind,
 /// attitude_count). Always inlined: it runs on every sample, and M fixes the loops.
 template <int M>
-[[gnu::always_inline]] inline Eigen::Vector4d kalman_update(
-    Eigen::Matrix4d& p, const Eigen::Matrix<double, M, 4>& h,
-    const Eigen::Matrix<double, M, 1>& innov, double w) {
+[[gnu::always_inline]] inline void kalman_update(TelltaleAttitudeFilter::State& st,
+                                                 const Eigen::Matrix<double, M, 4>& h,
+                                                 const Eigen::Matrix<double, M, 1>& innov,
+                                                 double w) {
+  Eigen::Matrix4d& p = st.cov;
   Eigen::Matrix<double, 4, M> pht;
   for (int i = 0; i < 4; ++i) {
     for (int j = 0; j < M; ++j) {
@@ -119,7 +121,8 @@ template <int M>
       p(j, i) = p(i, j);
     }
   }
-  return dx;
+  st.bias_rad_s += dx.head<3>();
+  st.gyro_scale += dx(3);
 }
 
 /// A unit vector perpendicular to the unit vector u (continuity does not matter: each motion
@@ -330,9 +333,7 @@ void TelltaleAttitudeFilter::course_update(const Eigen::Vector3d& gyro_raw, bool
   } else {
     // H = (hb, 0) on (bias, scale): the scale moves with the bias it is correlated with.
     const Eigen::RowVector4d h(hb.x(), hb.y(), hb.z(), 0.0);
-    const Eigen::Vector4d dx = kalman_update<1>(st.cov, h, Eigen::Matrix<double, 1, 1>(innov), w);
-    st.bias_rad_s += dx.head<3>();
-    st.gyro_scale += dx(3);
+    kalman_update<1>(st, h, Eigen::Matrix<double, 1, 1>(innov), w);
   }
   st.course_window_s = 0.0;
   st.course_gyro_rad = 0.0;
@@ -629,9 +630,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
     Eigen::Matrix<double, 3, 4> h = Eigen::Matrix<double, 3, 4>::Zero();
     h.leftCols<3>().setIdentity();
     const Eigen::Vector3d innov = st.gyro_rest_lp_rad_s - st.bias_rad_s;
-    const Eigen::Vector4d dx = kalman_update<3>(st.cov, h, innov, w);
-    st.bias_rad_s += dx.head<3>();
-    st.gyro_scale += dx(3);
+    kalman_update<3>(st, h, innov, w);
   }
   // The motion update runs at most every kBiasPeriod_s (the paper's 25 Hz): the bias changes
   // over minutes, and the drift of the vertical over 40 ms is a better-conditioned measurement
@@ -676,9 +675,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
     e = e.cwiseMax(-p.max_bias_rad_s).cwiseMin(p.max_bias_rad_s);
     // The same steady-state rule for one update per span: V over the span.
     const double w = sm2 * p.bias_forgetting_s / span + sm2;
-    const Eigen::Vector4d dx = kalman_update<2>(st.cov, h, e, w);
-    st.bias_rad_s += dx.head<3>();
-    st.gyro_scale += dx(3);
+    kalman_update<2>(st, h, e, w);
   }
   if (course_known || st.course_window_s > 0.0) course_update(s.gyro_body_rad_s, course_known, dt);
   st.bias_rad_s = st.bias_rad_s.cwiseMax(-p.max_bias_rad_s).cwiseMin(p.max_bias_rad_s);

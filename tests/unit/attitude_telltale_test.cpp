@@ -227,9 +227,9 @@ TEST(TelltaleAttitudeFilter, LearnsTheGyrosCommonScaleFromOneWayRotation) {
       f.update({t, 0.994 * Eigen::Vector3d(rate, 0.0, 0.0) + bias, kG * up});
       if (t < 55.0) continue;  // scored over the last 10 s
       const AttitudeOutput o = f.output();
-      const Eigen::Vector3d est(std::sin(o.pitch_rad), std::cos(o.pitch_rad) * std::sin(o.heel_rad),
-                                std::cos(o.pitch_rad) * std::cos(o.heel_rad));
-      worst_deg = std::max(worst_deg, std::acos(std::min(1.0, est.dot(up))) / kDeg);
+      // The truth's up (0, sin a, cos a) is heel a, pitch 0.
+      worst_deg =
+          std::max(worst_deg, inclination_error_rad(o.heel_rad, o.pitch_rad, angle, 0.0) / kDeg);
     }
     k_out = f.state().gyro_scale;
     return worst_deg;
