@@ -41,6 +41,7 @@ struct EvalOptions {
   int first_seed = 2001;
   bool detail = false;                       ///< IPOL: every file's misses and extras
   std::string detail_method = "gait-phase";  ///< ...of this detector
+  double rate_hz = 0.0;  ///< > 0: the real recordings resampled to this rate (resample_records)
 };
 
 double count_accuracy(std::size_t counted, std::size_t truth) {
@@ -104,6 +105,12 @@ void gait_table(const EvalOptions& o) {
 }
 
 std::string data_dir(const EvalOptions& o) { return real_data_dir(o.data_dir); }
+
+/// A real recording as read, or as a sensor at --rate-hz would have given it.
+std::vector<ImuRecord> read_records(const EvalOptions& o, const std::string& path) {
+  auto records = read_imu_csv(path, false);
+  return o.rate_hz > 0.0 ? resample_records(records, o.rate_hz) : records;
+}
 
 std::string find_oxford(const EvalOptions& o) {
   if (!o.oxford_dir.empty()) return o.oxford_dir;
@@ -270,7 +277,7 @@ void ipol_table(const EvalOptions& o, bool foot) {
       std::sort(hs.begin(), hs.end());
       const auto outside = [&t](double x) { return x < t.uturn0_s || x > t.uturn1_s; };
       const auto truth_out = static_cast<std::size_t>(std::count_if(hs.begin(), hs.end(), outside));
-      const auto records = read_imu_csv(path, false);
+      const auto records = read_records(o, path);
       const double end_s = records.empty() ? 0.0 : records.back().imu.t_s;
       const auto past = static_cast<std::size_t>(
           std::count_if(hs.begin(), hs.end(), [&](double x) { return x > end_s && outside(x); }));
@@ -357,7 +364,7 @@ void oxford_table(const EvalOptions& o) {
     progress("oxford", ++i, static_cast<int>(traces.size()));
     std::string path = dir + "/" + trace + ".imu.csv";
     if (!std::filesystem::exists(path)) path += ".gz";
-    const auto records = read_imu_csv(path, false);
+    const auto records = read_records(o, path);
     std::vector<fusion::ImuSample> samples;
     for (const auto& r : records) samples.push_back(r.imu);
     std::printf("| %s | %d |", trace.c_str(), truth);
@@ -581,7 +588,7 @@ void ipin_table(const EvalOptions& o) {
       std::printf("| %s | (no landmarks) | | | | | | |\n", name.c_str());
       continue;
     }
-    const auto records = read_imu_csv(dir + "/" + name + ".imu.csv", false);
+    const auto records = read_records(o, dir + "/" + name + ".imu.csv");
     fusion::HandheldPdrParams params;
     params.height_m = 1.75;
     const HandheldWalk walk = run_handheld_walk(records, params);
@@ -699,6 +706,10 @@ void register_steps_eval(CLI::App& app) {
   cmd->add_option("--detail-method", opts->detail_method,
                   "the detector --ipol-detail describes")
       ->capture_default_str();
+  cmd->add_option("--rate-hz", opts->rate_hz,
+                  "resample the real recordings (IPOL, Oxford, IPIN) to this rate first: below "
+                  "theirs by averaging, above by interpolation (the detectors at 50-200 Hz)")
+      ->check(CLI::Range(10.0, 1000.0));
   cmd->add_option("--tables", opts->tables, "comma list: gait, ipol, oxford, pose, pdr, ipin (IPIN 2023 phone walks, DATA/ipin_pdr)")
       ->capture_default_str();
   cmd->callback([opts] { run_eval(*opts); });

@@ -37,6 +37,15 @@ struct ImuRecord {
                                                   bool* has_gyro = nullptr, bool* has_mag = nullptr,
                                                   std::size_t* repeated_stamps = nullptr);
 
+/// The recording as a sensor sampling at `rate_hz` would have given it, on a grid from its first
+/// time: below the recording's rate each sample is the mean of the readings within half a period
+/// of its time (a sensor's output-rate averaging, which keeps the steps' band below 4 Hz and
+/// removes what would alias), above it the readings are interpolated linearly (no new content:
+/// it shows what depends on the rate itself, the detectors' sample counts and filters' steps).
+/// Readings missing (NaN) stay missing. Used by steps-eval's --rate-hz on the real recordings.
+[[nodiscard]] std::vector<ImuRecord> resample_records(const std::vector<ImuRecord>& records,
+                                                      double rate_hz);
+
 /// A phone walk through HandheldPdr, as `fusion_cli pdr --mount phone` writes it and steps-eval
 /// scores it: every step laid as walked (`live`, the track `wearable_node` publishes), then the
 /// whole track re-laid with the gyro bias the walk ended with (`steps`; fusion::relay_track says
