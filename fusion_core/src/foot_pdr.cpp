@@ -57,7 +57,7 @@ const PdrOutput& FootPdr::update(const ImuSample& raw, const Eigen::Vector3d& ma
   Eigen::Vector3d mag;
   if (!sensors_.prepare(raw, mag_uT, diag_, s, mag)) return out_;
   diag_.still_windows = sensors_.still_windows();
-  out_.t_s = s.t_s;
+  out_.t_s = raw.t_s;  // the caller's clock; the stages run on s.t_s, the local one
   // The sensor's frame is the walking frame: a foot carries it one way.
   heading_.update(s.t_s, s.gyro_body_rad_s, s.acc_body_m_s2, mag);
   if (heading_.initialised()) {

@@ -19,7 +19,7 @@ GaitPhaseStepDetector::GaitPhaseStepDetector(Params params)
 
 void GaitPhaseStepDetector::reset() { *this = GaitPhaseStepDetector(params_); }
 
-bool GaitPhaseStepDetector::update(const ImuSample& s, StepEvent& event) {
+bool GaitPhaseStepDetector::on_sample(const ImuSample& s, StepEvent& event) {
   const double dt = gate(s, have_t_, last_t_s_, diag_);
   if (dt < 0.0) return false;
   if (params_.mount == StepMount::kFoot && s.gyro_body_rad_s.allFinite()) {
@@ -314,7 +314,7 @@ bool GaitPhaseStepDetector::release_body_step(StepEvent& event) {
   return true;
 }
 
-bool GaitPhaseStepDetector::flush(StepEvent& event) {
+bool GaitPhaseStepDetector::on_flush(StepEvent& event) {
   while (judging_first_) judge_first_body_step(true);
   return release_body_step(event);
 }

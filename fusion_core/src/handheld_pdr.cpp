@@ -33,7 +33,9 @@ HandheldPdr::HandheldPdr(Params p)
       bias_(p.bias),
       detector_(p.steps) {}
 
-int HandheldPdr::update(const ImuSample& s, const Eigen::Vector3d& mag_uT) {
+int HandheldPdr::update(const ImuSample& sample, const Eigen::Vector3d& mag_uT) {
+  ImuSample s = sample;
+  s.t_s = clock_.to_local(sample.t_s);  // every stage on the local clock (LocalClock says why)
   if (gate_imu_sample(s, ImuGateParams{}, have_t_, last_t_s_, diag_).verdict ==
       ImuVerdict::kReject) {
     return 0;
@@ -79,7 +81,7 @@ int HandheldPdr::update(const ImuSample& s, const Eigen::Vector3d& mag_uT) {
         params_.step_scale * walk_ratio_step_length_m(params_.height_m, hz, params_.length);
     const WalkingHeading::At at = heading_.at(c.t_s);
     const double heading = at.heading_rad;
-    last_.t_s = c.t_s;
+    last_.t_s = clock_.to_caller(c.t_s);
     last_.x_m += len * std::sin(heading);
     last_.y_m += len * std::cos(heading);
     last_.heading_deg = wrap_360_deg(heading * 180.0 / M_PI);

@@ -283,7 +283,7 @@ const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT
   Eigen::Vector3d mag;
   if (!sensors_.prepare(raw, mag_uT, diag_, s, mag)) return out_;
   diag_.still_windows = sensors_.still_windows();
-  out_.t_s = s.t_s;
+  out_.t_s = raw.t_s;  // the caller's clock; the stages run on s.t_s, the local one
   pose_.push(s);
   recent_.push(s);
   // Into the walking frame of the pose in force (eqs. (14)-(15)).

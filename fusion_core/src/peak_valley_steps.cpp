@@ -30,7 +30,7 @@ bool PeakValleyStepDetector::keeps_rhythm(double t_s) const {
 
 void PeakValleyStepDetector::reset() { *this = PeakValleyStepDetector(params_); }
 
-bool PeakValleyStepDetector::update(const ImuSample& s, StepEvent& event) {
+bool PeakValleyStepDetector::on_sample(const ImuSample& s, StepEvent& event) {
   const double dt = gate(s, have_t_, last_t_s_, diag_);
   if (dt < 0.0) return false;
   const bool rule = params_.max_tilt_deg > 0.0;
@@ -66,7 +66,7 @@ bool PeakValleyStepDetector::update(const ImuSample& s, StepEvent& event) {
   return false;
 }
 
-bool PeakValleyStepDetector::flush(StepEvent& event) {
+bool PeakValleyStepDetector::on_flush(StepEvent& event) {
   // The stream has ended: the second after a held step is not all there, and the check before
   // it was made. Release as it is.
   if (held_.size() == 0) return false;

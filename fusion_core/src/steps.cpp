@@ -128,7 +128,7 @@ std::array<double, 4> AdaptiveStepDetector::thresholds() const {
           std::min(gyro_window_.negative_mean(), -params_.gyro_floor_rad_s)};
 }
 
-bool AdaptiveStepDetector::update(const ImuSample& s, StepEvent& event) {
+bool AdaptiveStepDetector::on_sample(const ImuSample& s, StepEvent& event) {
   const double dt = gate(s, have_t_, last_t_s_, diag_);
   if (dt < 0.0) return false;
   const bool gyro_ok = params_.use_gyro && s.gyro_body_rad_s.allFinite();
@@ -215,7 +215,7 @@ PeakStepDetector::PeakStepDetector(Params params) : params_(params), lp_(params.
 
 void PeakStepDetector::reset() { *this = PeakStepDetector(params_); }
 
-bool PeakStepDetector::update(const ImuSample& s, StepEvent& event) {
+bool PeakStepDetector::on_sample(const ImuSample& s, StepEvent& event) {
   bool have_t = n_ > 0;
   const double dt = gate(s, have_t, last_t_s_, diag_);
   if (dt < 0.0) return false;
@@ -244,7 +244,7 @@ FixedThresholdStepDetector::FixedThresholdStepDetector(Params params)
 
 void FixedThresholdStepDetector::reset() { *this = FixedThresholdStepDetector(params_); }
 
-bool FixedThresholdStepDetector::update(const ImuSample& s, StepEvent& event) {
+bool FixedThresholdStepDetector::on_sample(const ImuSample& s, StepEvent& event) {
   const double dt = gate(s, have_t_, last_t_s_, diag_);
   if (dt < 0.0) return false;
   const double y = lp_.step(s.acc_body_m_s2.norm(), dt);

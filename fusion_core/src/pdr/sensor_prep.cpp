@@ -5,9 +5,11 @@ namespace telltale::fusion {
 bool SensorPrep::prepare(const ImuSample& raw, const Eigen::Vector3d& mag_uT, ImuGateCounts& counts,
                          ImuSample& s, Eigen::Vector3d& mag) {
   static constexpr ImuGateParams kGate{.gyro_required = false};
-  if (gate_imu_sample(raw, kGate, have_t_, last_t_s_, counts).verdict == ImuVerdict::kReject)
+  ImuSample local = raw;
+  local.t_s = clock_.to_local(raw.t_s);
+  if (gate_imu_sample(local, kGate, have_t_, last_t_s_, counts).verdict == ImuVerdict::kReject)
     return false;
-  s = raw;
+  s = local;
   if (s.gyro_body_rad_s.allFinite()) {
     gyro_bias_.add(s);
     s.gyro_body_rad_s -= gyro_bias_.bias_rad_s();

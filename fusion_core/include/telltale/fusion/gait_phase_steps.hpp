@@ -115,9 +115,9 @@ class GaitPhaseStepDetector final : public StepDetector {
   explicit GaitPhaseStepDetector(Params params = {});
   /// `event.t_s` is the time the step happened (the heel strike), up to ~0.4 s before the
   /// sample that confirmed it; on the body, a walk's first steps up to its fourth step later.
-  bool update(const ImuSample& sample, StepEvent& event) override;
+  bool on_sample(const ImuSample& sample, StepEvent& event) override;
   /// Body: the steps still held (a walk's first and those after it) at the end of the stream.
-  bool flush(StepEvent& event) override;
+  bool on_flush(StepEvent& event) override;
   void reset() override;
   [[nodiscard]] std::string_view name() const override { return "gait-phase"; }
   [[nodiscard]] const StepDiagnostics& diagnostics() const override { return diag_; }

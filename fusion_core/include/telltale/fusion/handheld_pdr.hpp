@@ -86,7 +86,8 @@ class HandheldPdr {
   using Params = HandheldPdrParams;
   explicit HandheldPdr(Params p = {});
   /// Feeds one sample (mag may be NaN). Returns how many steps were laid at it: steps()[0..n),
-  /// each with its own time (at or before this sample's).
+  /// each with its own time (at or before this sample's, on the caller's clock; the stages run
+  /// on a LocalClock).
   int update(const ImuSample& s, const Eigen::Vector3d& mag_uT);
   [[nodiscard]] const std::array<HandheldStep, WalkStepDetector::kMaxHeld>& steps() const {
     return laid_;
@@ -103,6 +104,7 @@ class HandheldPdr {
  private:
   Params params_;
   ImuGateCounts diag_;
+  LocalClock clock_;
   bool have_t_ = false;
   double last_t_s_ = 0.0;
   TelltaleAttitudeFilter att_;

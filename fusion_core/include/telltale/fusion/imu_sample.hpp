@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cmath>
 #include <limits>
 
 namespace telltale::fusion {
@@ -17,6 +18,34 @@ struct ImuSample {
   double t_s = 0.0;                                       ///< sample time, seconds (any epoch)
   Eigen::Vector3d gyro_body_rad_s = Eigen::Vector3d::Zero();  ///< body rate, rad/s, right-hand
   Eigen::Vector3d acc_body_m_s2 = Eigen::Vector3d::Zero();    ///< specific force, m/s^2 (+g up at rest)
+};
+
+/// The time base of every step detector and dead reckoner: seconds since the first sample, to
+/// the microsecond. A sensor's clock ticks on a grid (t0 + n / rate), so durations between
+/// samples land exactly on a detector's thresholds (0.2 s is 20 samples at 100 Hz; 0.99 s is
+/// 1.5 x 0.66 s). Computed from the caller's time stamps, which side of a threshold such a
+/// duration falls on depends on how the stamps round, and so on where time zero is: the same
+/// walk stamped from 0 and with Unix time (2^-22 s resolution) counted different steps. From
+/// the first sample and rounded to 1 us, every origin gives the same local times, so the same
+/// decisions: 1 us is far below any clock tick that matters to gait (1-20 ms) and far above a
+/// Unix-time double's rounding (0.12 us until the year 2106). NaN and Inf pass through (the gate
+/// refuses them).
+class LocalClock {
+ public:
+  [[nodiscard]] double to_local(double t_s) {
+    if (!std::isfinite(t_s)) return t_s;
+    if (!started_) {
+      started_ = true;
+      origin_s_ = t_s;
+    }
+    return std::round((t_s - origin_s_) * 1e6) / 1e6;
+  }
+  /// A local time (an event's) on the caller's clock.
+  [[nodiscard]] double to_caller(double local_s) const { return origin_s_ + local_s; }
+
+ private:
+  double origin_s_ = 0.0;
+  bool started_ = false;
 };
 
 /// What one IMU can measure, for gate_imu_sample. Defaults: full scale unknown (nothing counts

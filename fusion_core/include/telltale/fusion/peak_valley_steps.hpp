@@ -45,8 +45,8 @@ class PeakValleyStepDetector final : public StepDetector {
  public:
   using Params = PeakValleyStepParams;
   explicit PeakValleyStepDetector(Params params = {});
-  bool update(const ImuSample& sample, StepEvent& event) override;
-  bool flush(StepEvent& event) override;
+  bool on_sample(const ImuSample& sample, StepEvent& event) override;
+  bool on_flush(StepEvent& event) override;
   void reset() override;
   [[nodiscard]] std::string_view name() const override { return "peak-valley"; }
   [[nodiscard]] const StepDiagnostics& diagnostics() const override { return diag_; }

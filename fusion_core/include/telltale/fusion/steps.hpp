@@ -155,11 +155,25 @@ class StepDetector {
  public:
   virtual ~StepDetector() = default;
   /// Feeds one sample. Returns true and fills `event` when a step is reported at this sample
-  /// (peak-valley on a phone reports each a second after confirming it: see its Params).
-  virtual bool update(const ImuSample& sample, StepEvent& event) = 0;
+  /// (peak-valley on a phone reports each a second after confirming it: see its Params). The
+  /// detector sees the time on its LocalClock (the same steps whatever the time origin);
+  /// `event.t_s` is on the caller's.
+  bool update(const ImuSample& sample, StepEvent& event) {
+    ImuSample local = sample;
+    local.t_s = clock_.to_local(sample.t_s);
+    if (!on_sample(local, event)) return false;
+    event.t_s = clock_.to_caller(event.t_s);
+    return true;
+  }
   /// The end of the stream: returns true and fills `event` while steps are still held (call
   /// until false). Only a detector that holds steps has any.
-  virtual bool flush(StepEvent& /*event*/) { return false; }
+  bool flush(StepEvent& event) {
+    if (!on_flush(event)) return false;
+    event.t_s = clock_.to_caller(event.t_s);
+    return true;
+  }
+  /// Back to the state before the first sample (the clock's origin too: each detector's reset
+  /// assigns a new detector to itself).
   virtual void reset() = 0;
   [[nodiscard]] virtual std::string_view name() const = 0;
   [[nodiscard]] virtual const StepDiagnostics& diagnostics() const = 0;
@@ -169,6 +183,12 @@ class StepDetector {
   /// time advancing; the gyro may be missing (the detectors that use it check gyro_finite).
   /// Returns dt (0 on the first sample) or a negative value when the sample must be ignored.
   static double gate(const ImuSample& s, bool& have_t, double& last_t, StepDiagnostics& diag);
+  /// update() and flush() of each detector, on its local time.
+  virtual bool on_sample(const ImuSample& sample, StepEvent& event) = 0;
+  virtual bool on_flush(StepEvent& /*event*/) { return false; }
+
+ private:
+  LocalClock clock_;
 };
 
 /// Runs `detector` over a whole stream of samples and its end: `on_step(event)` for every step
@@ -211,7 +231,7 @@ class AdaptiveStepDetector final : public StepDetector {
  public:
   using Params = AdaptiveStepParams;
   explicit AdaptiveStepDetector(Params params = {});
-  bool update(const ImuSample& sample, StepEvent& event) override;
+  bool on_sample(const ImuSample& sample, StepEvent& event) override;
   void reset() override;
   [[nodiscard]] std::string_view name() const override { return "adaptive"; }
   [[nodiscard]] const StepDiagnostics& diagnostics() const override { return diag_; }
@@ -247,7 +267,7 @@ class PeakStepDetector final : public StepDetector {
  public:
   using Params = PeakStepParams;
   explicit PeakStepDetector(Params params = {});
-  bool update(const ImuSample& sample, StepEvent& event) override;
+  bool on_sample(const ImuSample& sample, StepEvent& event) override;
   void reset() override;
   [[nodiscard]] std::string_view name() const override { return "peak"; }
   [[nodiscard]] const StepDiagnostics& diagnostics() const override { return diag_; }
@@ -273,7 +293,7 @@ class FixedThresholdStepDetector final : public StepDetector {
  public:
   using Params = FixedThresholdStepParams;
   explicit FixedThresholdStepDetector(Params params = {});
-  bool update(const ImuSample& sample, StepEvent& event) override;
+  bool on_sample(const ImuSample& sample, StepEvent& event) override;
   void reset() override;
   [[nodiscard]] std::string_view name() const override { return "fixed-threshold"; }
   [[nodiscard]] const StepDiagnostics& diagnostics() const override { return diag_; }

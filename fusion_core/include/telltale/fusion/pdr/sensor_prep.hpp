@@ -22,8 +22,9 @@ class SensorPrep {
   SensorPrep(const GyroBiasParams& gyro_bias, bool calibrate_mag, const HardIronParams& hard_iron)
       : gyro_bias_(gyro_bias), mag_cal_(hard_iron), calibrate_mag_(calibrate_mag) {}
   /// One raw sample and its field (NaN: none). false: the gate rejected it (counted in
-  /// `counts`), `s` and `mag` untouched. true: `s` with the bias off its rate (when it has one),
-  /// `mag` with the offset off (when it is finite and calibration is on).
+  /// `counts`), `s` and `mag` untouched. true: `s` on the stages' LocalClock (the same steps
+  /// whatever the time origin) with the bias off its rate (when it has one), `mag` with the
+  /// offset off (when it is finite and calibration is on).
   bool prepare(const ImuSample& raw, const Eigen::Vector3d& mag_uT, ImuGateCounts& counts,
                ImuSample& s, Eigen::Vector3d& mag);
   /// Gyro bias learnt while still (sensor frame, rad/s).
@@ -31,13 +32,14 @@ class SensorPrep {
   /// Still windows that set the gyro bias so far.
   [[nodiscard]] unsigned still_windows() const { return gyro_bias_.windows(); }
   [[nodiscard]] const HardIronCalibrator& mag_calibration() const { return mag_cal_; }
-  /// The last accepted sample's time (0 before the first).
+  /// The last accepted sample's time, local (0 before the first).
   [[nodiscard]] double last_t_s() const { return last_t_s_; }
 
  private:
   GyroBiasLearner gyro_bias_;
   HardIronCalibrator mag_cal_;
   bool calibrate_mag_;
+  LocalClock clock_;
   bool have_t_ = false;
   double last_t_s_ = 0.0;
 };
