@@ -99,6 +99,35 @@ std::vector<Segment> loop_plan() {
           {Phase::kPause, 8.0, 45.0}, {Phase::kWalking, 20.0, 45.0}, {Phase::kStanding, 10.0}};
 }
 
+// Given a phone sampled at 50, 100, 200 and 400 Hz (phones run their sensors at any of these),
+// then the walk detector's windows span the same seconds at every rate: the vertical force's
+// mean over mean_s and its smoothing over smooth_s. Seen failing with its rings at 256 and 32
+// samples, which a full ring cut short above 128 / 160 Hz (at 400 Hz a 0.64 s mean and a 0.08 s
+// smoothing); on the IPIN walks resampled to 200 Hz (`steps-eval --rate-hz 200`) that counted 3
+// more steps on every walk of route 01 and walked 4 % farther.
+TEST(WalkStepDetector, ItsWindowsSpanTheirSecondsAt50To400Hz) {
+  const telltale::fusion::WalkStepParams p;
+  for (double rate : {50.0, 100.0, 200.0, 400.0}) {
+    telltale::fusion::WalkStepDetector d(p);
+    ImuSample s;
+    for (int i = 0; i <= static_cast<int>(3.0 * rate); ++i) {
+      s.t_s = i / rate;
+      s.acc_body_m_s2 = {0.0, 0.0, kG + 2.0 * std::sin(2.0 * M_PI * 1.8 * s.t_s)};
+      d.update(s, Eigen::Vector3d::UnitZ());
+    }
+    const auto& st = d.state();
+    const auto newest = [](const auto& ring, std::size_t head, std::size_t size) {
+      return ring[(head + size - 1) % ring.size()];
+    };
+    const double mean_span = newest(st.ring_t, st.head, st.size) - st.ring_t[st.head];
+    const double smooth_span = newest(st.sm_t, st.sm_head, st.sm_size) - st.sm_t[st.sm_head];
+    // The mean: every sample up to mean_s old; the smoothing: those younger than smooth_s, n
+    // samples spanning n - 1 intervals.
+    EXPECT_NEAR(mean_span, p.mean_s, 0.5 / rate) << rate << " Hz";
+    EXPECT_NEAR(smooth_span + 1.0 / rate, p.smooth_s, 0.5 / rate) << rate << " Hz";
+  }
+}
+
 // Given a phone handled at random for its first seconds (turns of 2-7 rad/s, the hand's
 // jerks), then the PDR's attitude filter, which is the boat's with its defaults (no platform
 // rule), never runs its start's line fit: it has no GNSS speed, the only evidence of a hull in a

@@ -30,7 +30,7 @@ int WalkStepDetector::update(const ImuSample& s, const Eigen::Vector3d& up) {
   }
   const double centred = v - st.sum_v / static_cast<double>(st.size);
   // Smoothed over smooth_s.
-  constexpr std::size_t kSm = 32;
+  constexpr std::size_t kSm = State::kSm;
   if (st.sm_size == kSm) {
     st.sm_sum -= st.sm_v[st.sm_head];
     st.sm_head = (st.sm_head + 1) % kSm;

@@ -60,13 +60,17 @@ class WalkStepDetector {
     double peak_m_s2 = 0.0;  ///< its peak of the smoothed vertical force, over its 2 s mean
   };
   struct State {
-    // Moving sums (ring of the last mean_s of vertical force).
-    static constexpr std::size_t kRing = 256;
+    // Moving sums (ring of the last mean_s of vertical force), sized for phones up to 400 Hz
+    // (Android's fastest rate is 200-500 Hz): a full ring drops its oldest, so a faster stream
+    // would shorten both windows. At 256 and 32 (2 s and 0.2 s at 128 / 160 Hz) the IPIN walks
+    // resampled to 200 Hz counted 3 more steps each on route 01 and walked 4 % farther.
+    static constexpr std::size_t kRing = 1024;
+    static constexpr std::size_t kSm = 128;
     std::array<double, kRing> ring_t{}, ring_v{};
     std::size_t head = 0, size = 0;
     double sum_v = 0.0;
-    std::array<double, 32> sm_v{};  ///< last smoothing window of centred values
-    std::array<double, 32> sm_t{};
+    std::array<double, kSm> sm_v{};  ///< last smoothing window of centred values
+    std::array<double, kSm> sm_t{};
     std::size_t sm_head = 0, sm_size = 0;
     double sm_sum = 0.0;
     double prev_s = 0.0, prev2_s = 0.0, prev_t_s = 0.0;  ///< smoothed signal, two samples
