@@ -25,6 +25,7 @@ struct EvalAttitudeOptions {
   std::string broad_dir;               // empty = broad/ in the real-data folder
   std::string data_dir;                // --data: the real-data folder (real_data_dir)
   bool skip_broad = false;
+  double broad_rate_hz = 0.0;  // > 0: BROAD resampled to this rate (fusion::resample_trial)
   bool skip_sim = false;
   bool uncalibrated = false;  ///< raw datasheet sensor errors instead of the calibrated instrument
 };
@@ -105,8 +106,12 @@ void run_eval_attitude(const EvalAttitudeOptions& o) {
     }
   }
   std::sort(trials.begin(), trials.end());
-  std::printf("\n## attitude: BROAD (%s), inclination RMSE over movement rows, deg\n\n| trial |",
-              dir.c_str());
+  const std::string rate =
+      o.broad_rate_hz > 0.0
+          ? ", resampled to " + std::to_string(std::lround(o.broad_rate_hz)) + " Hz"
+          : "";
+  std::printf("\n## attitude: BROAD (%s%s), inclination RMSE over movement rows, deg\n\n| trial |",
+              dir.c_str(), rate.c_str());
   for (const auto& f : filters) std::printf(" %s |", f.c_str());
   std::printf("\n|---|");
   for (std::size_t i = 0; i < filters.size(); ++i) std::printf("---|");
@@ -114,8 +119,9 @@ void run_eval_attitude(const EvalAttitudeOptions& o) {
   std::vector<double> sum(filters.size(), 0.0);
   for (const auto& trial : trials) {
     progress("eval attitude: BROAD " + trial);
-    const auto data =
-        io::read_broad_trial(dir + "/" + trial + ".imu.csv", dir + "/" + trial + ".truth.csv");
+    const auto data = fusion::resample_trial(
+        io::read_broad_trial(dir + "/" + trial + ".imu.csv", dir + "/" + trial + ".truth.csv"),
+        o.broad_rate_hz);
     std::printf("| %s |", trial.c_str());
     for (std::size_t i = 0; i < filters.size(); ++i) {
       auto filter = fusion::make_attitude_filter(filters[i]);
@@ -147,6 +153,10 @@ void register_eval_attitude(CLI::App& eval, std::vector<std::function<void()>>& 
                   "real recordings folder (default: $TELLTALE_DATA, else ../shared/data); "
                   "BROAD is its broad/");
   cmd->add_option("--broad-dir", opts->broad_dir, "BROAD CSV folder (default: DATA/broad)");
+  cmd->add_option("--broad-rate-hz", opts->broad_rate_hz,
+                  "BROAD resampled to this rate first (averaged over each interval, as a "
+                  "sensor's output rate; the recordings are 286 Hz, a boat node runs 25-100 Hz)")
+      ->check(CLI::Range(5.0, 1000.0));
   cmd->add_flag("--no-broad", opts->skip_broad, "skip the BROAD recordings");
   cmd->add_flag("--no-sim", opts->skip_sim, "skip the simulator (BROAD only)");
   cmd->add_flag("--uncalibrated", opts->uncalibrated,

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "broad.hpp"
+#include "telltale/fusion/attitude.hpp"
 #include "telltale/fusion/attitude_eval.hpp"
 #include "telltale/fusion/attitude_telltale.hpp"
 
@@ -33,16 +34,21 @@ std::string gunzip_to_temp(const std::string& gz_path) {
   return out;
 }
 
-/// The production filter's inclination RMSE on one trial of tests/data/broad.
-double trial_rmse_deg(const std::string& trial, const TelltaleAttitudeParams& params = {}) {
+/// One trial of tests/data/broad, as recorded (286 Hz) or resampled to `rate_hz`.
+InclinationTrial read_trial(const std::string& trial, double rate_hz = 0.0) {
   const std::string dir = std::string(TELLTALE_TEST_DATA_DIR) + "/broad/";
   const std::string imu = gunzip_to_temp(dir + trial + ".imu.csv.gz");
   const std::string truth = gunzip_to_temp(dir + trial + ".truth.csv.gz");
   const InclinationTrial data = io::read_broad_trial(imu, truth);
   std::filesystem::remove(imu);
   std::filesystem::remove(truth);
+  return resample_trial(data, rate_hz);
+}
+
+/// The production filter's inclination RMSE on one trial of tests/data/broad.
+double trial_rmse_deg(const std::string& trial, const TelltaleAttitudeParams& params = {}) {
   TelltaleAttitudeFilter filter(params);
-  return inclination_rmse_deg(filter, data);
+  return inclination_rmse_deg(filter, read_trial(trial));
 }
 
 TEST(Broad, ProductionFilterMeanInclinationRmseWithinTarget) {
@@ -77,6 +83,40 @@ TEST(Broad, TheGyrosCommonScaleIsLearntOnTrial08) {
   std::printf("  %s: %.3f deg (without the scale's state %.3f)\n", trial.c_str(), e, e_off);
   EXPECT_LT(e, 1.0);
   EXPECT_GT(e_off, 1.3);
+}
+
+// A boat node's IMU runs at 25-100 Hz, not BROAD's 286: the seven trials as a sensor averaging
+// to 50 Hz would give them (resample_trial). Measured: 0.45, 1.51, 1.54, 0.45, 0.82, 0.46, 0.38
+// deg (mean 0.80; the fast rotations lose most, 8-12 deg per sample), the best baseline on each
+// 0.89-22 deg. Bound: mean <= 1.0, and ahead of every baseline on every trial. Seen failing with
+// the low-pass's coefficients formed for a fixed 286 Hz sample interval instead of each
+// sample's: mean 1.94, trial 08 5.83, trial 02 1.08 behind the plain average's 0.89.
+TEST(Broad, AtABoatNodesRateTheFilterHoldsAndLeadsEveryBaseline) {
+  const char* trials[] = {"02_undisturbed_slow_rotation_B",
+                          "07_undisturbed_fast_rotation_B",
+                          "08_undisturbed_fast_rotation_with_breaks_A",
+                          "11_undisturbed_slow_translation_B",
+                          "16_undisturbed_fast_translation_B",
+                          "25_disturbed_tapping_B",
+                          "27_disturbed_phone_vibration_B"};
+  double sum = 0.0;
+  for (const char* trial : trials) {
+    const InclinationTrial data = read_trial(trial, 50.0);
+    ASSERT_GT(data.imu.size(), 1000u) << trial;
+    double e_filter = 0.0;
+    for (const auto& name : attitude_filter_names()) {
+      auto filter = make_attitude_filter(name);
+      const double e = inclination_rmse_deg(*filter, data);
+      std::printf("  %s at 50 Hz, %s: %.3f deg\n", trial, name.c_str(), e);
+      if (name == kDefaultAttitudeFilter) {
+        e_filter = e;
+        sum += e;
+      } else {
+        EXPECT_LT(e_filter, e) << trial << " against " << name;
+      }
+    }
+  }
+  EXPECT_LE(sum / 7.0, 1.0);
 }
 
 }  // namespace
