@@ -180,10 +180,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
     hp.step_scale = o.step_scale;
     phone_pdr = std::make_unique<fusion::HandheldPdr>(hp);
   } else if (foot) {
-    fusion::FootPdrParams params;
-    params.step_length.height_m = o.height_m;
-    params.step_length.scale.fill(o.step_scale);
-    foot_pdr = std::make_unique<fusion::FootPdr>(params);
+    foot_pdr = std::make_unique<fusion::FootPdr>();  // the stride is measured: no height
   } else {
     fusion::PdrParams params;
     params.step_length.height_m = o.height_m;
@@ -302,7 +299,8 @@ int main(int argc, char** argv) {
   app.add_flag("--replay-fast", o.replay_fast, "replay as fast as possible")->group(sensor);
 
   const std::string step = "Step length";
-  app.add_option("--height-m", o.height_m, "athlete's height (step length model)")
+  app.add_option("--height-m", o.height_m,
+                 "athlete's height (step length model; a foot's strides are measured)")
       ->capture_default_str()
       ->group(step);
   app.add_option("--step-scale", o.step_scale,

@@ -114,10 +114,7 @@ void run_pdr(const PdrOptions& o) {
     return;
   }
   if (o.mount == "foot") {
-    fusion::FootPdrParams params;
-    params.step_length.height_m = o.height_m;
-    params.step_length.scale.fill(o.step_scale);
-    fusion::FootPdr pdr(params);
+    fusion::FootPdr pdr;  // the stride is measured: no height, no step scale
     run_track(o, records, has_gyro, has_mag, repeated, pdr);
     return;
   }
@@ -150,7 +147,8 @@ void register_pdr(CLI::App& app) {
                   "phone: held in front (reading pose; steps only while walking, heading from "
                   "the gyro about the vertical; the track re-laid once the walk is over with the "
                   "gyro bias all its stands measured) | body: the four simulated poses of seed "
-                  "003 | foot")
+                  "003 | foot: each stride measured by the foot's inertial navigation, reset at "
+                  "every stance (height and step scale unused; a gyro is required)")
       ->capture_default_str();
   cmd->callback([opts] { run_pdr(*opts); });
 }

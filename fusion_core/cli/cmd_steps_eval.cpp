@@ -19,6 +19,7 @@
 
 #include "commands.hpp"
 #include "gait_io.hpp"
+#include "telltale/fusion/foot_pdr.hpp"
 #include "telltale/fusion/handheld_pdr.hpp"
 #include "telltale/fusion/sim/gait_sim.hpp"
 #include "telltale/fusion/sim/phone_walk.hpp"
@@ -659,10 +660,56 @@ void ipin_table(const EvalOptions& o) {
   std::fflush(stdout);
 }
 
+/// The foot PDR (FootPdr: `pdr --mount foot`, the wearable's foot) on every IPOL foot file: each
+/// walk goes 10 m, turns and comes back 10 m, so a track should walk about 20 m (plus the turn)
+/// and end where it began. The recordings have no position truth beyond that protocol.
+void ipol_foot_pdr_table(const EvalOptions& o) {
+  const std::string dir = data_dir(o) + "/ipol_gait";
+  if (!std::filesystem::exists(dir)) return;
+  const auto trials = ipol_trials(dir);
+  std::printf(
+      "\n## IPOL healthy gait (%s), foot PDR (`pdr --mount foot`): walk 10 m, turn, walk back "
+      "10 m\n\n| file | steps counted / annotated (both feet, outside the U-turn) | walked m | "
+      "end from start m |\n|---|---|---|---|\n",
+      dir.c_str());
+  std::vector<double> walked, ends;
+  for (const auto& t : trials) {
+    for (const std::string side : {"lf", "rf"}) {
+      const std::string path = dir + "/" + t.name + "_" + side + ".imu.csv";
+      if (!std::filesystem::exists(path)) continue;
+      const auto records = read_records(o, path);
+      fusion::FootPdr pdr;
+      for (const auto& r : records) pdr.update(r.imu, r.mag_uT);
+      const auto& out = pdr.output();
+      std::size_t annotated = 0;
+      for (const auto* hs : {&t.left_hs_s, &t.right_hs_s})
+        for (double x : *hs) annotated += x < t.uturn0_s || x > t.uturn1_s ? 1u : 0u;
+      const double end = std::hypot(out.x_m, out.y_m);
+      walked.push_back(out.distance_m);
+      ends.push_back(end);
+      std::printf("| %s_%s | %zu / %zu | %.1f | %.2f |\n", t.name.c_str(), side.c_str(), out.steps,
+                  annotated, out.distance_m, end);
+    }
+  }
+  if (walked.empty()) return;
+  double sum_w = 0.0, sum_e = 0.0;
+  for (std::size_t i = 0; i < walked.size(); ++i) {
+    sum_w += walked[i];
+    sum_e += ends[i];
+  }
+  auto sorted = ends;
+  std::sort(sorted.begin(), sorted.end());
+  const auto n = static_cast<double>(walked.size());
+  std::printf("| **mean** | | **%.2f** | **%.2f** (median %.2f, 90th percentile %.2f) |\n",
+              sum_w / n, sum_e / n, sorted[sorted.size() / 2], sorted[sorted.size() * 9 / 10]);
+  std::fflush(stdout);
+}
+
 void run_eval(const EvalOptions& o) {
   if (o.tables.find("gait") != std::string::npos) gait_table(o);
   if (o.tables.find("ipol") != std::string::npos) {
     ipol_table(o, true);
+    ipol_foot_pdr_table(o);
     ipol_table(o, false);
   }
   if (o.tables.find("oxford") != std::string::npos) oxford_table(o);

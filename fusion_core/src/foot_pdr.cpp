@@ -1,54 +1,39 @@
 #include "telltale/fusion/foot_pdr.hpp"
 
-#include <Eigen/Dense>
 #include <cmath>
 
 #include "telltale/fusion/angles.hpp"
-#include "telltale/fusion/pdr.hpp"
+#include "telltale/fusion/pdr/walking_heading.hpp"
 
 namespace telltale::fusion {
 namespace {
 
-/// The detector sees one foot: each event closes a stride, two steps.
+/// The detector sees one foot: each of its steps closes a stride, two steps.
 constexpr double kStepsPerStride = 2.0;
 
 }  // namespace
 
-FootPdr::FootPdr(Params params) : FootPdr(params, builtin_step_length_model()) {}
-
-FootPdr::FootPdr(Params params, const StepLengthModel& lengths)
+FootPdr::FootPdr(Params params)
     : params_(params),
-      step_length_(params.step_length, lengths),
       steps_(params.steps),
+      ins_(params.ins),
       cadence_(params.min_step_interval_s),
-      heading_(params.heading),
-      sensors_(params.gyro_bias, params.calibrate_mag, params.hard_iron),
-      track_(params.track, params.calibrate_mag) {}
+      sensors_(params.gyro_bias, params.calibrate_mag, params.hard_iron) {}
 
-void FootPdr::on_stride(double t_s) {
-  track_.begin_step();
-  cadence_.at_step(t_s, kStepsPerStride, true);
-  out_.steps += static_cast<std::size_t>(kStepsPerStride);
-  if (cadence_.interval_s() > 0.0) {
-    out_.step_hz = 1.0 / cadence_.interval_s();
-    out_.cadence_spm = 60.0 * out_.step_hz;
+void FootPdr::lay_stride(const Eigen::Vector2d& d) {
+  if (!oriented_) {
+    oriented_ = true;
+    if (orient_sin_ != 0.0 || orient_cos_ != 0.0)
+      orient_rad_ = std::atan2(orient_sin_, orient_cos_);
   }
-  const double f = out_.step_hz;
-  out_.gait = f < 1.6 ? 0 : f < 1.95 ? 1 : f < 2.35 ? 2 : f < 2.75 ? 3 : 4;
-  // The heading filter's circular mean over the stride (its heading if it had none).
-  double heading = heading_.heading_rad();
-  if (sum_sin_ != 0.0 || sum_cos_ != 0.0) heading = std::atan2(sum_sin_, sum_cos_);
-  sum_sin_ = sum_cos_ = 0.0;
-  heading = wrap_2pi(heading);
-  // The first stride has no frequency yet: the person's usual walk.
-  const double hz = out_.step_hz > 0.0 ? out_.step_hz : 1.8;
-  const double step_m = step_length_.step_m(PhonePose::kHandHeld, hz);
-  const double len = kStepsPerStride * step_m;
-  out_.last_step_length_m = len;
-  heading_.set_speed(step_m * hz);
-  out_.distance_m += len;
-  track_.lay(len, heading, true, sensors_.mag_calibration().offset_uT());
+  const double length = d.norm();
+  const double heading = wrap_2pi(orient_rad_ - std::atan2(d.y(), d.x()));
+  out_.x_m += length * std::sin(heading);
+  out_.y_m += length * std::cos(heading);
+  out_.distance_m += length;
+  out_.last_step_length_m = length / kStepsPerStride;
   out_.heading_deg = heading * 180.0 / M_PI;
+  ++diag_.strides;
 }
 
 const PdrOutput& FootPdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT) {
@@ -58,18 +43,31 @@ const PdrOutput& FootPdr::update(const ImuSample& raw, const Eigen::Vector3d& ma
   if (!sensors_.prepare(raw, mag_uT, diag_, s, mag)) return out_;
   diag_.still_windows = sensors_.still_windows();
   out_.t_s = raw.t_s;  // the caller's clock; the stages run on s.t_s, the local one
-  // The sensor's frame is the walking frame: a foot carries it one way.
-  heading_.update(s.t_s, s.gyro_body_rad_s, s.acc_body_m_s2, mag);
-  if (heading_.initialised()) {
-    sum_sin_ += std::sin(heading_.heading_rad());
-    sum_cos_ += std::cos(heading_.heading_rad());
-    out_.heading_deg = heading_.heading_rad() * 180.0 / M_PI;
+  if (!s.gyro_body_rad_s.allFinite()) return out_;  // no gyro: nothing to navigate with
+  const double dt = have_t_ ? s.t_s - last_t_s_ : 0.0;
+  have_t_ = true;
+  last_t_s_ = s.t_s;
+  if (ins_.update(s, dt)) lay_stride(ins_.stride_m());
+  // North, before the first stride: over the stance the magnetometer gives the sensor's x axis
+  // a heading, and the INS the same axis an angle; their sum is the track's orientation.
+  if (!oriented_ && ins_.started() && ins_.stance() && mag.allFinite()) {
+    const Eigen::Vector3d up = ins_.up_body();
+    const double h = HeadingFilter::magnetic_heading_rad(mag, up);
+    if (std::isfinite(h)) {
+      orient_sin_ += std::sin(h + ins_.sensor_yaw_rad());
+      orient_cos_ += std::cos(h + ins_.sensor_yaw_rad());
+    }
   }
   StepEvent ev;
   if (steps_.update(s, ev)) {
-    on_stride(ev.t_s);
-    out_.x_m = track_.x_m();
-    out_.y_m = track_.y_m();
+    cadence_.at_step(ev.t_s, kStepsPerStride, true);
+    out_.steps += static_cast<std::size_t>(kStepsPerStride);
+    if (cadence_.interval_s() > 0.0) {
+      out_.step_hz = 1.0 / cadence_.interval_s();
+      out_.cadence_spm = 60.0 * out_.step_hz;
+    }
+    const double f = out_.step_hz;
+    out_.gait = f < 1.6 ? 0 : f < 1.95 ? 1 : f < 2.35 ? 2 : f < 2.75 ? 3 : 4;
     out_.step = true;
   }
   return out_;

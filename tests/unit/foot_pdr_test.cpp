@@ -1,10 +1,16 @@
-// FootPdr (seed 004): a foot-mounted IMU's dead reckoning on the gait simulator's foot walks.
+// FootPdr: a foot-mounted IMU's dead reckoning (its own inertial navigation, reset at every
+// stance) on the gait simulator's foot walks.
 #include "telltale/fusion/foot_pdr.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 
+#include "telltale/fusion/gait_phase_steps.hpp"
+#include "telltale/fusion/pdr/foot_ins.hpp"
 #include "telltale/fusion/sim/gait_sim.hpp"
 
 namespace telltale::fusion {
@@ -12,35 +18,89 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-// Given a foot sensor on straight walks of five simulated people, when FootPdr runs with each
-// walker's height, then it counts every step (one event per stride, two steps each), the
-// distance is the step-length model's and the track points the way the walk went, give or take
-// some degrees; the output has no pose.
-TEST(FootPdr, CountsTwoStepsPerStrideAndLaysTheWalk) {
+// Given a foot sensor on straight walks of five simulated people, when FootPdr runs, then the
+// foot's inertial navigation measures the walk: its distance within 3 % of the truth and its
+// end within 6 deg of the walk's bearing (measured: 0.8-1.4 % and 1-5.5 deg; the step model
+// and heading filter it replaced, 17 % and 6-11 deg); the steps are the gait-phase detector's,
+// two per step of the instrumented foot; the output has no pose. (The simulated foot's IMU errors
+// leave almost no velocity at the stance: the drift's correction is the next test's.)
+TEST(FootPdr, MeasuresEachStrideAndCountsTheDetectorsSteps) {
   for (std::uint64_t seed = 1; seed <= 5; ++seed) {
     const auto run = sim::simulate_gait(*sim::make_gait_scenario("foot-walk", seed),
                                         sim::random_person(seed), seed);
-    FootPdrParams p;
-    p.step_length.height_m = sim::random_person(seed).height_m;
-    FootPdr pdr(p);
-    std::size_t strides = 0;
-    for (const auto& s : run.samples) strides += pdr.update(s.imu, s.mag_uT).step ? 1u : 0u;
+    FootPdr pdr;
+    GaitPhaseStepDetector detector;
+    std::size_t events = 0;
+    StepEvent ev;
+    for (const auto& s : run.samples) {
+      pdr.update(s.imu, s.mag_uT);
+      events += detector.update(s.imu, ev) ? 1u : 0u;
+    }
     const auto& out = pdr.output();
     const auto& last = run.samples.back();
-    EXPECT_EQ(out.steps, 2 * strides) << seed;
-    EXPECT_NEAR(static_cast<double>(out.steps), static_cast<double>(run.step_times_s.size()), 2.0)
-        << seed;
-    // As measured when FootPdr left Pdr (seeds 1-5): distance within 17 %, the track's
-    // bearing 6-11 deg off the walk's.
-    EXPECT_NEAR(out.distance_m, run.distance_m, 0.2 * run.distance_m) << seed;
+    std::printf("  seed %d: distance %.2f of %.2f m, end (%.2f, %.2f) for (%.2f, %.2f)\n",
+                static_cast<int>(seed), out.distance_m, run.distance_m, out.x_m, out.y_m, last.x_m,
+                last.y_m);
+    EXPECT_EQ(out.steps, 2 * events) << seed;
+    EXPECT_NEAR(out.distance_m, run.distance_m, 0.03 * run.distance_m) << seed;
     const double off_deg =
         std::remainder(std::atan2(out.x_m, out.y_m) - std::atan2(last.x_m, last.y_m), 2 * M_PI) /
         kDeg;
-    EXPECT_LT(std::abs(off_deg), 15.0) << seed;
+    EXPECT_LT(std::abs(off_deg), 6.0) << seed;
+    EXPECT_GT(pdr.diagnostics().strides, 20u) << seed;
     EXPECT_EQ(out.pose, PhonePose::kHandHeld);
     EXPECT_FALSE(out.switching);
     EXPECT_GT(out.cadence_spm, 80.0) << seed;
   }
+}
+
+// Given samples without a gyro (an accelerometer alone cannot navigate a foot), then FootPdr
+// moves nothing and counts nothing, and says so by its diagnostics; with the gyro back it walks.
+TEST(FootPdr, WithoutAGyroNothingMoves) {
+  const auto run =
+      sim::simulate_gait(*sim::make_gait_scenario("foot-walk", 2), sim::random_person(2), 2);
+  FootPdr pdr;
+  for (auto s : run.samples) {
+    s.imu.gyro_body_rad_s.setConstant(std::numeric_limits<double>::quiet_NaN());
+    pdr.update(s.imu, s.mag_uT);
+  }
+  EXPECT_EQ(pdr.output().steps, 0u);
+  EXPECT_EQ(pdr.output().distance_m, 0.0);
+  EXPECT_EQ(pdr.diagnostics().strides, 0u);
+}
+
+// Given a stride of 1.4 m in 1 s between two stances, its specific force read with an error of
+// 0.3 m/s^2 forward during the swing alone (what a stance cannot see: a swing's vibration
+// rectified, a tilt error of the swing), then the velocity the foot seems to have at the next
+// stance, 0.3 m/s, is taken as grown evenly over the swing and its integral comes off: the
+// stride is 1.40 m, not 1.56. Seen failing without the correction (1.56 m). On the IPOL foot
+// recordings the correction is what makes the distance: 20.7 m walked for the 20 m walks
+// (17.7 m without it), the end 1.23 m from the start (2.60 m).
+TEST(FootIns, TheVelocityLeftAtAStanceComesOffTheStride) {
+  const double g = kStandardGravity_m_s2, rate = 100.0;
+  FootIns ins;
+  ImuSample s;
+  int strides = 0;
+  Eigen::Vector2d stride = Eigen::Vector2d::Zero();
+  for (int i = 0; i <= static_cast<int>(3.0 * rate); ++i) {
+    s.t_s = i / rate;
+    const double t = s.t_s - 1.0;  // the swing: 1 s from t = 1 s
+    const bool swing = t > 0.0 && t < 1.0;
+    // x(t) = 1.4 (t - sin(2 pi t) / (2 pi)): at rest at both ends, 1.4 m on; the foot turns
+    // about the vertical at 1 rad/s while it swings (a swing is never still), so the body
+    // reads the world's acceleration turned by -yaw.
+    const double a = swing ? 1.4 * 2.0 * M_PI * std::sin(2.0 * M_PI * t) + 0.3 : 0.0;
+    const double yaw = std::clamp(t, 0.0, 1.0) * 1.0;
+    s.acc_body_m_s2 = {std::cos(yaw) * a, -std::sin(yaw) * a, g};
+    s.gyro_body_rad_s = {0.0, 0.0, swing ? 1.0 : 0.0};
+    if (ins.update(s, i == 0 ? 0.0 : 1.0 / rate)) {
+      ++strides;
+      stride = ins.stride_m();
+    }
+  }
+  ASSERT_EQ(strides, 1);
+  EXPECT_NEAR(stride.norm(), 1.4, 0.02);
+  EXPECT_NEAR(stride.y(), 0.0, 1e-9);
 }
 
 }  // namespace

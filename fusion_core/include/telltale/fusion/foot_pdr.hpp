@@ -1,53 +1,52 @@
 #pragma once
 /// \file
-/// Pedestrian dead reckoning with an IMU on the foot (seed 004): `fusion_cli pdr --mount foot`,
+/// Pedestrian dead reckoning with an IMU on the foot: `fusion_cli pdr --mount foot`,
 /// `wearable_node --mount foot`.
 ///
 /// Pipeline per sample (FootPdr::update): gyro bias learnt while standing and hard-iron offset
-/// (SensorPrep) -> heading of the sensor's x axis from gyro + magnetometer (the two-state Kalman
-/// filter of seed 004, Fig. 2) -> strides of the adaptive detector (seed 004) -> at each stride:
-/// the cadence, the heading's circular mean over the stride, two steps of the step-length model
-/// laid along it -> position.
+/// (SensorPrep) -> the foot's own inertial navigation, reset at every stance (FootIns): each
+/// stride's displacement is measured, its length and its direction -> steps counted by the
+/// gait-phase detector (two per stride of the instrumented foot) -> the track, each stride laid
+/// as the INS measured it, turned once onto north by the magnetometer over the stance before
+/// the first stride (no magnetometer: the track starts along north).
+///
+/// Why an INS and not a step model (seed 004's adaptive detector, a height-and-cadence line and
+/// a gyro + magnetometer heading filter, until December 2026): on the IPOL foot recordings
+/// (walk 10 m, turn, walk back; 44 files) that pipeline walked 24.4 m and ended 7.7 m (mean)
+/// from its start; its heading, the gyro integrated about an up direction pulled toward the
+/// accelerometer, drifted tens of degrees per leg, as a foot's swing accelerates at several g.
+/// A foot's stance gives what no other mount has, zero velocity and a clean gravity every
+/// second: the INS walked 20.67 m and ended 0.62 m (median) from its start (docs/pdr.md). The
+/// step count is the gait-phase detector's, the real recordings' best (steps-eval).
 ///
 /// What the phone's pipeline (Pdr, pdr.hpp) has and this one has not, and why: a foot sensor
-/// is strapped on, so there is no pose to classify and no switch between poses, and its frame
-/// is the walking frame (no rotation into one); the detector sees each stride, so no step is
-/// left in a gap; the phone's corrections of the walking direction and of the accelerometer
-/// bias read a trunk's or a hand's motion, which a foot does not make.
-///
-/// Structure: FootPdr orders the work of a sample and of a stride; the stages it calls are the
-/// phone's (pdr/: cadence, step_length, walking_heading's HeadingFilter,
-/// sensor_prep, track), each with its Params a member of FootPdrParams.
+/// is strapped on, so there is no pose to classify and no switch between poses; the stride is
+/// measured, so no step-length model and no height.
 /// Frames and units as Pdr: position x east, y north (m) from the start; heading clockwise from
-/// north.
+/// north. The gyro is required (an accelerometer alone cannot navigate a foot): samples without
+/// one move nothing and count nothing.
 ///
-/// Memory: fixed-size buffers and Eigen fixed-size types, no heap in update().
+/// Memory: fixed-size members, no heap in update().
 
 #include <cstddef>
 
+#include "telltale/fusion/gait_phase_steps.hpp"
 #include "telltale/fusion/hard_iron.hpp"
 #include "telltale/fusion/imu_sample.hpp"
 #include "telltale/fusion/pdr/bias_learners.hpp"
 #include "telltale/fusion/pdr/cadence.hpp"
+#include "telltale/fusion/pdr/foot_ins.hpp"
 #include "telltale/fusion/pdr/sensor_prep.hpp"
-#include "telltale/fusion/pdr/step_length.hpp"
-#include "telltale/fusion/pdr/track.hpp"
-#include "telltale/fusion/pdr/walking_heading.hpp"
 #include "telltale/fusion/pdr_output.hpp"
-#include "telltale/fusion/steps.hpp"
 
 namespace telltale::fusion {
 
 struct FootPdrParams {
-  AdaptiveStepParams steps;  ///< the stride detector (its defaults are the foot's)
+  GaitPhaseStepParams steps;  ///< the step counter (its defaults are the foot's)
+  FootInsParams ins;          ///< the stride's navigation
   /// Shorter step intervals are no cadence (Cadence::kMinIntervalS).
   double min_step_interval_s = Cadence::kMinIntervalS;
   GyroBiasParams gyro_bias;
-  /// Height and personal factor; the model's hand-held row and its `scale` are the foot's (it
-  /// has no pose): the seed's line, fitted to our gait simulator.
-  StepLengthParams step_length;
-  TrackParams track;
-  HeadingFilterParams heading;
   bool calibrate_mag = true;  ///< online hard-iron calibration (hard_iron.hpp) before the heading
   HardIronParams hard_iron;
 };
@@ -58,11 +57,12 @@ class FootPdr {
   /// The IMU gate's counts (gate_imu_sample; the gyro may be missing) and the stands.
   struct Diagnostics : ImuGateCounts {
     unsigned still_windows = 0;  ///< still windows that set the gyro bias
+    unsigned strides = 0;        ///< strides the INS laid
   };
   explicit FootPdr(Params params = {});
-  FootPdr(Params params, const StepLengthModel& lengths);
   /// Feeds one sample; `mag_uT` may be NaN. Returns the state after it (also `output()`); its
-  /// `pose` and `switching` keep their defaults (a foot has no pose).
+  /// `pose` and `switching` keep their defaults (a foot has no pose). `step`: steps were counted
+  /// at this sample; the position moves at each stance (a stride laid).
   const PdrOutput& update(const ImuSample& sample, const Eigen::Vector3d& mag_uT);
   [[nodiscard]] const PdrOutput& output() const { return out_; }
   [[nodiscard]] const Diagnostics& diagnostics() const { return diag_; }
@@ -76,19 +76,23 @@ class FootPdr {
   }
 
  private:
-  /// A stride ended at t_s: counts its two steps and lays them.
-  void on_stride(double t_s);
+  /// A stride measured by the INS: laid along its own direction.
+  void lay_stride(const Eigen::Vector2d& d);
 
   Params params_;
-  StepLength step_length_;
-  AdaptiveStepDetector steps_;
+  GaitPhaseStepDetector steps_;
+  FootIns ins_;
   Cadence cadence_;  ///< the cadence only: the detector sees every stride, no gap is filled
-  HeadingFilter heading_;
   SensorPrep sensors_;
-  Track track_;
   Diagnostics diag_;
   PdrOutput out_;
-  double sum_sin_ = 0.0, sum_cos_ = 0.0;  ///< heading over the current stride (circular mean)
+  double last_t_s_ = 0.0;
+  bool have_t_ = false;
+  /// North: heading (clockwise from north) = orient_rad_ - (INS angle, counter-clockwise from
+  /// its x). Circular sums over the stance before the first stride; fixed from then on.
+  double orient_sin_ = 0.0, orient_cos_ = 0.0;
+  double orient_rad_ = 0.0;
+  bool oriented_ = false;
 };
 
 }  // namespace telltale::fusion

@@ -3,7 +3,7 @@
 /// PDR stage (phone pipeline): the phone's two step detectors, the acceleration's peaks and
 /// valleys (any pose) and the arm's turns (while the phone swings), and which of them speaks for
 /// the steps. What their events stand for (a step, none, several) is the step clock's to say
-/// (step_clock.hpp). The foot pipeline (FootPdr) uses AdaptiveStepDetector (steps.hpp) alone.
+/// (step_clock.hpp). The foot pipeline (FootPdr) uses GaitPhaseStepDetector alone.
 ///
 /// Memory: the detectors' fixed-size buffers, no heap.
 
