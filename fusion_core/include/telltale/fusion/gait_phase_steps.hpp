@@ -113,16 +113,16 @@ class GaitPhaseStepDetector final : public StepDetector {
  public:
   using Params = GaitPhaseStepParams;
   explicit GaitPhaseStepDetector(Params params = {});
-  /// `event.t_s` is the time the step happened (the heel strike), up to ~0.4 s before the
-  /// sample that confirmed it; on the body, a walk's first steps up to its fourth step later.
-  bool on_sample(const ImuSample& sample, StepEvent& event) override;
-  /// Body: the steps still held (a walk's first and those after it) at the end of the stream.
-  bool on_flush(StepEvent& event) override;
   void reset() override;
   [[nodiscard]] std::string_view name() const override { return "gait-phase"; }
   [[nodiscard]] const StepDiagnostics& diagnostics() const override { return diag_; }
 
  private:
+  /// `event.t_s` is the time the step happened (the heel strike), up to ~0.4 s before the
+  /// sample that confirmed it; on the body, a walk's first steps up to its fourth step later.
+  bool on_sample(const ImuSample& sample, StepEvent& event) override;
+  /// Body: the steps still held (a walk's first and those after it) at the end of the stream.
+  bool on_flush(StepEvent& event) override;
   bool update_foot(const ImuSample& s, double dt, StepEvent& event);
   bool update_body(const ImuSample& s, double dt, StepEvent& event);
   bool emit(double t_s, StepEvent& event);

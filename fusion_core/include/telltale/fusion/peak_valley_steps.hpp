@@ -45,13 +45,13 @@ class PeakValleyStepDetector final : public StepDetector {
  public:
   using Params = PeakValleyStepParams;
   explicit PeakValleyStepDetector(Params params = {});
-  bool on_sample(const ImuSample& sample, StepEvent& event) override;
-  bool on_flush(StepEvent& event) override;
   void reset() override;
   [[nodiscard]] std::string_view name() const override { return "peak-valley"; }
   [[nodiscard]] const StepDiagnostics& diagnostics() const override { return diag_; }
 
  private:
+  bool on_sample(const ImuSample& sample, StepEvent& event) override;
+  bool on_flush(StepEvent& event) override;
   Params params_;
   StepDiagnostics diag_;
   LowPass2 lp_;

@@ -231,7 +231,6 @@ class AdaptiveStepDetector final : public StepDetector {
  public:
   using Params = AdaptiveStepParams;
   explicit AdaptiveStepDetector(Params params = {});
-  bool on_sample(const ImuSample& sample, StepEvent& event) override;
   void reset() override;
   [[nodiscard]] std::string_view name() const override { return "adaptive"; }
   [[nodiscard]] const StepDiagnostics& diagnostics() const override { return diag_; }
@@ -239,6 +238,7 @@ class AdaptiveStepDetector final : public StepDetector {
   [[nodiscard]] std::array<double, 4> thresholds() const;
 
  private:
+  bool on_sample(const ImuSample& sample, StepEvent& event) override;
   Params params_;
   StepDiagnostics diag_;
   SignedMeanWindow acc_window_;
@@ -267,12 +267,12 @@ class PeakStepDetector final : public StepDetector {
  public:
   using Params = PeakStepParams;
   explicit PeakStepDetector(Params params = {});
-  bool on_sample(const ImuSample& sample, StepEvent& event) override;
   void reset() override;
   [[nodiscard]] std::string_view name() const override { return "peak"; }
   [[nodiscard]] const StepDiagnostics& diagnostics() const override { return diag_; }
 
  private:
+  bool on_sample(const ImuSample& sample, StepEvent& event) override;
   Params params_;
   StepDiagnostics diag_;
   LowPass2 lp_;
@@ -293,12 +293,12 @@ class FixedThresholdStepDetector final : public StepDetector {
  public:
   using Params = FixedThresholdStepParams;
   explicit FixedThresholdStepDetector(Params params = {});
-  bool on_sample(const ImuSample& sample, StepEvent& event) override;
   void reset() override;
   [[nodiscard]] std::string_view name() const override { return "fixed-threshold"; }
   [[nodiscard]] const StepDiagnostics& diagnostics() const override { return diag_; }
 
  private:
+  bool on_sample(const ImuSample& sample, StepEvent& event) override;
   Params params_;
   StepDiagnostics diag_;
   LowPass2 lp_;
