@@ -22,9 +22,10 @@ FootPdr::FootPdr(Params params)
 
 void FootPdr::lay_stride(const Eigen::Vector2d& d) {
   if (!oriented_) {
+    // The magnetometer's orientation; without one, the sensor's x axis at the start is north.
     oriented_ = true;
-    if (orient_sin_ != 0.0 || orient_cos_ != 0.0)
-      orient_rad_ = std::atan2(orient_sin_, orient_cos_);
+    orient_rad_ = orient_sin_ != 0.0 || orient_cos_ != 0.0 ? std::atan2(orient_sin_, orient_cos_)
+                                                           : start_yaw_rad_;
   }
   const double length = d.norm();
   const double heading = wrap_2pi(orient_rad_ - std::atan2(d.y(), d.x()));
@@ -47,7 +48,13 @@ const PdrOutput& FootPdr::update(const ImuSample& raw, const Eigen::Vector3d& ma
   const double dt = have_t_ ? s.t_s - last_t_s_ : 0.0;
   have_t_ = true;
   last_t_s_ = s.t_s;
-  if (ins_.update(s, dt)) lay_stride(ins_.stride_m());
+  const bool stride = ins_.update(s, dt);
+  if (!have_start_yaw_ && ins_.started()) {
+    have_start_yaw_ = true;
+    start_yaw_rad_ = ins_.sensor_yaw_rad();
+  }
+  diag_.dropped_swings = ins_.dropped();
+  if (stride) lay_stride(ins_.stride_m());
   // North, before the first stride: over the stance the magnetometer gives the sensor's x axis
   // a heading, and the INS the same axis an angle; their sum is the track's orientation.
   if (!oriented_ && ins_.started() && ins_.stance() && mag.allFinite()) {

@@ -103,5 +103,44 @@ TEST(FootIns, TheVelocityLeftAtAStanceComesOffTheStride) {
   EXPECT_NEAR(stride.y(), 0.0, 1e-9);
 }
 
+// Given a swing with no stance for 6 s (not a walk's stride: a foot swung under a chair), or a
+// swing with 0.5 s of samples lost in it (its rotation unknown), then neither is laid (the
+// drift over 6 s would be metres) and both are counted as dropped; the next stance and swing
+// are measured again. Seen failing with the two checks removed: each was laid as a stride,
+// nothing dropped.
+TEST(FootIns, SwingsTooLongOrBrokenByAGapAreNotLaid) {
+  const double g = kStandardGravity_m_s2;
+  for (const bool gap : {false, true}) {
+    FootIns ins;
+    ImuSample s;
+    int strides = 0;
+    double last = -1.0;
+    // Samples at 100 Hz over [t0, t1): still, or moving (1 rad/s about the vertical, 3 m/s^2).
+    const auto feed = [&](double t0, double t1, bool moving) {
+      for (int i = static_cast<int>(std::lround(t0 * 100.0)); i < std::lround(t1 * 100.0); ++i) {
+        s.t_s = i / 100.0;
+        s.acc_body_m_s2 = {moving ? 3.0 : 0.0, 0.0, g};
+        s.gyro_body_rad_s = {0.0, 0.0, moving ? 1.0 : 0.0};
+        strides += ins.update(s, last < 0.0 ? 0.0 : s.t_s - last) ? 1 : 0;
+        last = s.t_s;
+      }
+    };
+    feed(0.0, 1.0, false);
+    if (gap) {
+      feed(1.0, 1.3, true);
+      feed(1.8, 2.0, true);  // 1.3-1.8 s lost
+    } else {
+      feed(1.0, 7.0, true);
+    }
+    const double end = gap ? 2.0 : 7.0;
+    feed(end, end + 1.0, false);
+    EXPECT_EQ(strides, 0) << (gap ? "gap" : "long swing");
+    EXPECT_EQ(ins.dropped(), 1u) << (gap ? "gap" : "long swing");
+    feed(end + 1.0, end + 1.6, true);
+    feed(end + 1.6, end + 2.0, false);
+    EXPECT_EQ(strides, 1) << (gap ? "gap" : "long swing");
+  }
+}
+
 }  // namespace
 }  // namespace telltale::fusion

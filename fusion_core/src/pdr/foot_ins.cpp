@@ -16,6 +16,14 @@ bool FootIns::update(const ImuSample& s, double dt_s) {
     return false;
   }
   if (!(dt_s > 0.0)) return false;
+  if (dt_s > params_.max_gap_s) {
+    // Samples lost: the rotation over the gap is unknown. A swing in progress is not measured;
+    // the next one is, from the next stance.
+    if (!stance_ && !waiting_) ++dropped_;
+    waiting_ = true;
+    still_s_ = 0.0;
+    return false;
+  }
   // The sample's rate over the interval that ends at it (a MEMS gyro's sample is close to the
   // mean rate over it), as a rotation of exact angle.
   const double angle = w.norm() * dt_s;
@@ -25,6 +33,11 @@ bool FootIns::update(const ImuSample& s, double dt_s) {
   const bool still = w.norm() < params_.stance_gyro_rad_s &&
                      std::abs(f.norm() - g_m_s2_) < params_.stance_acc_m_s2;
   still_s_ = still ? still_s_ + dt_s : 0.0;
+  if (waiting_) {
+    if (still_s_ < params_.stance_min_s) return false;
+    waiting_ = false;  // a stance again: level from here and measure the next swing
+    stance_ = true;
+  }
   if (stance_) {
     if (still) {
       // Foot flat: up is what the accelerometer says. Level to it (the smallest rotation, about
@@ -44,6 +57,12 @@ bool FootIns::update(const ImuSample& s, double dt_s) {
   v_ += a * dt_s;
   p_ += v_ * dt_s;
   swing_s_ += dt_s;
+  if (swing_s_ > params_.max_swing_s) {
+    // No stance for this long: not a walking stride. Start over at the next stance.
+    ++dropped_;
+    waiting_ = true;
+    return false;
+  }
   if (still_s_ < params_.stance_min_s) return false;
   // A stance: the velocity left is all error, taken as grown evenly since the swing began; its
   // integral comes off the displacement.

@@ -8,7 +8,7 @@
 /// stride's displacement is measured, its length and its direction -> steps counted by the
 /// gait-phase detector (two per stride of the instrumented foot) -> the track, each stride laid
 /// as the INS measured it, turned once onto north by the magnetometer over the stance before
-/// the first stride (no magnetometer: the track starts along north).
+/// the first stride (no magnetometer: the sensor's x axis at the start is taken as north).
 ///
 /// Why an INS and not a step model (seed 004's adaptive detector, a height-and-cadence line and
 /// a gyro + magnetometer heading filter, until December 2026): on the IPOL foot recordings
@@ -58,6 +58,7 @@ class FootPdr {
   struct Diagnostics : ImuGateCounts {
     unsigned still_windows = 0;  ///< still windows that set the gyro bias
     unsigned strides = 0;        ///< strides the INS laid
+    unsigned dropped_swings = 0;  ///< swings not laid: longer than a stride's, or a gap in them
   };
   explicit FootPdr(Params params = {});
   /// Feeds one sample; `mag_uT` may be NaN. Returns the state after it (also `output()`); its
@@ -93,6 +94,8 @@ class FootPdr {
   double orient_sin_ = 0.0, orient_cos_ = 0.0;
   double orient_rad_ = 0.0;
   bool oriented_ = false;
+  double start_yaw_rad_ = 0.0;  ///< the INS's angle of the sensor's x axis at the start
+  bool have_start_yaw_ = false;
 };
 
 }  // namespace telltale::fusion

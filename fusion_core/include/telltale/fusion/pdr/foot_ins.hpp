@@ -23,8 +23,13 @@
 /// Measured on the IPOL foot recordings (walk 10 m, turn, walk back 10 m; 44 files, docs/pdr.md):
 /// distance 20.67 m mean, the walk's end 0.62 m (median) from its start.
 ///
-/// Frames: world x, y horizontal (the first sample's yaw: x along the horizontal part of the
-/// sensor's x axis when it can be), z up. Memory: fixed-size members, no heap.
+/// A swing longer than max_swing_s is no stride of a walk (a foot swung under a chair, a ride):
+/// dropped, the drift of that long would be metres. Over a gap in the samples (longer than
+/// max_gap_s) the rotation is unknown: the swing in progress is dropped, the yaw kept.
+///
+/// Frames: world x, y horizontal, z up; the first sample's attitude is the smallest rotation
+/// that levels it, so the world's yaw origin is arbitrary but fixed (sensor_yaw_rad() says where
+/// the sensor's x axis points in it). Memory: fixed-size members, no heap.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -38,6 +43,8 @@ struct FootInsParams {
   double stance_acc_m_s2 = 1.5;    ///< ||f| - g| below this: no acceleration but gravity's
   double stance_min_s = 0.04;      ///< held this long: a stance, not a swing passing through
   double g_tau_s = 2.0;            ///< |f|'s mean over stances (the accelerometer's own g)
+  double max_swing_s = 5.0;        ///< a walking stride's swing lasts 0.4-1 s, a pivot 1-2 s
+  double max_gap_s = 0.2;          ///< a fifth of a stride unseen: its rotation is lost
 };
 
 class FootIns {
@@ -59,6 +66,8 @@ class FootIns {
   }
   [[nodiscard]] bool stance() const { return stance_; }
   [[nodiscard]] bool started() const { return started_; }
+  /// Swings dropped: longer than max_swing_s, or broken by a gap.
+  [[nodiscard]] unsigned dropped() const { return dropped_; }
 
  private:
   Params params_;
@@ -71,6 +80,8 @@ class FootIns {
   double swing_s_ = 0.0;  ///< since the last stance ended
   bool stance_ = true;    ///< a walk starts from standing
   bool started_ = false;
+  bool waiting_ = false;  ///< a swing was dropped: nothing measured until the next stance
+  unsigned dropped_ = 0;
 };
 
 }  // namespace telltale::fusion
