@@ -4,6 +4,7 @@
 // these six, Madgwick's ~2.6 deg). Seen failing: the filter before the VQF-style rebuild gives a
 // mean of ~0.54 here. The seventh, trial 08, is the gyro's scale (below).
 #include <gtest/gtest.h>
+#include <unistd.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -22,11 +23,15 @@
 namespace telltale::fusion {
 namespace {
 
-/// Inflates a .gz file to a temporary CSV, so the one CSV reader of telltale_io parses it.
+/// Inflates a .gz file to a temporary CSV, so the one CSV reader of telltale_io parses it. The
+/// name carries the process id: ctest runs this file's tests as parallel processes, and with one
+/// name for all, one test removed a trial's CSV while another was reading it (seen in the
+/// sanitized suite: "cannot open file").
 std::string gunzip_to_temp(const std::string& gz_path) {
-  const std::string out = (std::filesystem::temp_directory_path() /
-                           ("telltale_" + std::filesystem::path(gz_path).stem().string()))
-                              .string();
+  const std::string out =
+      (std::filesystem::temp_directory_path() / ("telltale_" + std::to_string(getpid()) + "_" +
+                                                 std::filesystem::path(gz_path).stem().string()))
+          .string();
   gzFile in = gzopen(gz_path.c_str(), "rb");
   if (in == nullptr) throw std::runtime_error("cannot open " + gz_path);
   std::ofstream os(out, std::ios::binary);
