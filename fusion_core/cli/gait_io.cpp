@@ -1,9 +1,9 @@
 #include "gait_io.hpp"
 
-#include <algorithm>
 #include <chrono>
 
 #include "csv.hpp"
+#include "telltale/fusion/resample.hpp"
 
 namespace telltale::cli {
 
@@ -96,48 +96,17 @@ HandheldWalk run_handheld_walk(const std::vector<ImuRecord>& records,
 }
 
 std::vector<ImuRecord> resample_records(const std::vector<ImuRecord>& records, double rate_hz) {
+  std::vector<double> t;
+  for (const auto& r : records) t.push_back(r.imu.t_s);
   std::vector<ImuRecord> out;
-  if (records.size() < 2 || !(rate_hz > 0.0)) return records;
-  std::vector<double> dts;
-  for (std::size_t i = 1; i < records.size(); ++i)
-    dts.push_back(records[i].imu.t_s - records[i - 1].imu.t_s);
-  std::nth_element(dts.begin(), dts.begin() + static_cast<std::ptrdiff_t>(dts.size() / 2),
-                   dts.end());
-  const double dt_in = dts[dts.size() / 2], period = 1.0 / rate_hz;
-  const double t0 = records.front().imu.t_s, t_end = records.back().imu.t_s;
-  const bool averaging = period > dt_in;
-  std::size_t lo = 0;  // first reading not before the window (averaging) or the interval's start
-  for (long k = 0;; ++k) {
-    const double t = t0 + static_cast<double>(k) * period;
-    if (t > t_end) break;
+  for (const fusion::ResampleSpan& span : fusion::resample_spans(t, rate_hz)) {
     ImuRecord r;
-    r.imu.t_s = t;
-    if (averaging) {
-      while (lo < records.size() && records[lo].imu.t_s < t - 0.5 * period) ++lo;
-      Eigen::Vector3d g = Eigen::Vector3d::Zero(), a = g, m = g;
-      int n = 0;
-      for (std::size_t i = lo; i < records.size() && records[i].imu.t_s < t + 0.5 * period; ++i) {
-        g += records[i].imu.gyro_body_rad_s;
-        a += records[i].imu.acc_body_m_s2;
-        m += records[i].mag_uT;
-        ++n;
-      }
-      if (n == 0) continue;  // a gap in the recording stays a gap
-      r.imu.gyro_body_rad_s = g / n;
-      r.imu.acc_body_m_s2 = a / n;
-      r.mag_uT = m / n;
-    } else {
-      while (lo + 2 < records.size() && records[lo + 1].imu.t_s <= t) ++lo;
-      const ImuRecord& p = records[lo];
-      const ImuRecord& q = records[lo + 1];
-      const double span = q.imu.t_s - p.imu.t_s;
-      if (span > 3.0 * dt_in) continue;  // no reading to interpolate from: a gap
-      const double f = span > 0.0 ? std::clamp((t - p.imu.t_s) / span, 0.0, 1.0) : 0.0;
-      r.imu.gyro_body_rad_s =
-          p.imu.gyro_body_rad_s + f * (q.imu.gyro_body_rad_s - p.imu.gyro_body_rad_s);
-      r.imu.acc_body_m_s2 = p.imu.acc_body_m_s2 + f * (q.imu.acc_body_m_s2 - p.imu.acc_body_m_s2);
-      r.mag_uT = p.mag_uT + f * (q.mag_uT - p.mag_uT);
-    }
+    r.imu.t_s = span.t_s;
+    r.imu.gyro_body_rad_s =
+        fusion::resampled(span, [&](std::size_t i) { return records[i].imu.gyro_body_rad_s; });
+    r.imu.acc_body_m_s2 =
+        fusion::resampled(span, [&](std::size_t i) { return records[i].imu.acc_body_m_s2; });
+    r.mag_uT = fusion::resampled(span, [&](std::size_t i) { return records[i].mag_uT; });
     out.push_back(r);
   }
   return out;

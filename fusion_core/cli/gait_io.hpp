@@ -37,12 +37,9 @@ struct ImuRecord {
                                                   bool* has_gyro = nullptr, bool* has_mag = nullptr,
                                                   std::size_t* repeated_stamps = nullptr);
 
-/// The recording as a sensor sampling at `rate_hz` would have given it, on a grid from its first
-/// time: below the recording's rate each sample is the mean of the readings within half a period
-/// of its time (a sensor's output-rate averaging, which keeps the steps' band below 4 Hz and
-/// removes what would alias), above it the readings are interpolated linearly (no new content:
-/// it shows what depends on the rate itself, the detectors' sample counts and filters' steps).
-/// Readings missing (NaN) stay missing. Used by steps-eval's --rate-hz on the real recordings.
+/// The recording as a sensor at `rate_hz` would have given it (fusion::resample_spans: averaged
+/// over the interval before each sample below the recording's rate, interpolated above; the
+/// field likewise, NaN staying NaN). Used by steps-eval's --rate-hz on the real recordings.
 [[nodiscard]] std::vector<ImuRecord> resample_records(const std::vector<ImuRecord>& records,
                                                       double rate_hz);
 

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "telltale/fusion/attitude_speed.hpp"
+#include "telltale/fusion/resample.hpp"
 #include "telltale/fusion/sim/scenario.hpp"
 
 namespace telltale::fusion {
@@ -91,32 +92,21 @@ double inclination_error_rad(double heel_a, double pitch_a, double heel_b, doubl
 InclinationTrial resample_trial(const InclinationTrial& trial, double rate_hz) {
   const auto& imu = trial.imu;
   if (imu.size() < 2 || !(rate_hz > 0.0)) return trial;
-  const double period = 1.0 / rate_hz;
+  // Only below the recording's rate: interpolated truth angles would cross their wrap.
   const double span = imu.back().t_s - imu.front().t_s;
-  if (!(span / static_cast<double>(imu.size() - 1) < period)) return trial;
+  if (!(span / static_cast<double>(imu.size() - 1) < 1.0 / rate_hz)) return trial;
+  std::vector<double> t;
+  for (const auto& s : imu) t.push_back(s.t_s);
   InclinationTrial out;
-  std::size_t i = 0;
-  for (long k = 0;; ++k) {
-    const double t = imu.front().t_s + static_cast<double>(k) * period;
-    if (t > imu.back().t_s) break;
+  for (const ResampleSpan& r : resample_spans(t, rate_hz)) {
     ImuSample s;
-    s.t_s = t;
-    int n = 0;
-    std::size_t last = 0;
-    for (; i < imu.size() && imu[i].t_s <= t; ++i) {
-      if (imu[i].t_s <= t - period) continue;
-      s.gyro_body_rad_s += imu[i].gyro_body_rad_s;
-      s.acc_body_m_s2 += imu[i].acc_body_m_s2;
-      last = i;
-      ++n;
-    }
-    if (n == 0) continue;
-    s.gyro_body_rad_s /= n;
-    s.acc_body_m_s2 /= n;
+    s.t_s = r.t_s;
+    s.gyro_body_rad_s = resampled(r, [&](std::size_t i) { return imu[i].gyro_body_rad_s; });
+    s.acc_body_m_s2 = resampled(r, [&](std::size_t i) { return imu[i].acc_body_m_s2; });
     out.imu.push_back(s);
-    out.heel_true_rad.push_back(trial.heel_true_rad[last]);
-    out.pitch_true_rad.push_back(trial.pitch_true_rad[last]);
-    out.scored.push_back(trial.scored[last]);
+    out.heel_true_rad.push_back(trial.heel_true_rad[r.last]);
+    out.pitch_true_rad.push_back(trial.pitch_true_rad[r.last]);
+    out.scored.push_back(trial.scored[r.last]);
   }
   return out;
 }

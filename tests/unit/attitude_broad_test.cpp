@@ -14,11 +14,13 @@
 #include <fstream>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "broad.hpp"
 #include "telltale/fusion/attitude.hpp"
 #include "telltale/fusion/attitude_eval.hpp"
 #include "telltale/fusion/attitude_telltale.hpp"
+#include "telltale/fusion/resample.hpp"
 
 namespace telltale::fusion {
 namespace {
@@ -148,6 +150,29 @@ TEST(Broad, TheTiltDoesNotDependOnTheTimeOrigin) {
   }
   std::printf("  from 0 against Unix time: %.5f deg at most\n", worst_deg);
   EXPECT_LT(worst_deg, 0.01);
+}
+
+// The evaluation tools' one resampler: 100 Hz to 25 Hz averages the four readings of each
+// interval before the output (ending at it), 100 Hz to 200 Hz interpolates, and a reading-less
+// stretch stays a gap both ways. Seen failing with the averaging window centred on the output.
+TEST(ResampleSpans, AveragesTheIntervalBeforeAndInterpolatesAboveKeepingGaps) {
+  std::vector<double> t;
+  for (int i = 0; i <= 100; ++i)
+    if (i < 40 || i > 60) t.push_back(i / 100.0);  // 0.40-0.60 s lost
+  const auto down = resample_spans(t, 25.0);
+  ASSERT_GE(down.size(), 2u);
+  EXPECT_EQ(down[0].first, 0u);  // t = 0: the first reading alone
+  EXPECT_EQ(down[0].last, 0u);
+  EXPECT_DOUBLE_EQ(down[1].t_s, 0.04);  // (0, 0.04]: readings 1..4
+  EXPECT_EQ(down[1].first, 1u);
+  EXPECT_EQ(down[1].last, 4u);
+  EXPECT_DOUBLE_EQ(resampled(down[1], [&](std::size_t i) { return t[i]; }), 0.025);
+  for (const auto& s : down) EXPECT_FALSE(s.t_s > 0.44 && s.t_s < 0.6) << s.t_s;  // the gap
+  const auto up = resample_spans(t, 200.0);
+  ASSERT_GE(up.size(), 3u);
+  EXPECT_TRUE(up[1].interpolated);
+  EXPECT_DOUBLE_EQ(resampled(up[1], [&](std::size_t i) { return t[i]; }), 0.005);
+  for (const auto& s : up) EXPECT_FALSE(s.t_s > 0.4 && s.t_s < 0.6) << s.t_s;
 }
 
 }  // namespace

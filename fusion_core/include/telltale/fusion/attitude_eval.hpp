@@ -47,12 +47,10 @@ struct InclinationTrial {
   std::vector<unsigned char> scored;
 };
 
-/// The trial as an IMU sampling at `rate_hz` (below the recording's rate) would have given it:
-/// sample k, stamped t_k on a grid from the first time, is the mean of the readings in
-/// (t_k - 1 / rate, t_k] (the rate over the interval before it, as a sensor averaging to its
-/// output rate delivers it, and as the filters integrate it); its truth and scored flag are
-/// the last reading's in that interval. Intervals without a reading are left out (a gap). At or
-/// above the recording's rate the trial is returned as it is.
+/// The trial as an IMU averaging to `rate_hz` (below the recording's rate) would have given it
+/// (resample_spans: each sample the mean of the readings over the interval before it); its truth
+/// and scored flag are the last reading's in that interval. At or above the recording's rate the
+/// trial is returned as it is.
 [[nodiscard]] InclinationTrial resample_trial(const InclinationTrial& trial, double rate_hz);
 
 /// RMS inclination error (deg) of the filter over the scored rows of the trial.
