@@ -26,9 +26,7 @@ bool FootIns::update(const ImuSample& s, double dt_s) {
   }
   // The sample's rate over the interval that ends at it (a MEMS gyro's sample is close to the
   // mean rate over it), as a rotation of exact angle.
-  const double angle = w.norm() * dt_s;
-  if (angle > 1e-12) q_ = (q_ * Eigen::Quaterniond(Eigen::AngleAxisd(angle, w / w.norm())));
-  q_.normalize();
+  q_ = (q_ * interval_rotation(w, w, dt_s)).normalized();
 
   const bool still = w.norm() < params_.stance_gyro_rad_s &&
                      std::abs(f.norm() - g_m_s2_) < params_.stance_acc_m_s2;
