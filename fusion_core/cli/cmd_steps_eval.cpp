@@ -175,6 +175,45 @@ std::vector<IpolTrial> ipol_trials(const std::string& dir) {
   return trials;
 }
 
+/// The foot PDR (FootPdr: `pdr --mount foot`, the wearable's foot) on the IPOL foot files, beside
+/// their step table: each walk goes 10 m, turns and comes back 10 m, so a track should walk
+/// about 20 m (plus the turn) and end where it began. The recordings have no position truth
+/// beyond that protocol.
+struct FootPdrRows {
+  std::string rows;
+  std::vector<double> walked, ends;
+  void add(const std::string& file, const std::vector<ImuRecord>& records, std::size_t annotated) {
+    fusion::FootPdr pdr;
+    for (const auto& r : records) pdr.update(r.imu, r.mag_uT);
+    const auto& out = pdr.output();
+    const double end = std::hypot(out.x_m, out.y_m);
+    walked.push_back(out.distance_m);
+    ends.push_back(end);
+    char line[160];
+    std::snprintf(line, sizeof line, "| %s | %zu / %zu | %.1f | %.2f |\n", file.c_str(), out.steps,
+                  annotated, out.distance_m, end);
+    rows += line;
+  }
+  void print(const std::string& dir) const {
+    if (walked.empty()) return;
+    std::printf(
+        "\n## IPOL healthy gait (%s), foot PDR (`pdr --mount foot`): walk 10 m, turn, walk back "
+        "10 m\n\n| file | steps counted / annotated (both feet, outside the U-turn) | walked m | "
+        "end from start m |\n|---|---|---|---|\n%s",
+        dir.c_str(), rows.c_str());
+    double sum_w = 0.0, sum_e = 0.0;
+    for (std::size_t i = 0; i < walked.size(); ++i) {
+      sum_w += walked[i];
+      sum_e += ends[i];
+    }
+    auto sorted = ends;
+    std::sort(sorted.begin(), sorted.end());
+    const auto n = static_cast<double>(walked.size());
+    std::printf("| **mean** | | **%.2f** | **%.2f** (median %.2f, 90th percentile %.2f) |\n",
+                sum_w / n, sum_e / n, sorted[sorted.size() / 2], sorted[sorted.size() * 9 / 10]);
+  }
+};
+
 /// A detection matches the nearest annotated heel strike within this (half a step), s.
 constexpr double kMatchS = 0.3;
 
@@ -265,6 +304,7 @@ void ipol_table(const EvalOptions& o, bool foot) {
   double sum_ceiling = 0.0;
   std::vector<double> worst(columns, 1.0);
   std::string details;
+  FootPdrRows foot_pdr;  // read once: the foot files' PDR table follows this one
   int files = 0, i = 0;
   for (const auto& t : trials) {
     progress(foot ? "ipol foot" : "ipol lower back", ++i, static_cast<int>(trials.size()));
@@ -302,7 +342,12 @@ void ipol_table(const EvalOptions& o, bool foot) {
         std::printf(" %zu (%.0f / %.0f) |", n, 100.0 * a, 100.0 * b);
         if (o.detail && names[m] == o.detail_method) details += ipol_detail(t, side, hs, found);
       }
-      if (!foot) {
+      if (foot) {
+        std::size_t both_feet = 0;
+        for (const auto* feet : {&t.left_hs_s, &t.right_hs_s})
+          both_feet += static_cast<std::size_t>(std::count_if(feet->begin(), feet->end(), outside));
+        foot_pdr.add(t.name + "_" + side, records, both_feet);
+      } else {
         fusion::HandheldPdrParams params;
         params.height_m = 1.75;
         const auto track = run_handheld_walk(records, params).steps;
@@ -334,6 +379,7 @@ void ipol_table(const EvalOptions& o, bool foot) {
         "wrong side: the detection and the heel strike on two sides of a U-turn boundary "
         "(U = inside); offset: median detection - heel strike.\n\n%s",
         o.detail_method.c_str(), kMatchS, kMatchS, details.c_str());
+  foot_pdr.print(dir);
   std::fflush(stdout);
 }
 
@@ -660,56 +706,10 @@ void ipin_table(const EvalOptions& o) {
   std::fflush(stdout);
 }
 
-/// The foot PDR (FootPdr: `pdr --mount foot`, the wearable's foot) on every IPOL foot file: each
-/// walk goes 10 m, turns and comes back 10 m, so a track should walk about 20 m (plus the turn)
-/// and end where it began. The recordings have no position truth beyond that protocol.
-void ipol_foot_pdr_table(const EvalOptions& o) {
-  const std::string dir = data_dir(o) + "/ipol_gait";
-  if (!std::filesystem::exists(dir)) return;
-  const auto trials = ipol_trials(dir);
-  std::printf(
-      "\n## IPOL healthy gait (%s), foot PDR (`pdr --mount foot`): walk 10 m, turn, walk back "
-      "10 m\n\n| file | steps counted / annotated (both feet, outside the U-turn) | walked m | "
-      "end from start m |\n|---|---|---|---|\n",
-      dir.c_str());
-  std::vector<double> walked, ends;
-  for (const auto& t : trials) {
-    for (const std::string side : {"lf", "rf"}) {
-      const std::string path = dir + "/" + t.name + "_" + side + ".imu.csv";
-      if (!std::filesystem::exists(path)) continue;
-      const auto records = read_records(o, path);
-      fusion::FootPdr pdr;
-      for (const auto& r : records) pdr.update(r.imu, r.mag_uT);
-      const auto& out = pdr.output();
-      std::size_t annotated = 0;
-      for (const auto* hs : {&t.left_hs_s, &t.right_hs_s})
-        for (double x : *hs) annotated += x < t.uturn0_s || x > t.uturn1_s ? 1u : 0u;
-      const double end = std::hypot(out.x_m, out.y_m);
-      walked.push_back(out.distance_m);
-      ends.push_back(end);
-      std::printf("| %s_%s | %zu / %zu | %.1f | %.2f |\n", t.name.c_str(), side.c_str(), out.steps,
-                  annotated, out.distance_m, end);
-    }
-  }
-  if (walked.empty()) return;
-  double sum_w = 0.0, sum_e = 0.0;
-  for (std::size_t i = 0; i < walked.size(); ++i) {
-    sum_w += walked[i];
-    sum_e += ends[i];
-  }
-  auto sorted = ends;
-  std::sort(sorted.begin(), sorted.end());
-  const auto n = static_cast<double>(walked.size());
-  std::printf("| **mean** | | **%.2f** | **%.2f** (median %.2f, 90th percentile %.2f) |\n",
-              sum_w / n, sum_e / n, sorted[sorted.size() / 2], sorted[sorted.size() * 9 / 10]);
-  std::fflush(stdout);
-}
-
 void run_eval(const EvalOptions& o) {
   if (o.tables.find("gait") != std::string::npos) gait_table(o);
   if (o.tables.find("ipol") != std::string::npos) {
     ipol_table(o, true);
-    ipol_foot_pdr_table(o);
     ipol_table(o, false);
   }
   if (o.tables.find("oxford") != std::string::npos) oxford_table(o);
