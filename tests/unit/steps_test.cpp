@@ -8,14 +8,13 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <ostream>
 #include <string>
 #include <vector>
 
-#include "csv.hpp"
+#include "oxford_traces.hpp"
 #include "telltale/fusion/gait_phase_steps.hpp"
 #include "telltale/fusion/peak_valley_steps.hpp"
 #include "telltale/fusion/sim/gait_sim.hpp"
@@ -648,39 +647,19 @@ TEST(GaitPhaseStepDetector, FootReportsTheHeelStrike) {
 // handled-phone rule, which the bound below would have failed). Every trace above 89 %: the
 // swinging arm is the lowest (89.8 here, 90.8 full), its pendulum swamping the trunk's steps.
 TEST(OxfordTraces, PeakValleyMeanCountAccuracyAtLeast98Percent) {
-  const std::string dir = std::string(TELLTALE_TEST_DATA_DIR) + "/oxford_steps";
-  std::ifstream counts(dir + "/counts.csv");
-  ASSERT_TRUE(counts) << dir;
-  std::string line;
-  std::getline(counts, line);
+  const auto traces = read_oxford_traces();
+  ASSERT_EQ(traces.size(), 24u);
   double sum = 0.0;
-  int traces = 0;
-  while (std::getline(counts, line)) {
-    const auto c1 = line.find(','), c2 = line.rfind(',');
-    ASSERT_NE(c1, std::string::npos);
-    const std::string trace = line.substr(0, c1);
-    const auto truth = static_cast<std::size_t>(std::stoi(line.substr(c2 + 1)));
-    const auto table = io::read_csv(dir + "/" + trace + ".imu.csv",
-                                    {{"t_s"}, {"ax_m_s2"}, {"ay_m_s2"}, {"az_m_s2"}}, "t_s");
+  for (const auto& trace : traces) {
     PeakValleyStepDetector d;
-    StepEvent ev;
     std::size_t n = 0;
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    for (std::size_t i = 0; i < table.rows(); ++i) {
-      const ImuSample s{table.columns[0][i],
-                        {nan, nan, nan},
-                        {table.columns[1][i], table.columns[2][i], table.columns[3][i]}};
-      n += d.update(s, ev) ? 1u : 0u;
-    }
-    while (d.flush(ev)) ++n;
-    const double acc = accuracy(n, truth);
-    EXPECT_GE(acc, 0.89) << trace << ": " << n << " of " << truth;
+    for_each_step(d, trace.samples, [&n](const StepEvent&) { ++n; });
+    const double acc = accuracy(n, trace.steps);
+    EXPECT_GE(acc, 0.89) << trace.name << ": " << n << " of " << trace.steps;
     sum += acc;
-    ++traces;
   }
-  ASSERT_EQ(traces, 24);
-  RecordProperty("mean_accuracy_percent", std::to_string(100.0 * sum / traces));
-  EXPECT_GE(sum / traces, 0.98);
+  RecordProperty("mean_accuracy_percent", std::to_string(100.0 * sum / 24.0));
+  EXPECT_GE(sum / 24.0, 0.98);
 }
 
 }  // namespace

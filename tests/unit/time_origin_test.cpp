@@ -11,12 +11,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <string>
 #include <vector>
 
-#include "csv.hpp"
+#include "oxford_traces.hpp"
 #include "telltale/fusion/foot_pdr.hpp"
 #include "telltale/fusion/handheld_pdr.hpp"
 #include "telltale/fusion/pdr.hpp"
@@ -77,29 +76,13 @@ TEST(TimeOrigin, StepDetectorsOnSimulatedWalks) {
 // The same on the real Oxford phone traces (tests/data/oxford_steps, CC BY 4.0): accelerometer
 // only, 50 Hz, every detector.
 TEST(TimeOrigin, StepDetectorsOnRealPhoneTraces) {
-  const std::string dir = std::string(TELLTALE_TEST_DATA_DIR) + "/oxford_steps";
-  std::ifstream counts(dir + "/counts.csv");
-  ASSERT_TRUE(counts) << dir;
-  std::string line;
-  std::getline(counts, line);
-  int traces = 0;
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  while (std::getline(counts, line)) {
-    const std::string trace = line.substr(0, line.find(','));
-    const auto table = io::read_csv(dir + "/" + trace + ".imu.csv",
-                                    {{"t_s"}, {"ax_m_s2"}, {"ay_m_s2"}, {"az_m_s2"}}, "t_s");
-    std::vector<ImuSample> samples;
-    for (std::size_t i = 0; i < table.rows(); ++i)
-      samples.push_back({table.columns[0][i],
-                         {nan, nan, nan},
-                         {table.columns[1][i], table.columns[2][i], table.columns[3][i]}});
+  const auto traces = read_oxford_traces();
+  ASSERT_EQ(traces.size(), 24u);
+  for (const auto& trace : traces)
     for (auto name : step_detector_names())
-      expect_same(step_times(name, StepMount::kBody, samples, 0.0),
-                  step_times(name, StepMount::kBody, samples, kUnixOffset_s),
-                  std::string(name) + " " + trace);
-    ++traces;
-  }
-  EXPECT_EQ(traces, 24);
+      expect_same(step_times(name, StepMount::kBody, trace.samples, 0.0),
+                  step_times(name, StepMount::kBody, trace.samples, kUnixOffset_s),
+                  std::string(name) + " " + trace.name);
 }
 
 // Given the hand-held PDR on simulated IPIN-like walks (handling, standing, a loop with
