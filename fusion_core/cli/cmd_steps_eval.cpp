@@ -21,6 +21,7 @@
 #include "gait_io.hpp"
 #include "telltale/fusion/foot_pdr.hpp"
 #include "telltale/fusion/handheld_pdr.hpp"
+#include "telltale/fusion/pdr.hpp"
 #include "telltale/fusion/sim/gait_sim.hpp"
 #include "telltale/fusion/sim/phone_walk.hpp"
 #include "telltale/fusion/sim/pose_dataset.hpp"
@@ -143,8 +144,20 @@ std::vector<long> json_ints(const std::string& text, const std::string& key) {
   return out;
 }
 
+/// The number after "key": in a JSON text (NaN when there is none).
+double json_number(const std::string& text, const std::string& key) {
+  auto at = text.find("\"" + key + "\"");
+  if (at == std::string::npos) return std::nan("");
+  at = text.find(':', at);
+  if (at == std::string::npos) return std::nan("");
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str() + at + 1, &end);
+  return end == text.c_str() + at + 1 ? std::nan("") : v;
+}
+
 struct IpolTrial {
   std::string name;
+  double height_m = std::nan("");  ///< the walker's (Height, cm)
   double uturn0_s = 0.0, uturn1_s = 0.0;
   std::vector<double> left_hs_s, right_hs_s;  ///< heel strikes, s (sample index / 100)
 };
@@ -161,6 +174,7 @@ std::vector<IpolTrial> ipol_trials(const std::string& dir) {
     const std::string text = ss.str();
     IpolTrial t;
     t.name = name;
+    t.height_m = json_number(text, "Height") / 100.0;
     const auto u = json_ints(text, "UTurnBoundaries");
     if (u.size() != 2) continue;
     t.uturn0_s = static_cast<double>(u[0]) / 100.0;
@@ -211,6 +225,53 @@ struct FootPdrRows {
     const auto n = static_cast<double>(walked.size());
     std::printf("| **mean** | | **%.2f** | **%.2f** (median %.2f, 90th percentile %.2f) |\n",
                 sum_w / n, sum_e / n, sorted[sorted.size() / 2], sorted[sorted.size() * 9 / 10]);
+  }
+};
+
+/// The two PDRs that lay steps of a height-and-cadence length (`pdr --mount body`, the seed-003
+/// Pdr, and `--mount phone`, the HandheldPdr) on the IPOL lower-back files, at each walker's
+/// own height: the only real walks of a known length where a body-worn sensor's step length is
+/// tested (10 m, a turn, 10 m: the foot's own navigation measures 20.7 m on the same trials).
+/// A lower back is neither PDR's mount (a phone on a belt is the nearest), and these are short
+/// walks that start and stop, but a step's length from height and cadence is what is scored.
+struct BodyPdrRows {
+  std::string rows;
+  std::vector<double> body, handheld;
+  void add(const std::string& file, const std::vector<ImuRecord>& records, double height_m) {
+    if (!(height_m > 0.5 && height_m < 2.5)) return;
+    fusion::PdrParams params;
+    params.step_length.height_m = height_m;
+    fusion::Pdr pdr(params);
+    for (const auto& r : records) (void)pdr.update(r.imu, r.mag_uT);
+    fusion::HandheldPdrParams hp;
+    hp.height_m = height_m;
+    const auto walk = run_handheld_walk(records, hp).steps;
+    const double held = walk.empty() ? 0.0 : walk.back().distance_m;
+    const std::size_t held_steps = walk.empty() ? 0 : walk.back().steps;
+    body.push_back(pdr.output().distance_m);
+    handheld.push_back(held);
+    char line[192];
+    std::snprintf(line, sizeof line, "| %s | %.2f | %zu, %.1f | %zu, %.1f |\n", file.c_str(),
+                  height_m, pdr.output().steps, pdr.output().distance_m, held_steps, held);
+    rows += line;
+  }
+  void print(const std::string& dir) const {
+    if (body.empty()) return;
+    const auto stats = [](std::vector<double> v) {
+      std::sort(v.begin(), v.end());
+      double sum = 0.0;
+      for (const double x : v) sum += x;
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "%.1f (%.1f-%.1f)", sum / static_cast<double>(v.size()),
+                    v.front(), v.back());
+      return std::string(buf);
+    };
+    std::printf(
+        "\n## IPOL healthy gait (%s), lower back: the step-length PDRs at the walker's height "
+        "(walk 10 m, turn, walk back 10 m; the foot PDR measures 20.7 m)\n\n| file | height m | "
+        "`pdr --mount body`: steps, walked m | `pdr --mount phone`: steps, walked m |\n"
+        "|---|---|---|---|\n%s| **mean (min-max)** | | %s | %s |\n",
+        dir.c_str(), rows.c_str(), stats(body).c_str(), stats(handheld).c_str());
   }
 };
 
@@ -305,6 +366,7 @@ void ipol_table(const EvalOptions& o, bool foot) {
   std::vector<double> worst(columns, 1.0);
   std::string details;
   FootPdrRows foot_pdr;  // read once: the foot files' PDR table follows this one
+  BodyPdrRows body_pdr;  // and the lower back's
   int files = 0, i = 0;
   for (const auto& t : trials) {
     progress(foot ? "ipol foot" : "ipol lower back", ++i, static_cast<int>(trials.size()));
@@ -358,6 +420,7 @@ void ipol_table(const EvalOptions& o, bool foot) {
         sum_all.back() += b;
         worst.back() = std::min(worst.back(), a);
         std::printf(" %zu (%.0f / %.0f) |", n, 100.0 * a, 100.0 * b);
+        body_pdr.add(t.name + "_" + side, records, t.height_m);
       }
       std::printf("\n");
     }
@@ -380,6 +443,7 @@ void ipol_table(const EvalOptions& o, bool foot) {
         "(U = inside); offset: median detection - heel strike.\n\n%s",
         o.detail_method.c_str(), kMatchS, kMatchS, details.c_str());
   foot_pdr.print(dir);
+  body_pdr.print(dir);
   std::fflush(stdout);
 }
 

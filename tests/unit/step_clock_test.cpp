@@ -112,16 +112,16 @@ TEST(StepClock, AWalkAfterAStandStartsOnlyWhenASecondEventConfirmsIt) {
   ASSERT_TRUE(step);
   EXPECT_EQ(step->extra, 1);  // the held first event
   EXPECT_DOUBLE_EQ(step->prev_t_s, 3.5);
-  // Nor is the interval across the stand a cadence: after a walk of one interval (0.5 s) and a
-  // short stand, the confirmed restart leaves the cadence at 0.5 s.
+  // Nor is the interval across the stand a cadence: after a walk of three intervals (0.5 s, the
+  // fewest that make a cadence) and a short stand, the confirmed restart leaves it at 0.5 s.
   StepClock short_walk(StepClockParams{});
   RecentSamples recent_short = make_recent();
-  walk(short_walk, recent_short, 1.0, 2);  // steps at 1.0 and 1.5
-  push_samples(recent_short, 1.5, 2.3, false);
-  push_samples(recent_short, 2.3, 2.5, true);
-  EXPECT_FALSE(short_walk.at_events(acc_event(2.5), recent_short, kWalkEnergy));
-  push_samples(recent_short, 2.5, 3.0, true);
-  ASSERT_TRUE(short_walk.at_events(acc_event(3.0), recent_short, kWalkEnergy));
+  walk(short_walk, recent_short, 1.0, 4);  // steps at 1.0 .. 2.5
+  push_samples(recent_short, 2.5, 3.3, false);
+  push_samples(recent_short, 3.3, 3.5, true);
+  EXPECT_FALSE(short_walk.at_events(acc_event(3.5), recent_short, kWalkEnergy));
+  push_samples(recent_short, 3.5, 4.0, true);
+  ASSERT_TRUE(short_walk.at_events(acc_event(4.0), recent_short, kWalkEnergy));
   EXPECT_DOUBLE_EQ(short_walk.cadence().interval_s(), 0.5);
   // Off (walk_start_intervals 0), the first event after the stand is a step at once.
   StepClock off(StepClockParams{.walk_start_intervals = 0.0});
@@ -139,19 +139,19 @@ TEST(StepClock, AWalkAfterAStandStartsOnlyWhenASecondEventConfirmsIt) {
 TEST(StepClock, AHandoffBetweenTheDetectorsCountsTheSameStepOnce) {
   StepClock clock(StepClockParams{});
   RecentSamples recent = make_recent();
-  walk(clock, recent, 1.0, 2);  // steps at 1.0 and 1.5: one interval, 0.5 s
-  push_samples(recent, 1.5, 1.6, true);
-  EXPECT_FALSE(clock.at_events(swing_event(1.6, true, 1.55), recent, kWalkEnergy));
-  push_samples(recent, 1.6, 2.1, true);
-  const auto step = clock.at_events(swing_event(2.1, true, 2.05), recent, kWalkEnergy);
+  walk(clock, recent, 1.0, 4);  // steps at 1.0 .. 2.5: a cadence of 0.5 s
+  push_samples(recent, 2.5, 2.6, true);
+  EXPECT_FALSE(clock.at_events(swing_event(2.6, true, 2.55), recent, kWalkEnergy));
+  push_samples(recent, 2.6, 3.1, true);
+  const auto step = clock.at_events(swing_event(3.1, true, 3.05), recent, kWalkEnergy);
   ASSERT_TRUE(step);
-  EXPECT_DOUBLE_EQ(step->t_s, 2.05);
+  EXPECT_DOUBLE_EQ(step->t_s, 3.05);
   EXPECT_EQ(step->extra, 0);
   // The cadence is still the walk's, not the 0.55 s across the handoff.
   EXPECT_DOUBLE_EQ(clock.cadence().interval_s(), 0.5);
   // While the phone swings the acceleration's events are not steps.
-  push_samples(recent, 2.1, 2.3, true);
-  PhoneEvents acc_while_swinging = acc_event(2.3);
+  push_samples(recent, 3.1, 3.3, true);
+  PhoneEvents acc_while_swinging = acc_event(3.3);
   acc_while_swinging.swing = true;
   EXPECT_FALSE(clock.at_events(acc_while_swinging, recent, kWalkEnergy));
 }
@@ -222,6 +222,21 @@ TEST(Cadence, MedianOfTheLastIntervalsPerStep) {
   c.forget();
   EXPECT_DOUBLE_EQ(c.interval_s(), 0.0);
   EXPECT_DOUBLE_EQ(c.last_step_t_s(), 12.0);
+}
+
+// Given a walk whose first two events are one step detected twice (0.2 s apart, as on a real
+// lower-back recording), then that interval alone is no cadence (it read 300 steps/min, and the
+// body PDR laid each of the next ten steps twice, 1.9 m each); two more intervals of the walk
+// outvote it, and the cadence is the walk's.
+TEST(Cadence, OneIntervalIsNoCadenceTheMedianOfThreeIs) {
+  Cadence c(0.2);
+  c.at_step(4.27, 1.0, true);
+  c.at_step(4.47, 1.0, true);  // the same step again
+  EXPECT_DOUBLE_EQ(c.interval_s(), 0.0);
+  c.at_step(5.00, 1.0, true);
+  EXPECT_DOUBLE_EQ(c.interval_s(), 0.0);
+  c.at_step(5.48, 1.0, true);
+  EXPECT_NEAR(c.interval_s(), 0.48, 1e-12);  // median of 0.20, 0.53, 0.48
 }
 
 }  // namespace

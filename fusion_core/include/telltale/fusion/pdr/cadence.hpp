@@ -22,8 +22,14 @@ class Cadence {
   void at_step(double t_s, double per_event, bool learn);
   /// The cadence is unknown again (the last step's time is kept).
   void forget();
-  /// The step interval, s (0 until one is measured).
-  [[nodiscard]] double interval_s() const { return interval_s_; }
+  /// The step interval, s: 0 until kMinIntervals have been measured. One interval is one
+  /// measurement, not a cadence: a walk's first two events may be one step detected twice
+  /// (0.2 s apart, read as 300 steps/min), and everything that trusts the cadence goes wrong
+  /// with it (the body PDR laid every step of a lower-back walk twice at 1.9 m each, ten steps
+  /// in a row, before the gap filler gave up on it). The median of three outvotes one.
+  [[nodiscard]] double interval_s() const {
+    return interval_count_ >= kMinIntervals ? interval_s_ : 0.0;
+  }
   /// The last step's time (< 0: none yet).
   [[nodiscard]] double last_step_t_s() const { return last_step_t_s_; }
 
@@ -33,6 +39,7 @@ class Cadence {
   double last_step_t_s_ = -1.0;
   double interval_s_ = 0.0;
   static constexpr std::size_t kIntervals = 5;
+  static constexpr std::size_t kMinIntervals = 3;
   std::array<double, kIntervals> intervals_{};
   std::size_t interval_count_ = 0;
 };
