@@ -16,8 +16,9 @@ msg::Gait gait_of(const fusion::PdrOutput& p) {
   }
 }
 
-msg::Pose pose_of(const fusion::PdrOutput& p, bool foot) {
-  if (foot) return msg::POSE_FOOT;
+msg::Pose pose_of(const fusion::PdrOutput& p, WearableMount mount) {
+  if (mount == WearableMount::kFoot) return msg::POSE_FOOT;
+  if (mount == WearableMount::kTrunk) return msg::POSE_TRUNK;
   switch (p.pose) {
     case fusion::PhonePose::kHandHeld: return msg::POSE_HAND_HELD;
     case fusion::PhonePose::kCall: return msg::POSE_PHONE_CALL;
@@ -83,7 +84,7 @@ void to_wire(const WearableRecord& r, const std::string& athlete_id, msg::Wearab
   m.steps(static_cast<std::uint32_t>(r.pdr.steps));
   m.cadence_spm(r.pdr.cadence_spm);
   m.gait(gait_of(r.pdr));
-  m.pose(pose_of(r.pdr, r.foot));
+  m.pose(pose_of(r.pdr, r.mount));
   m.x_m(r.pdr.x_m);
   m.y_m(r.pdr.y_m);
   m.heading_deg(r.pdr.heading_deg);

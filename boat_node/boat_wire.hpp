@@ -39,15 +39,19 @@ struct WindRecord {
 void to_wire(const WindRecord& r, const std::string& boat_id, std::uint64_t run, msg::BoatWind& m);
 
 /// What a wearable publishes of its dead reckoning; `foot` for a foot-mounted IMU (pose FOOT).
+/// Where the wearable's sensor sits: a phone carried in any pose (the classifier's pose goes on
+/// the wire), or strapped to the foot or the trunk (that is the pose).
+enum class WearableMount { kCarried, kFoot, kTrunk };
+
 struct WearableRecord {
   std::uint64_t seq = 0;
   std::uint64_t t_utc_ns = 0;
   fusion::PdrOutput pdr;
-  bool foot = false;
+  WearableMount mount = WearableMount::kCarried;
 };
 
 /// WearableMotion (telltale_wearable_motion): the gait from the cadence class (still at no
-/// cadence), the pose from the classifier (foot for a foot sensor).
+/// cadence), the pose from the classifier (foot or trunk for a strapped-on sensor).
 void to_wire(const WearableRecord& r, const std::string& athlete_id, msg::WearableMotion& m);
 
 }  // namespace telltale::boat

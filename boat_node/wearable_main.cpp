@@ -18,6 +18,7 @@
 #include "telltale/fusion/handheld_pdr.hpp"
 #include "telltale/fusion/pdr.hpp"
 #include "telltale/fusion/sim/gait_sim.hpp"
+#include "telltale/fusion/trunk_pdr.hpp"
 #include "telltalePubSubTypes.h"
 #include "witmotion_feed.hpp"
 
@@ -135,10 +136,13 @@ class WitMotionWearable : public WearableSource {
 };
 
 std::unique_ptr<WearableSource> make_source(const Options& o) {
-  // The simulated walker carries the phone the way the mount says: held in front for `phone`
-  // (what HandheldPdr is for), switching poses for `body` and `foot` (as before).
+  // The simulated walker carries the sensor the way the mount says: a phone held in front for
+  // `phone` (what HandheldPdr is for), a belt sensor on a walk for `trunk`, a phone switching
+  // poses for `body` and `foot` (as before).
   if (o.source == "sim")
-    return std::make_unique<SimWearable>(o.mount == "phone" ? "phone-hand-held-walk" : "phone-switch",
+    return std::make_unique<SimWearable>(o.mount == "phone"   ? "phone-hand-held-walk"
+                                         : o.mount == "trunk" ? "body-walk"
+                                                              : "phone-switch",
                                          o.seed);
   if (o.source.rfind("sim:", 0) == 0)
     return std::make_unique<SimWearable>(o.source.substr(4), o.seed);
@@ -164,15 +168,18 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   if (!(o.step_scale >= 0.5 && o.step_scale <= 1.5))
     throw std::invalid_argument("--step-scale must be in 0.5..1.5");
   if (!(o.rate_hz > 0 && o.rate_hz <= 50)) throw std::invalid_argument("--rate-hz in (0, 50]");
-  if (o.mount != "phone" && o.mount != "body" && o.mount != "foot")
-    throw std::invalid_argument("--mount is phone, body or foot");
+  if (o.mount != "phone" && o.mount != "body" && o.mount != "foot" && o.mount != "trunk")
+    throw std::invalid_argument("--mount is phone, body, foot or trunk");
   const bool foot = o.mount == "foot";
+  const bool trunk = o.mount == "trunk";
   const bool handheld = o.mount == "phone";
   auto source = make_source(o);
   // One pipeline per mount, the same as `fusion_cli pdr --mount`: phone -> HandheldPdr (a phone
-  // held in front), body -> the seed-003 Pdr with its four poses, foot -> FootPdr.
+  // held in front), body -> the seed-003 Pdr with its four poses, foot -> FootPdr, trunk ->
+  // TrunkPdr.
   std::unique_ptr<fusion::Pdr> pdr;  // 110 kB: not on the stack
   std::unique_ptr<fusion::FootPdr> foot_pdr;
+  std::unique_ptr<fusion::TrunkPdr> trunk_pdr;
   std::unique_ptr<fusion::HandheldPdr> phone_pdr;
   if (handheld) {
     fusion::HandheldPdrParams hp;
@@ -181,6 +188,10 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
     phone_pdr = std::make_unique<fusion::HandheldPdr>(hp);
   } else if (foot) {
     foot_pdr = std::make_unique<fusion::FootPdr>();  // the stride is measured: no height
+  } else if (trunk) {
+    fusion::TrunkPdrParams tp;  // each step measured: the height is the pendulum's leg
+    tp.height_m = o.height_m;
+    trunk_pdr = std::make_unique<fusion::TrunkPdr>(tp);
   } else {
     fusion::PdrParams params;
     params.step_length.height_m = o.height_m;
@@ -248,17 +259,22 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
     }
     const fusion::PdrOutput& p = handheld ? handheld_out
                                  : foot   ? foot_pdr->update(s->imu, s->mag_uT)
+                                 : trunk  ? trunk_pdr->update(s->imu, s->mag_uT)
                                           : pdr->update(s->imu, s->mag_uT);
     if (t >= next_publish) {
       next_publish = t + 1.0 / o.rate_hz;
-      telltale::boat::to_wire({++seq, start_utc + static_cast<unsigned long long>(t * 1e9), p, foot},
-                              o.athlete_id, m);
+      const auto mount = foot    ? telltale::boat::WearableMount::kFoot
+                         : trunk ? telltale::boat::WearableMount::kTrunk
+                                 : telltale::boat::WearableMount::kCarried;
+      telltale::boat::to_wire(
+          {++seq, start_utc + static_cast<unsigned long long>(t * 1e9), p, mount}, o.athlete_id, m);
       motion_writer->write(&m);
     }
     if (Clock::now() >= next_status) {
       next_status += std::chrono::seconds(1);
       const unsigned bad = handheld ? rejected_non_finite
                            : foot   ? rejected(foot_pdr->diagnostics())
+                           : trunk  ? rejected(trunk_pdr->diagnostics())
                                     : rejected(pdr->diagnostics());
       status.t_utc_ns(run_clock.now_ns());
       status.uptime_s(std::chrono::duration<double>(Clock::now() - start).count());
@@ -292,7 +308,8 @@ int main(int argc, char** argv) {
       ->group(sensor);
   app.add_option("--mount", o.mount,
                  "phone (held in front: HandheldPdr, as fusion_cli pdr --mount phone) | body "
-                 "(carried in any of the seed-003 poses) | foot (toe-mounted module)")
+                 "(carried in any of the seed-003 poses) | foot (toe-mounted module) | trunk (a "
+                 "belt or lower-back module: each step measured by the inverted pendulum)")
       ->capture_default_str()
       ->group(sensor);
   app.add_option("--seed", o.seed, "simulator seed")->capture_default_str()->group(sensor);
@@ -300,7 +317,8 @@ int main(int argc, char** argv) {
 
   const std::string step = "Step length";
   app.add_option("--height-m", o.height_m,
-                 "athlete's height (step length model; a foot's strides are measured)")
+                 "athlete's height (step length model; the trunk's pendulum leg is 0.53 of it; a "
+                 "foot's strides are measured)")
       ->capture_default_str()
       ->group(step);
   app.add_option("--step-scale", o.step_scale,

@@ -133,7 +133,8 @@ struct WearableSample {
   std::uint32_t steps = 0;
   double cadence_spm = 0.0;
   std::string gait;  ///< "still", "slow_walk", "walk", "fast_walk", "jog", "run", "unknown"
-  std::string pose;  ///< "hand_held", "phone_call", "pocket", "arm_swing", "foot", "unknown"
+  std::string
+      pose;  ///< "hand_held", "phone_call", "pocket", "arm_swing", "foot", "trunk", "unknown"
   double x_m = 0.0;  ///< east of the start
   double y_m = 0.0;  ///< north of the start
   double heading_deg = 0.0;

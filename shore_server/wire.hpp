@@ -52,13 +52,14 @@ inline constexpr std::array<EnumRow<msg::Gait, std::string_view>, 7> kGaits = {{
     {msg::GAIT_RUN, "run"},
     {msg::GAIT_UNKNOWN, "unknown"},
 }};
-inline constexpr std::array<EnumRow<msg::Pose, std::string_view>, 6> kPoses = {{
+inline constexpr std::array<EnumRow<msg::Pose, std::string_view>, 7> kPoses = {{
     {msg::POSE_HAND_HELD, "hand_held"},
     {msg::POSE_PHONE_CALL, "phone_call"},
     {msg::POSE_POCKET, "pocket"},
     {msg::POSE_ARM_SWING, "arm_swing"},
     {msg::POSE_FOOT, "foot"},
     {msg::POSE_UNKNOWN, "unknown"},
+    {msg::POSE_TRUNK, "trunk"},
 }};
 inline constexpr std::array<EnumRow<msg::AlarmLevel, AlarmLevel>, 3> kAlarmLevels = {{
     {msg::ALARM_LEVEL_NORMAL, AlarmLevel::kNormal},

@@ -1,6 +1,7 @@
 // fusion_cli pdr: IMU.csv -> TRACK.csv (one row per step) + JSON summary (SPEC section 6).
 #include <chrono>
 #include <cstdio>
+#include <memory>
 #include <string>
 
 #include "commands.hpp"
@@ -9,6 +10,7 @@
 #include "telltale/fusion/foot_pdr.hpp"
 #include "telltale/fusion/handheld_pdr.hpp"
 #include "telltale/fusion/pdr.hpp"
+#include "telltale/fusion/trunk_pdr.hpp"
 
 namespace telltale::cli {
 namespace {
@@ -62,9 +64,10 @@ Switches switches_of(const fusion::Pdr& pdr) {
   return {d.switches, d.pose_changes, d.replaced_headings};
 }
 Switches switches_of(const fusion::FootPdr& /*pdr*/) { return {}; }
+Switches switches_of(const fusion::TrunkPdr& /*pdr*/) { return {}; }
 
-/// Runs `pdr` (Pdr or FootPdr) over the records: the track CSV, one row per step, and the JSON
-/// summary. The two print the same columns and fields, so that a foot's track and a phone's
+/// Runs `pdr` (Pdr, FootPdr or TrunkPdr) over the records: the track CSV, one row per step, and the
+/// JSON summary. The two print the same columns and fields, so that a foot's track and a phone's
 /// read alike: the foot's pose and switch columns are those of a pose that never changes.
 template <class Pipeline>
 void run_track(const PdrOptions& o, const std::vector<ImuRecord>& records, bool has_gyro,
@@ -104,8 +107,8 @@ void run_pdr(const PdrOptions& o) {
     throw UsageError("--height-m must be a body height in metres (0.5-2.5)");
   if (!(o.step_scale >= 0.5 && o.step_scale <= 1.5))
     throw UsageError("--step-scale must be a personal factor between 0.5 and 1.5");
-  if (o.mount != "phone" && o.mount != "body" && o.mount != "foot")
-    throw UsageError("unknown mount '" + o.mount + "' (phone, body, foot)");
+  if (o.mount != "phone" && o.mount != "body" && o.mount != "foot" && o.mount != "trunk")
+    throw UsageError("unknown mount '" + o.mount + "' (phone, body, foot, trunk)");
   bool has_gyro = false, has_mag = false;
   std::size_t repeated = 0;
   const auto records = read_imu_csv(o.in, false, &has_gyro, &has_mag, &repeated);
@@ -116,6 +119,14 @@ void run_pdr(const PdrOptions& o) {
   if (o.mount == "foot") {
     fusion::FootPdr pdr;  // the stride is measured: no height, no step scale
     run_track(o, records, has_gyro, has_mag, repeated, pdr);
+    return;
+  }
+  if (o.mount == "trunk") {
+    if (o.step_scale != 1.0) throw UsageError("--step-scale is for step models: a trunk measures");
+    fusion::TrunkPdrParams params;  // each step measured by the pendulum: no step scale
+    params.height_m = o.height_m;
+    auto pdr = std::make_unique<fusion::TrunkPdr>(params);  // 50 kB of rings: not on the stack
+    run_track(o, records, has_gyro, has_mag, repeated, *pdr);
     return;
   }
   fusion::PdrParams params;
@@ -148,7 +159,9 @@ void register_pdr(CLI::App& app) {
                   "the gyro about the vertical; the track re-laid once the walk is over with the "
                   "gyro bias all its stands measured) | body: the four simulated poses of seed "
                   "003 | foot: each stride measured by the foot's inertial navigation, reset at "
-                  "every stance (height and step scale unused; a gyro is required)")
+                  "every stance (height and step scale unused; a gyro is required) | trunk: a "
+                  "belt or lower-back sensor, each step measured from the trunk's rise and fall "
+                  "(the inverted pendulum on a leg of 0.53 x height; a gyro is required)")
       ->capture_default_str();
   cmd->callback([opts] { run_pdr(*opts); });
 }

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <optional>
 #include <ranges>
 #include <set>
@@ -26,6 +27,7 @@
 #include "telltale/fusion/sim/phone_walk.hpp"
 #include "telltale/fusion/sim/pose_dataset.hpp"
 #include "telltale/fusion/steps.hpp"
+#include "telltale/fusion/trunk_pdr.hpp"
 
 namespace telltale::cli {
 namespace {
@@ -228,35 +230,46 @@ struct FootPdrRows {
   }
 };
 
-/// The two PDRs that lay steps of a height-and-cadence length (`pdr --mount body`, the seed-003
-/// Pdr, and `--mount phone`, the HandheldPdr) on the IPOL lower-back files, at each walker's
-/// own height: the only real walks of a known length where a body-worn sensor's step length is
-/// tested (10 m, a turn, 10 m: the foot's own navigation measures 20.7 m on the same trials).
-/// A lower back is neither PDR's mount (a phone on a belt is the nearest), and these are short
-/// walks that start and stop, but a step's length from height and cadence is what is scored.
+/// The PDRs that can carry a body-worn sensor, on the IPOL lower-back files at each walker's
+/// own height: the only real walks of a known length with one (10 m, a turn, 10 m back: the
+/// foot's own navigation measures 20.7 m on the same trials). `pdr --mount trunk` (TrunkPdr)
+/// measures each step by the inverted pendulum; `--mount body` (the seed-003 Pdr) and
+/// `--mount phone` (HandheldPdr) lay a length from height and cadence (a lower back is neither's
+/// mount: a phone on a belt is the nearest). The trunk's track also ends where it began.
 struct BodyPdrRows {
   std::string rows;
-  std::vector<double> body, handheld;
+  std::vector<double> trunk, trunk_end, body, handheld;
   void add(const std::string& file, const std::vector<ImuRecord>& records, double height_m) {
     if (!(height_m > 0.5 && height_m < 2.5)) return;
+    fusion::TrunkPdrParams tp;
+    tp.height_m = height_m;
+    auto tr = std::make_unique<fusion::TrunkPdr>(tp);
     fusion::PdrParams params;
     params.step_length.height_m = height_m;
-    fusion::Pdr pdr(params);
-    for (const auto& r : records) (void)pdr.update(r.imu, r.mag_uT);
+    auto pdr = std::make_unique<fusion::Pdr>(params);
+    for (const auto& r : records) {
+      (void)tr->update(r.imu, r.mag_uT);
+      (void)pdr->update(r.imu, r.mag_uT);
+    }
     fusion::HandheldPdrParams hp;
     hp.height_m = height_m;
     const auto walk = run_handheld_walk(records, hp).steps;
     const double held = walk.empty() ? 0.0 : walk.back().distance_m;
     const std::size_t held_steps = walk.empty() ? 0 : walk.back().steps;
-    body.push_back(pdr.output().distance_m);
+    const auto& t = tr->output();
+    const double end = std::hypot(t.x_m, t.y_m);
+    trunk.push_back(t.distance_m);
+    trunk_end.push_back(end);
+    body.push_back(pdr->output().distance_m);
     handheld.push_back(held);
-    char line[192];
-    std::snprintf(line, sizeof line, "| %s | %.2f | %zu, %.1f | %zu, %.1f |\n", file.c_str(),
-                  height_m, pdr.output().steps, pdr.output().distance_m, held_steps, held);
+    char line[224];
+    std::snprintf(line, sizeof line, "| %s | %.2f | %zu, %.1f, %.2f | %zu, %.1f | %zu, %.1f |\n",
+                  file.c_str(), height_m, t.steps, t.distance_m, end, pdr->output().steps,
+                  pdr->output().distance_m, held_steps, held);
     rows += line;
   }
   void print(const std::string& dir) const {
-    if (body.empty()) return;
+    if (trunk.empty()) return;
     const auto stats = [](std::vector<double> v) {
       std::sort(v.begin(), v.end());
       double sum = 0.0;
@@ -266,12 +279,17 @@ struct BodyPdrRows {
                     v.front(), v.back());
       return std::string(buf);
     };
+    auto ends = trunk_end;
+    std::sort(ends.begin(), ends.end());
     std::printf(
-        "\n## IPOL healthy gait (%s), lower back: the step-length PDRs at the walker's height "
+        "\n## IPOL healthy gait (%s), lower back: the body-worn PDRs at the walker's height "
         "(walk 10 m, turn, walk back 10 m; the foot PDR measures 20.7 m)\n\n| file | height m | "
-        "`pdr --mount body`: steps, walked m | `pdr --mount phone`: steps, walked m |\n"
-        "|---|---|---|---|\n%s| **mean (min-max)** | | %s | %s |\n",
-        dir.c_str(), rows.c_str(), stats(body).c_str(), stats(handheld).c_str());
+        "`pdr --mount trunk` (pendulum): steps, walked m, end from start m | `--mount body` "
+        "(seed line): steps, walked m | `--mount phone` (walk ratio): steps, walked m |\n"
+        "|---|---|---|---|---|\n%s| **mean (min-max)** | | %s, end median %.2f (90th "
+        "percentile %.2f) | %s | %s |\n",
+        dir.c_str(), rows.c_str(), stats(trunk).c_str(), ends[ends.size() / 2],
+        ends[ends.size() * 9 / 10], stats(body).c_str(), stats(handheld).c_str());
   }
 };
 

@@ -184,6 +184,27 @@ TEST_F(FleetTest, WearableAthleteAppearsAndWalks) {
   EXPECT_EQ(walker.stop(SIGINT), 0);
 }
 
+// A belt sensor's athlete (wearable_node --mount trunk, each step measured from the trunk's rise
+// and fall) reaches the shore over DDS as the trunk pose, walking: the IDL's newest pose value on
+// the real wire.
+TEST_F(FleetTest, TrunkMountedAthleteArrivesAsTheTrunkPose) {
+  Process walker({bin_dir() + "/wearable_node", "--domain", std::to_string(domain_), "--athlete-id",
+                  "bea", "--mount", "trunk", "--height-m", "1.68"});
+  ASSERT_TRUE(walker.wait_for_line("wearable_node ready: ", 20s)) << walker.output();
+  nlohmann::json now;
+  ASSERT_TRUE(eventually(
+      [&] {
+        now = get_json("/api/v1/athletes");
+        return now.is_array() && now.size() == 1 && now[0]["steps"].get<int>() > 4 &&
+               now[0]["distance_m"].is_number() && now[0]["distance_m"].get<double>() > 1.0;
+      },
+      20s))
+      << now.dump();
+  EXPECT_EQ(now[0]["id"], "bea");
+  EXPECT_EQ(now[0]["pose"], "trunk");
+  EXPECT_EQ(walker.stop(SIGINT), 0);
+}
+
 TEST_F(FleetTest, AuthAndOpenEndpoints) {
   auto c = client();
   auto health = c.Get("/healthz");

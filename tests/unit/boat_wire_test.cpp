@@ -112,18 +112,21 @@ TEST(BoatWire, EveryGaitAndPoseAsTheShoreReadsIt) {
     double cadence;
     int gait;
     fusion::PhonePose pose;
-    bool foot;
+    boat::WearableMount mount;
     const char* want_gait;
     const char* want_pose;
   };
   const Case cases[] = {
-      {0.0, 1, fusion::PhonePose::kHandHeld, false, "still", "hand_held"},
-      {90.0, 0, fusion::PhonePose::kCall, false, "slow_walk", "phone_call"},
-      {110.0, 1, fusion::PhonePose::kPocket, false, "walk", "pocket"},
-      {125.0, 2, fusion::PhonePose::kArmSwing, false, "fast_walk", "arm_swing"},
-      {150.0, 3, fusion::PhonePose::kHandHeld, true, "jog", "foot"},
-      {175.0, 4, fusion::PhonePose::kHandHeld, false, "run", "hand_held"},
-      {120.0, 9, fusion::PhonePose::kHandHeld, false, "unknown", "hand_held"},
+      {0.0, 1, fusion::PhonePose::kHandHeld, boat::WearableMount::kCarried, "still", "hand_held"},
+      {90.0, 0, fusion::PhonePose::kCall, boat::WearableMount::kCarried, "slow_walk", "phone_call"},
+      {110.0, 1, fusion::PhonePose::kPocket, boat::WearableMount::kCarried, "walk", "pocket"},
+      {125.0, 2, fusion::PhonePose::kArmSwing, boat::WearableMount::kCarried, "fast_walk",
+       "arm_swing"},
+      {150.0, 3, fusion::PhonePose::kHandHeld, boat::WearableMount::kFoot, "jog", "foot"},
+      {175.0, 4, fusion::PhonePose::kHandHeld, boat::WearableMount::kCarried, "run", "hand_held"},
+      {100.0, 1, fusion::PhonePose::kPocket, boat::WearableMount::kTrunk, "walk", "trunk"},
+      {120.0, 9, fusion::PhonePose::kHandHeld, boat::WearableMount::kCarried, "unknown",
+       "hand_held"},
   };
   for (const Case& c : cases) {
     boat::WearableRecord r;
@@ -137,7 +140,7 @@ TEST(BoatWire, EveryGaitAndPoseAsTheShoreReadsIt) {
     r.pdr.y_m = 40.25;
     r.pdr.heading_deg = 181.5;
     r.pdr.distance_m = 88.0;
-    r.foot = c.foot;
+    r.mount = c.mount;
     msg::WearableMotion m;
     boat::to_wire(r, "ath-1", m);
     const shore::WearableSample w = shore::from_wire(m);

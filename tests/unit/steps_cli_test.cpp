@@ -152,6 +152,52 @@ TEST_F(StepsCli, IpolReadmeRuleLeavesTheUTurnOutOfTheAnnotationsToo) {
 // No simulated walk to score is a usage error, not a table that reads its first element.
 // Seen failing before the check: `steps-eval --loops 0 --tables pdr` ended in a segmentation
 // fault (status -1 here), `--people 0` printed -nan.
+// `pdr --mount trunk` on a simulated belt sensor's walk (gait-sim body-walk): one track row per
+// step and the summary's distance within 12 % of the walk (the simulated person's bounce moves the
+// pendulum's step by up to 10 %: docs/pdr.md); a personal step scale is refused (a trunk measures
+// its steps), and so is a mount the command does not know.
+TEST_F(StepsCli, TrunkMountMeasuresTheWalk) {
+  ASSERT_EQ(run("gait-sim body-walk --seed 3 --out " + path("belt.csv") + " --truth " +
+                path("belt_truth.csv")),
+            0)
+      << read("err.txt");
+  ASSERT_EQ(run("pdr --in " + path("belt.csv") + " --mount trunk --height-m 1.75 --out " +
+                path("belt_track.csv")),
+            0)
+      << read("err.txt");
+  const std::string out = read("out.txt");
+  const auto at = out.find("\"distance_m\": ");
+  ASSERT_NE(at, std::string::npos) << out;
+  const double distance = std::strtod(out.c_str() + at + 14, nullptr);
+  // The truth's last row: t_s,x_m,y_m,heading_deg,distance_m,...
+  std::ifstream truth(path("belt_truth.csv"));
+  std::string line, last;
+  while (std::getline(truth, line))
+    if (!line.empty()) last = line;
+  std::vector<double> cols;
+  for (std::size_t a = 0; a <= last.size();) {
+    const std::size_t b = std::min(last.find(',', a), last.size());
+    cols.push_back(std::strtod(last.substr(a, b - a).c_str(), nullptr));
+    a = b + 1;
+  }
+  ASSERT_GE(cols.size(), 5u) << last;
+  EXPECT_NEAR(distance, cols[4], 0.12 * cols[4]) << out;
+  std::ifstream track(path("belt_track.csv"));
+  std::size_t rows = 0;
+  while (std::getline(track, line)) rows += line.empty() ? 0u : 1u;
+  EXPECT_GT(rows, 50u);
+  EXPECT_NE(run("pdr --in " + path("belt.csv") +
+                " --mount trunk --height-m 1.75 --step-scale 1.1 "
+                "--out " +
+                path("x.csv")),
+            0);
+  EXPECT_NE(read("err.txt").find("step-scale"), std::string::npos) << read("err.txt");
+  EXPECT_NE(
+      run("pdr --in " + path("belt.csv") + " --mount belly --height-m 1.75 --out " + path("x.csv")),
+      0);
+  EXPECT_NE(read("err.txt").find("trunk"), std::string::npos) << read("err.txt");
+}
+
 TEST_F(StepsCli, EvalRefusesNoSimulatedWalks) {
   for (const char* args :
        {"--loops 0 --tables pdr", "--loops -3 --tables ipin", "--people 0 --tables gait"}) {

@@ -12,6 +12,7 @@
 #include "telltale/fusion/pdr.hpp"
 #include "telltale/fusion/sim/gait_sim.hpp"
 #include "telltale/fusion/steps.hpp"
+#include "telltale/fusion/trunk_pdr.hpp"
 
 namespace telltale::fusion {
 namespace {
@@ -29,13 +30,15 @@ TEST(NoHeap, StepDetectorsAndPdrUpdateWithoutAllocation) {
     auto pdr = std::make_unique<Pdr>();
     auto foot_pdr = std::make_unique<FootPdr>();
     auto handheld = std::make_unique<HandheldPdr>();
+    auto trunk = std::make_unique<TrunkPdr>();
     StepEvent ev;
-    std::size_t steps = 0, handheld_steps = 0, foot_steps = 0;
+    std::size_t steps = 0, handheld_steps = 0, foot_steps = 0, trunk_steps = 0;
     const std::size_t n = allocations_in([&] {
       for (const auto& s : run.samples) {
         for (auto& d : detectors) steps += d->update(s.imu, ev) ? 1u : 0u;
         steps += pdr->update(s.imu, s.mag_uT).step ? 1u : 0u;
         foot_steps += foot_pdr->update(s.imu, s.mag_uT).step ? 1u : 0u;
+        trunk_steps += trunk->update(s.imu, s.mag_uT).step ? 1u : 0u;
         handheld_steps += static_cast<std::size_t>(handheld->update(s.imu, s.mag_uT));
       }
     });
@@ -46,6 +49,7 @@ TEST(NoHeap, StepDetectorsAndPdrUpdateWithoutAllocation) {
     // of the time, the foot scenario's strides are FootPdr's.
     if (mount == StepMount::kBody) {
       EXPECT_GT(handheld_steps, 20u) << scenario;
+      EXPECT_GT(trunk_steps, 20u) << scenario;
     } else {
       EXPECT_GT(foot_steps, 100u) << scenario;
     }

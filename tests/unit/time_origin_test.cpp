@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,7 @@
 #include "telltale/fusion/sim/gait_sim.hpp"
 #include "telltale/fusion/sim/phone_walk.hpp"
 #include "telltale/fusion/steps.hpp"
+#include "telltale/fusion/trunk_pdr.hpp"
 
 namespace telltale::fusion {
 namespace {
@@ -113,21 +115,24 @@ TEST(TimeOrigin, HandheldPdrOnSimulatedPhoneWalks) {
   }
 }
 
-// The foot's and the four-pose PDR's step counts and distances, the same way.
-TEST(TimeOrigin, FootAndPosePdr) {
+// The foot's, the trunk's and the four-pose PDR's step counts and distances, the same way.
+TEST(TimeOrigin, FootTrunkAndPosePdr) {
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
-    for (const std::string scenario : {"foot-mixed", "loop"}) {
+    for (const std::string scenario : {"foot-mixed", "body-mixed", "loop"}) {
       const auto run = sim::simulate_gait(*sim::make_gait_scenario(scenario, seed),
                                           sim::random_person(seed), seed);
       PdrOutput out[2];
       for (int k = 0; k < 2; ++k) {
         FootPdr foot;
+        auto trunk = std::make_unique<TrunkPdr>();
         Pdr pose;
         const double offset = k == 0 ? 0.0 : kUnixOffset_s;
         for (const auto& g : run.samples) {
           ImuSample s = g.imu;
           s.t_s += offset;
-          out[k] = scenario == "loop" ? pose.update(s, g.mag_uT) : foot.update(s, g.mag_uT);
+          out[k] = scenario == "loop"         ? pose.update(s, g.mag_uT)
+                   : scenario == "body-mixed" ? trunk->update(s, g.mag_uT)
+                                              : foot.update(s, g.mag_uT);
         }
       }
       EXPECT_EQ(out[0].steps, out[1].steps) << scenario << " seed " << seed;
