@@ -78,10 +78,14 @@ const PdrOutput& TrunkPdr::update(const ImuSample& raw, const Eigen::Vector3d& m
   const double dt = have_t_ ? s.t_s - last_t_s_ : 0.0;
   have_t_ = true;
   last_t_s_ = s.t_s;
-  // The yaw: the bias-corrected rate about the vertical (the filter's, which also learns the
-  // bias at rest), integrated. Not over a gap the gate flagged (nothing is known of it).
+  // The yaw: the rate about the vertical, integrated, with the bias the stands measured
+  // (SensorPrep), not the attitude filter's. A bias about the vertical moves no vertical, so in
+  // motion the filter learns it only through the sensor's tilt off the vertical, from the
+  // low-pass's noise: on a lower back that never stood still (IPOL 4-4) its estimate on the
+  // near-vertical axis ran to 7 deg/s, and the track turned 20-40 deg too far in a U-turn (end
+  // 5.3 m from the start, 1.7 m with the stands' bias). Not over a gap the gate flagged.
   if (dt > 0.0 && dt <= params_.attitude.max_gap_s)
-    yaw_rad_ = std::remainder(yaw_rad_ + attitude_.state().rate_rad_s.dot(up) * dt, 2.0 * M_PI);
+    yaw_rad_ = std::remainder(yaw_rad_ + s.gyro_body_rad_s.dot(up) * dt, 2.0 * M_PI);
   motion_.add(s.t_s, s.acc_body_m_s2.dot(up), yaw_rad_);
   // North, before the first step: the magnetometer's heading of the x axis plus the yaw.
   if (!oriented_ && mag.allFinite()) {

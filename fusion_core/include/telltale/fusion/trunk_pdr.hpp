@@ -6,7 +6,8 @@
 /// Pipeline per sample (TrunkPdr::update): gyro bias learnt while standing and hard-iron offset
 /// (SensorPrep) -> the vertical from the production attitude filter (TelltaleAttitudeFilter: a
 /// walk's accelerations average out in its frame I, the trunk's sway is a rotation the gyro
-/// sees) -> the specific force along it and the yaw (the rate about it, integrated) kept for the
+/// sees) -> the specific force along it and the yaw (the rate about it, less the bias the
+/// stands measured, integrated) kept for the
 /// last seconds (TrunkMotion) -> steps counted by the gait-phase detector on the body (one per
 /// heel strike) -> each step measured from the trunk's rise and fall over it, the inverted
 /// pendulum (trunk_motion.hpp), and laid along the trunk's mean yaw over it.
