@@ -249,8 +249,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       handheld_out.steps = h.steps;
       handheld_out.step_hz = phone_pdr->walking() ? h.step_hz : 0.0;
       handheld_out.cadence_spm = 60.0 * handheld_out.step_hz;
-      const double f = handheld_out.step_hz;  // the same cadence classes as Pdr
-      handheld_out.gait = f < 1.6 ? 0 : f < 1.95 ? 1 : f < 2.35 ? 2 : f < 2.75 ? 3 : 4;
+      handheld_out.gait = fusion::gait_of_step_hz(handheld_out.step_hz);
       handheld_out.pose = fusion::PhonePose::kHandHeld;
       handheld_out.x_m = h.x_m;
       handheld_out.y_m = h.y_m;

@@ -69,12 +69,7 @@ const PdrOutput& FootPdr::update(const ImuSample& raw, const Eigen::Vector3d& ma
   if (steps_.update(s, ev)) {
     cadence_.at_step(ev.t_s, kStepsPerStride, true);
     out_.steps += static_cast<std::size_t>(kStepsPerStride);
-    if (cadence_.interval_s() > 0.0) {
-      out_.step_hz = 1.0 / cadence_.interval_s();
-      out_.cadence_spm = 60.0 * out_.step_hz;
-    }
-    const double f = out_.step_hz;
-    out_.gait = f < 1.6 ? 0 : f < 1.95 ? 1 : f < 2.35 ? 2 : f < 2.75 ? 3 : 4;
+    set_cadence(out_, cadence_.interval_s());
     out_.step = true;
   }
   return out_;

@@ -119,13 +119,7 @@ const StepDiagnostics& Pdr::step_diagnostics() const { return phone_steps_.diagn
 void Pdr::count_steps(const ClockStep& step) {
   diag_.filled_steps += static_cast<unsigned>(step.extra);
   out_.steps += static_cast<std::size_t>(step.extra) + 1;
-  const double interval_s = clock_.cadence().interval_s();
-  if (interval_s > 0.0) {
-    out_.step_hz = 1.0 / interval_s;
-    out_.cadence_spm = 60.0 * out_.step_hz;
-  }
-  const double f = out_.step_hz;
-  out_.gait = f < 1.6 ? 0 : f < 1.95 ? 1 : f < 2.35 ? 2 : f < 2.75 ? 3 : 4;
+  set_cadence(out_, clock_.cadence().interval_s());
 }
 
 void Pdr::detect_switch(double t_prev, double t_s,

@@ -34,12 +34,8 @@ void TrunkPdr::on_step(double t_s) {
   ++out_.steps;
   out_.step = true;
   cadence_.at_step(t_s, 1.0, true);
-  if (cadence_.interval_s() > 0.0) {
-    out_.step_hz = 1.0 / cadence_.interval_s();
-    out_.cadence_spm = 60.0 * out_.step_hz;
-  }
+  set_cadence(out_, cadence_.interval_s());
   const double f = out_.step_hz;
-  out_.gait = f < 1.6 ? 0 : f < 1.95 ? 1 : f < 2.35 ? 2 : f < 2.75 ? 3 : 4;
   const double prev = last_step_t_s_;
   last_step_t_s_ = t_s;
   if (prev < 0.0 || t_s - prev > params_.max_step_s) {

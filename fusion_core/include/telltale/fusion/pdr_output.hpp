@@ -26,4 +26,19 @@ struct PdrOutput {
   bool step = false;       ///< a step completed at this sample
 };
 
+/// The coarse gait of a step frequency (Hz): 0 slow walk, 1 walk, 2 fast walk, 3 jog, 4 run.
+[[nodiscard]] inline int gait_of_step_hz(double f) {
+  return f < 1.6 ? 0 : f < 1.95 ? 1 : f < 2.35 ? 2 : f < 2.75 ? 3 : 4;
+}
+
+/// A step's cadence into `out`: the step frequency and cadence from the step interval when one
+/// is known (> 0; else the last are kept), and the gait they make.
+inline void set_cadence(PdrOutput& out, double interval_s) {
+  if (interval_s > 0.0) {
+    out.step_hz = 1.0 / interval_s;
+    out.cadence_spm = 60.0 * out.step_hz;
+  }
+  out.gait = gait_of_step_hz(out.step_hz);
+}
+
 }  // namespace telltale::fusion
