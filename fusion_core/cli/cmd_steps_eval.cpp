@@ -232,8 +232,8 @@ struct FootPdrRows {
 
 /// The PDRs that can carry a body-worn sensor, on the IPOL lower-back files at each walker's
 /// own height: the only real walks of a known length with one (10 m, a turn, 10 m back: the
-/// foot's own navigation measures 20.7 m on the same trials). `pdr --mount trunk` (TrunkPdr)
-/// measures each step by the inverted pendulum; `--mount body` (the seed-003 Pdr) and
+/// foot's own navigation measures 20.7 m on the same trials, its table above). `pdr --mount trunk`
+/// (TrunkPdr) measures each step by the inverted pendulum; `--mount body` (the seed-003 Pdr) and
 /// `--mount phone` (HandheldPdr) lay a length from height and cadence (a lower back is neither's
 /// mount: a phone on a belt is the nearest). The trunk's track also ends where it began.
 struct BodyPdrRows {
@@ -283,7 +283,8 @@ struct BodyPdrRows {
     std::sort(ends.begin(), ends.end());
     std::printf(
         "\n## IPOL healthy gait (%s), lower back: the body-worn PDRs at the walker's height "
-        "(walk 10 m, turn, walk back 10 m; the foot PDR measures 20.7 m)\n\n| file | height m | "
+        "(walk 10 m, turn, walk back 10 m; the foot PDR's table measures the same trials)\n\n| "
+        "file | height m | "
         "`pdr --mount trunk` (pendulum): steps, walked m, end from start m | `--mount body` "
         "(seed line): steps, walked m | `--mount phone` (walk ratio): steps, walked m |\n"
         "|---|---|---|---|---|\n%s| **mean (min-max)** | | %s, end median %.2f (90th "

@@ -6,11 +6,11 @@
 /// Pipeline per sample (TrunkPdr::update): gyro bias learnt while standing and hard-iron offset
 /// (SensorPrep) -> the vertical from the production attitude filter (TelltaleAttitudeFilter: a
 /// walk's accelerations average out in its frame I, the trunk's sway is a rotation the gyro
-/// sees) -> the specific force along it and the yaw (the rate about it, less the bias the
-/// stands measured, integrated) kept for the
-/// last seconds (TrunkMotion) -> steps counted by the gait-phase detector on the body (one per
-/// heel strike) -> each step measured from the trunk's rise and fall over it, the inverted
-/// pendulum (trunk_motion.hpp), and laid along the trunk's mean yaw over it.
+/// sees) -> the specific force along it and the yaw (the rate about it less the bias the stands
+/// measured, integrated) kept for the last seconds (TrunkMotion) -> steps counted by the
+/// gait-phase detector on the body (one per heel strike) -> each step measured from the trunk's
+/// rise and fall over it, the inverted pendulum (trunk_motion.hpp), and laid along the trunk's
+/// mean yaw over it.
 ///
 /// Why not a step model: the height-and-cadence laws (the seed's line of `--mount body`, the
 /// walk ratio of `--mount phone`) are a population's; on the IPOL lower-back walks of four
@@ -23,8 +23,8 @@
 /// direction. A step whose excursion is no pendulum's (a jump, the sensor handled) is laid at
 /// the walk's last measured length (the walk ratio when there is none).
 /// North: the magnetometer gives the sensor's x axis a heading over the samples before the
-/// first step; without one, or with x near vertical, the track's north is the direction of the
-/// trunk's yaw at the start (the track is right up to one rotation). Frames and units as Pdr:
+/// first step is laid; without one, or with x near vertical, the track's north is the direction of
+/// the trunk's yaw at the start (the track is right up to one rotation). Frames and units as Pdr:
 /// x east, y north (m) from the start; heading clockwise from north. The gyro is required.
 ///
 /// Memory: fixed-size members, no heap in update().
