@@ -38,11 +38,11 @@ struct WindRecord {
 /// BoatWind (telltale_boat_wind) of run `run`.
 void to_wire(const WindRecord& r, const std::string& boat_id, std::uint64_t run, msg::BoatWind& m);
 
-/// What a wearable publishes of its dead reckoning; `foot` for a foot-mounted IMU (pose FOOT).
 /// Where the wearable's sensor sits: a phone carried in any pose (the classifier's pose goes on
-/// the wire), or strapped to the foot or the trunk (that is the pose).
+/// the wire), or strapped to the foot or the trunk (that is the pose: FOOT, TRUNK).
 enum class WearableMount { kCarried, kFoot, kTrunk };
 
+/// What a wearable publishes of its dead reckoning, and where its sensor sits.
 struct WearableRecord {
   std::uint64_t seq = 0;
   std::uint64_t t_utc_ns = 0;

@@ -122,7 +122,6 @@ void run_pdr(const PdrOptions& o) {
     return;
   }
   if (o.mount == "trunk") {
-    if (o.step_scale != 1.0) throw UsageError("--step-scale is for step models: a trunk measures");
     fusion::TrunkPdrParams params;  // each step measured by the pendulum: no step scale
     params.height_m = o.height_m;
     auto pdr = std::make_unique<fusion::TrunkPdr>(params);  // 50 kB of rings: not on the stack
@@ -161,7 +160,8 @@ void register_pdr(CLI::App& app) {
                   "003 | foot: each stride measured by the foot's inertial navigation, reset at "
                   "every stance (height and step scale unused; a gyro is required) | trunk: a "
                   "belt or lower-back sensor, each step measured from the trunk's rise and fall "
-                  "(the inverted pendulum on a leg of 0.53 x height; a gyro is required)")
+                  "(the inverted pendulum on a leg of 0.53 x height; step scale unused; a gyro is "
+                  "required)")
       ->capture_default_str();
   cmd->callback([opts] { run_pdr(*opts); });
 }
