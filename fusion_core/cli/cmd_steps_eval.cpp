@@ -125,6 +125,8 @@ std::string find_oxford(const EvalOptions& o) {
 }
 
 // --- IPOL healthy-gait trials (data/ipol_gait/README.md) --------------------------------------
+/// The trials' JSON files are read by hand, not by a JSON library: they write NaN for a missing
+/// value ("Weight": NaN), which JSON does not allow and a strict parser refuses whole.
 /// The integers of the JSON array that follows `"key":` (nested arrays flattened), or empty.
 std::vector<long> json_ints(const std::string& text, const std::string& key) {
   std::vector<long> out;
@@ -239,8 +241,9 @@ struct FootPdrRows {
 struct BodyPdrRows {
   std::string rows;
   std::vector<double> trunk, trunk_end, body, handheld;
-  void add(const std::string& file, const std::vector<ImuRecord>& records, double height_m) {
-    if (!(height_m > 0.5 && height_m < 2.5)) return;
+  /// `handheld_steps`: the hand-held PDR's steps on these records at height_m (the step table's).
+  void add(const std::string& file, const std::vector<ImuRecord>& records, double height_m,
+           const std::vector<fusion::HandheldStep>& handheld_steps) {
     fusion::TrunkPdrParams tp;
     tp.height_m = height_m;
     auto tr = std::make_unique<fusion::TrunkPdr>(tp);
@@ -251,9 +254,7 @@ struct BodyPdrRows {
       (void)tr->update(r.imu, r.mag_uT);
       (void)pdr->update(r.imu, r.mag_uT);
     }
-    fusion::HandheldPdrParams hp;
-    hp.height_m = height_m;
-    const auto walk = run_handheld_walk(records, hp).steps;
+    const auto& walk = handheld_steps;
     const double held = walk.empty() ? 0.0 : walk.back().distance_m;
     const std::size_t held_steps = walk.empty() ? 0 : walk.back().steps;
     const auto& t = tr->output();
@@ -429,8 +430,9 @@ void ipol_table(const EvalOptions& o, bool foot) {
           both_feet += static_cast<std::size_t>(std::count_if(feet->begin(), feet->end(), outside));
         foot_pdr.add(t.name + "_" + side, records, both_feet);
       } else {
+        // The walker's own height (it sets the step's length, not the count; 1.75 m unknown).
         fusion::HandheldPdrParams params;
-        params.height_m = 1.75;
+        if (t.height_m > 0.5 && t.height_m < 2.5) params.height_m = t.height_m;
         const auto track = run_handheld_walk(records, params).steps;
         const auto n = static_cast<std::size_t>(std::count_if(
             track.begin(), track.end(), [&](const auto& st) { return outside(st.t_s); }));
@@ -439,7 +441,7 @@ void ipol_table(const EvalOptions& o, bool foot) {
         sum_all.back() += b;
         worst.back() = std::min(worst.back(), a);
         std::printf(" %zu (%.0f / %.0f) |", n, 100.0 * a, 100.0 * b);
-        body_pdr.add(t.name + "_" + side, records, t.height_m);
+        body_pdr.add(t.name + "_" + side, records, params.height_m, track);
       }
       std::printf("\n");
     }
