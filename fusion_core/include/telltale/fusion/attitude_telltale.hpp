@@ -5,7 +5,8 @@
 /// inertial on average) and builds it from the physics, after Laidig & Seel's VQF (2023):
 ///   - strapdown: the gyro (minus the estimated bias) is integrated as a quaternion into an
 ///     almost-inertial frame I; each sample is the mean rate over the interval that ends at it
-///     (a MEMS decimation filter);
+///     (a MEMS decimation filter), with the two-sample coning term; the accelerometer's sample
+///     is rotated into I at the orientation of the instant it describes (mid-interval);
 ///   - the specific force is rotated into I and low-passed THERE by a 2nd-order Butterworth of
 ///     time constant tau_acc_s. In an earth-fixed frame the mean of the acceleration of any
 ///     bounded motion over T is dv / T -> 0, so waves, a pendulum's swing, a hand's shake and a
@@ -152,6 +153,9 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
   struct State {
     Eigen::Quaterniond q_gyro = Eigen::Quaterniond::Identity();  ///< body -> inertial frame I
     Eigen::Vector3d bias_rad_s = Eigen::Vector3d::Zero();        ///< gyro bias, body
+    /// The rotation increment of the last update (rad, body; 0 after a gap): the coning term's
+    /// other half (update).
+    Eigen::Vector3d dtheta_prev_rad = Eigen::Vector3d::Zero();
     /// The gyro's common scale error (Params::gyro_scale_sigma_init): rate = (1 + k)(gyro - bias).
     double gyro_scale = 0.0;
     /// The covariance of (bias, scale), one Kalman filter on 4 states: the bias's 3x3 block in
