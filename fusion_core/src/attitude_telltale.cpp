@@ -428,18 +428,13 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // filter, close to the mean rate over the interval that ends at the sample: integrate it over
   // that interval. Over a gap nothing is known about the rotation: not integrated, and the
   // low-pass restarts below (the old vertical in I means nothing any more).
-  // The interval's rotation vector is its increment plus the coning term (the two-sample
-  // algorithm of strapdown navigation): where the rotation's axis itself turns (a hand tumbling
-  // the sensor, a hull rolling while it yaws), rotations about different axes do not commute,
-  // and the increment alone misses (1/12) dtheta_prev x dtheta per interval (the rate taken as
-  // linear in time across the two intervals). It does not average out: a coning motion makes the
-  // same error each interval. At 25 Hz it matters (BROAD resampled to 25 Hz: mean inclination
-  // error 1.69 -> 1.35 deg); at 100 Hz and above it is a few hundredths of a degree.
+  // With the two-sample coning term (coned_rotation_vector says why): BROAD resampled to
+  // 25 Hz, mean inclination error 1.69 -> 1.35 deg; at 100 Hz and above a few hundredths.
   const Eigen::Vector3d gyro_less_bias = s.gyro_body_rad_s - st.bias_rad_s;
   const Eigen::Vector3d gyro = (1.0 + st.gyro_scale) * gyro_less_bias;
   const Eigen::Vector3d dtheta = gyro * dt;
   if (!gap) {
-    st.q_gyro = rotate_by(st.q_gyro, dtheta + (1.0 / 12.0) * st.dtheta_prev_rad.cross(dtheta));
+    st.q_gyro = rotate_by(st.q_gyro, coned_rotation_vector(st.dtheta_prev_rad, dtheta));
     st.dtheta_prev_rad = dtheta;
   } else {
     st.dtheta_prev_rad.setZero();  // nothing is known of the rotation over a gap
@@ -594,19 +589,10 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   if (start_ends) end_start_fit(st, r, c.b0, c.a2, tau, p.g_m_s2);
   if (gap) st.lp_running = false;
   Eigen::Matrix<double, 3, 6> x;
-  // The accelerometer's sample is, like the gyro's, its sensor's reading over the interval
-  // that ends at it: it describes the orientation half an interval before r, which the gyro's
-  // increment carried to the interval's end. (For point samples the same holds: the rectangle
-  // rule carries r half an interval past the rate's instant; and a decimation filter that delays
-  // both sensors alike moves both instants, not the half interval between them.) Rotated with
-  // r, a rotation at w tilts the specific force by w dt / 2 toward the turn, the same way on
-  // every sample of a one-way rotation, so the low-pass keeps it: 4 deg at 200 deg/s at 25 Hz.
-  // So the force is seen at r Rot(-a), a = dtheta / 2, to second order in a:
-  // f + f x a + (a x (a x f)) / 2. BROAD resampled to 25 Hz, with the coning term: mean
+  // The specific force seen at the instant it describes, half an interval before r
+  // (force_at_its_instant says why): BROAD resampled to 25 Hz, with the coning term, mean
   // inclination error 1.35 -> 0.98 deg (docs/attitude.md has every rate).
-  const Eigen::Vector3d a_half = gap ? Eigen::Vector3d::Zero() : Eigen::Vector3d(0.5 * dtheta);
-  const Eigen::Vector3d fa = f.cross(a_half);
-  const Eigen::Vector3d f_seen = f + fa - 0.5 * a_half.cross(fa);
+  const Eigen::Vector3d f_seen = gap ? f : force_at_its_instant(f, dtheta);
   // (Written out: as Eigen assignments GCC left the block copy and the products out-of-line
   // calls once the update had grown by the lines above, +55 instructions per update.)
   const Eigen::Vector3d& b = st.bias_rad_s;

@@ -22,11 +22,17 @@ bool FootIns::update(const ImuSample& s, double dt_s) {
     if (!stance_ && !waiting_) ++dropped_;
     waiting_ = true;
     still_s_ = 0.0;
+    dtheta_prev_rad_.setZero();
     return false;
   }
   // The sample's rate over the interval that ends at it (a MEMS gyro's sample is close to the
-  // mean rate over it), as a rotation of exact angle.
-  q_ = (q_ * interval_rotation(w, w, dt_s)).normalized();
+  // mean rate over it) with the coning term, as a rotation of exact angle.
+  const Eigen::Vector3d dtheta = w * dt_s;
+  const Eigen::Vector3d phi = coned_rotation_vector(dtheta_prev_rad_, dtheta);
+  dtheta_prev_rad_ = dtheta;
+  const double angle = phi.norm();
+  if (angle > 1e-12)
+    q_ = (q_ * Eigen::Quaterniond(Eigen::AngleAxisd(angle, phi / angle))).normalized();
 
   const bool still = w.norm() < params_.stance_gyro_rad_s &&
                      std::abs(f.norm() - g_m_s2_) < params_.stance_acc_m_s2;
@@ -51,7 +57,8 @@ bool FootIns::update(const ImuSample& s, double dt_s) {
     swing_s_ = 0.0;
   }
   // Swing: navigate. The specific force in the world less gravity is the acceleration.
-  const Eigen::Vector3d a = q_ * f - Eigen::Vector3d(0.0, 0.0, g_m_s2_);
+  const Eigen::Vector3d a =
+      q_ * force_at_its_instant(f, dtheta) - Eigen::Vector3d(0.0, 0.0, g_m_s2_);
   v_ += a * dt_s;
   p_ += v_ * dt_s;
   swing_s_ += dt_s;

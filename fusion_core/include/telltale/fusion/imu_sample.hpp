@@ -139,4 +139,33 @@ struct ImuGateResult {
   return Eigen::Quaterniond(Eigen::AngleAxisd(angle, theta / angle));
 }
 
+/// Two rules of a strapdown integration that follow from how a sample is made (each sample the
+/// sensor's reading over the interval that ends at it), shared by the attitude filter and the
+/// foot's inertial navigation (docs/attitude.md, the rate table):
+///
+/// The interval's rotation vector from its gyro increment `dtheta` (rate x dt) and the previous
+/// interval's: where the rotation's axis itself turns, increments about different axes do not
+/// commute, and the increment alone misses (1/12) dtheta_prev x dtheta (the two-sample coning
+/// term, the rate taken as linear across the two intervals). A coning motion makes that error on
+/// every interval, in the same sense: it accumulates. Pass zero as `dtheta_prev` after a gap.
+[[nodiscard]] inline Eigen::Vector3d coned_rotation_vector(const Eigen::Vector3d& dtheta_prev,
+                                                           const Eigen::Vector3d& dtheta) {
+  return dtheta + (1.0 / 12.0) * dtheta_prev.cross(dtheta);
+}
+
+/// The specific force `f` (body frame) as seen from the attitude at the interval's end, which
+/// the gyro's increment `dtheta` has carried the attitude to, turned to the instant the sample
+/// describes: half an interval earlier (for point samples too: the rectangle rule carries the
+/// attitude half an interval past the rate's instant; a filter delaying both sensors alike moves
+/// both instants, not the half interval between them). So R_end * result is the force in the
+/// reference frame. Uncorrected, a one-way rotation at w tilts the force by w dt / 2 on every
+/// sample, 4 deg at 200 deg/s at 25 Hz. The half rotation a = dtheta / 2 to second order:
+/// Rot(-a) f = f + f x a + (a x (a x f)) / 2.
+[[nodiscard]] inline Eigen::Vector3d force_at_its_instant(const Eigen::Vector3d& f,
+                                                          const Eigen::Vector3d& dtheta) {
+  const Eigen::Vector3d a = 0.5 * dtheta;
+  const Eigen::Vector3d fa = f.cross(a);
+  return f + fa - 0.5 * a.cross(fa);
+}
+
 }  // namespace telltale::fusion
