@@ -160,7 +160,9 @@ struct ImuGateResult {
 /// both instants, not the half interval between them). So R_end * result is the force in the
 /// reference frame. Uncorrected, a one-way rotation at w tilts the force by w dt / 2 on every
 /// sample, 4 deg at 200 deg/s at 25 Hz. The half rotation a = dtheta / 2 to second order:
-/// Rot(-a) f = f + f x a + (a x (a x f)) / 2.
+/// Rot(-a) f = f + f x a + (a x (a x f)) / 2. (interval_rotation's trapezoidal rate makes the
+/// same half-interval correction on the attitude instead, so that it refers to the samples' own
+/// instants; the hard-iron fit and the four-pose PDR's up direction pair it with point readings.)
 [[nodiscard]] inline Eigen::Vector3d force_at_its_instant(const Eigen::Vector3d& f,
                                                           const Eigen::Vector3d& dtheta) {
   const Eigen::Vector3d a = 0.5 * dtheta;
