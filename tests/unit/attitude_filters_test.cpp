@@ -1,7 +1,9 @@
 // Shared helpers, the registry, and the contract every attitude filter keeps (NaN, time).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 #include <vector>
@@ -233,6 +235,75 @@ TEST(ImuGate, EveryFilterAndDetectorCountsTheSame) {
   }
   check(pdr.diagnostics(), "pdr");
   check(handheld.diagnostics(), "handheld");
+}
+
+// The strapdown's two rules (imu_sample.hpp) on a motion with a closed form. Coning: the body's
+// attitude q(t) = (cos a/2, sin a/2 cos Wt, sin a/2 sin Wt, 0), its z axis circling at a = 10 deg
+// off the reference's once a second; each sample is the body rate's exact mean over the interval
+// that ends at it (midpoint sums, 200 per interval). Integrated at 25 Hz for 60 s, the increments
+// alone drift from the truth (the commuting error of a rotation whose axis turns, the same every
+// interval); with the coning term the attitude stays near it. Measured: 3.42 deg off without the
+// term, 0.045 deg with it (what is left is the two-sample algorithm's own, at 0.25 rad of cone
+// per sample). And the force seen at its instant: a body turning at 1 rad/s about z, reading a
+// world-fixed force as the mean over each interval, seen from the attitude at the interval's end,
+// lands on the world's force within 2e-5 of its size (the mean's own shrinking), where turned
+// at the end it is 6e-3 off (dt / 2 of turn). Seen failing with either helper returning its
+// input unchanged.
+TEST(Strapdown, TheConingTermAndTheForceAtItsInstantFollowTheirMotions) {
+  constexpr double kA = 10.0 * kDeg, kW = 2.0 * M_PI, kDt = 0.04;
+  const auto truth = [](double t) {
+    return Eigen::Quaterniond(std::cos(kA / 2), std::sin(kA / 2) * std::cos(kW * t),
+                              std::sin(kA / 2) * std::sin(kW * t), 0.0);
+  };
+  const auto rate = [&truth](double t) {  // body rate: 2 vec(q* dq/dt)
+    const Eigen::Quaterniond dq(0.0, -kW * std::sin(kA / 2) * std::sin(kW * t),
+                                kW * std::sin(kA / 2) * std::cos(kW * t), 0.0);
+    const Eigen::Quaterniond w = truth(t).conjugate() * dq;
+    return Eigen::Vector3d(2.0 * w.vec());
+  };
+  constexpr int kSub = 200;
+  Eigen::Quaterniond plain = truth(0.0), coned = truth(0.0);
+  Eigen::Vector3d prev = Eigen::Vector3d::Zero();
+  const auto turn = [](Eigen::Quaterniond& q, const Eigen::Vector3d& phi) {
+    q = (q * Eigen::Quaterniond(Eigen::AngleAxisd(phi.norm(), phi.normalized()))).normalized();
+  };
+  const int n = static_cast<int>(60.0 / kDt);
+  for (int i = 1; i <= n; ++i) {
+    Eigen::Vector3d dtheta = Eigen::Vector3d::Zero();
+    for (int k = 0; k < kSub; ++k) dtheta += rate((i - 1 + (k + 0.5) / kSub) * kDt) * (kDt / kSub);
+    turn(plain, dtheta);
+    turn(coned, coned_rotation_vector(i == 1 ? Eigen::Vector3d::Zero() : prev, dtheta));
+    prev = dtheta;
+  }
+  const Eigen::Quaterniond end = truth(n * kDt);
+  const double plain_deg = plain.angularDistance(end) / kDeg;
+  const double coned_deg = coned.angularDistance(end) / kDeg;
+  std::printf("  after 60 s: %.3f deg without the coning term, %.4f deg with it\n", plain_deg,
+              coned_deg);
+  EXPECT_GT(plain_deg, 1.0);
+  EXPECT_LT(coned_deg, 0.1);
+
+  // The force at its instant: f_world fixed, the body turning at 1 rad/s about z.
+  const Eigen::Vector3d f_world(3.0, -1.0, kG);
+  const double w = 1.0;
+  double worst_seen = 0.0, worst_end = 0.0;
+  for (int i = 1; i <= 50; ++i) {
+    const double t1 = i * kDt;
+    Eigen::Vector3d f_mean = Eigen::Vector3d::Zero();  // the body's reading, its interval's mean
+    for (int k = 0; k < kSub; ++k) {
+      const double t = t1 - kDt + (k + 0.5) * kDt / kSub;
+      f_mean += Eigen::AngleAxisd(-w * t, Eigen::Vector3d::UnitZ()) * f_world / kSub;
+    }
+    const Eigen::Matrix3d r_end = Eigen::AngleAxisd(w * t1, Eigen::Vector3d::UnitZ()).matrix();
+    const Eigen::Vector3d seen =
+        r_end * force_at_its_instant(f_mean, Eigen::Vector3d(0, 0, w * kDt));
+    worst_seen = std::max(worst_seen, (seen - f_world).norm() / f_world.norm());
+    worst_end = std::max(worst_end, (r_end * f_mean - f_world).norm() / f_world.norm());
+  }
+  std::printf("  force: %.2e of its size seen at its instant, %.2e at the interval's end\n",
+              worst_seen, worst_end);
+  EXPECT_LT(worst_seen, 1e-4);
+  EXPECT_GT(worst_end, 3e-3);
 }
 
 TEST(GyroAttitudeFilter, IntegratesARollRateAndCountsRejections) {
