@@ -272,12 +272,9 @@ void Pdr::relay_switch_steps(std::optional<double> heading_after, PhonePose pose
 }
 
 const PdrOutput& Pdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT) {
-  out_.step = false;
   ImuSample s;
   Eigen::Vector3d mag;
-  if (!sensors_.prepare(raw, mag_uT, diag_, s, mag)) return out_;
-  diag_.still_windows = sensors_.still_windows();
-  out_.t_s = raw.t_s;  // the caller's clock; the stages run on s.t_s, the local one
+  if (!sensors_.arrive(raw, mag_uT, diag_, out_, s, mag)) return out_;
   pose_.push(s);
   recent_.push(s);
   // Into the walking frame of the pose in force (eqs. (14)-(15)).

@@ -62,12 +62,9 @@ void TrunkPdr::on_step(double t_s) {
 }
 
 const PdrOutput& TrunkPdr::update(const ImuSample& raw, const Eigen::Vector3d& mag_uT) {
-  out_.step = false;
   ImuSample s;
   Eigen::Vector3d mag;
-  if (!sensors_.prepare(raw, mag_uT, diag_, s, mag)) return out_;
-  diag_.still_windows = sensors_.still_windows();
-  out_.t_s = raw.t_s;  // the caller's clock; the stages run on s.t_s, the local one
+  if (!sensors_.arrive(raw, mag_uT, diag_, out_, s, mag)) return out_;
   if (!s.gyro_body_rad_s.allFinite()) return out_;  // no gyro: no vertical, no heading
   attitude_.update(s);
   const Eigen::Vector3d& up = attitude_.state().up_body;

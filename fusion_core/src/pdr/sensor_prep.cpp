@@ -22,4 +22,13 @@ bool SensorPrep::prepare(const ImuSample& raw, const Eigen::Vector3d& mag_uT, Im
   return true;
 }
 
+bool SensorPrep::arrive(const ImuSample& raw, const Eigen::Vector3d& mag_uT, PrepCounts& counts,
+                        PdrOutput& out, ImuSample& s, Eigen::Vector3d& mag) {
+  out.step = false;
+  if (!prepare(raw, mag_uT, counts, s, mag)) return false;
+  counts.still_windows = still_windows();
+  out.t_s = raw.t_s;
+  return true;
+}
+
 }  // namespace telltale::fusion

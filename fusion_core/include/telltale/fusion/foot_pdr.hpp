@@ -54,9 +54,8 @@ struct FootPdrParams {
 class FootPdr {
  public:
   using Params = FootPdrParams;
-  /// The IMU gate's counts (gate_imu_sample; the gyro may be missing) and the stands.
-  struct Diagnostics : ImuGateCounts {
-    unsigned still_windows = 0;  ///< still windows that set the gyro bias
+  /// The samples' counts (PrepCounts) and the strides.
+  struct Diagnostics : PrepCounts {
     unsigned strides = 0;        ///< strides the INS laid
     unsigned dropped_swings = 0;  ///< swings not laid: longer than a stride's, or a gap in them
   };

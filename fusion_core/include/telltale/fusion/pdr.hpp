@@ -104,13 +104,12 @@ struct PdrParams {
 class Pdr {
  public:
   using Params = PdrParams;
-  /// The IMU gate's counts (gate_imu_sample; the gyro may be missing) and the PDR's own.
-  struct Diagnostics : ImuGateCounts {
+  /// The samples' counts (PrepCounts) and the PDR's own.
+  struct Diagnostics : PrepCounts {
     unsigned switches = 0;           ///< pose switches detected by cross-correlation
     unsigned pose_changes = 0;       ///< classified pose changes applied
     unsigned replaced_headings = 0;  ///< steps that used the pre-switch heading
     unsigned filled_steps = 0;       ///< steps added for gaps the detector left
-    unsigned still_windows = 0;      ///< still windows that set the gyro bias
   };
   /// `net` and `lengths` default to the built-in model; they are copied.
   explicit Pdr(Params params = {}, const PoseNetwork& net = builtin_pose_network(),

@@ -60,8 +60,7 @@ struct TrunkPdrParams {
 class TrunkPdr {
  public:
   using Params = TrunkPdrParams;
-  struct Diagnostics : ImuGateCounts {
-    unsigned still_windows = 0;  ///< still windows that set the gyro bias
+  struct Diagnostics : PrepCounts {
     unsigned walks = 0;          ///< walks begun (a first step after a pause)
     unsigned unmeasured = 0;     ///< steps laid at another's length (no pendulum's excursion)
   };
