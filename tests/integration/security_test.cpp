@@ -17,8 +17,12 @@
 #include <cstdlib>
 #include <cstring>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <map>
+#include <set>
+#include <sstream>
 #include <thread>
 
 #include "dds_participant.hpp"
@@ -62,8 +66,45 @@ class CountingListener : public fdds::DataReaderListener {
   using ReturnCode = eprosima::fastrtps::types::ReturnCode_t;
 };
 
+/// The UDP ports the sockets of processes `pids` are bound to (their /proc/<pid>/fd links to
+/// socket inodes, looked up in /proc/net/udp).
+std::set<std::uint16_t> udp_ports_of(const std::vector<pid_t>& pids) {
+  std::set<unsigned long> inodes;
+  for (const pid_t pid : pids) {
+    std::error_code ec;
+    for (const auto& fd :
+         std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/fd", ec)) {
+      const auto target = std::filesystem::read_symlink(fd.path(), ec).string();
+      if (!ec && target.rfind("socket:[", 0) == 0)
+        inodes.insert(std::stoul(target.substr(8, target.size() - 9)));
+    }
+  }
+  std::set<std::uint16_t> ports;
+  for (const char* table : {"/proc/net/udp", "/proc/net/udp6"}) {
+    std::ifstream in(table);
+    std::string line;
+    std::getline(in, line);  // header
+    while (std::getline(in, line)) {
+      // sl local_address rem_address st tx_queue:rx_queue tr:tm retrnsmt uid timeout inode
+      std::istringstream fields(line);
+      std::string sl, local, remote, st, queues, timer, retransmits, uid, timeout;
+      unsigned long inode = 0;
+      if (!(fields >> sl >> local >> remote >> st >> queues >> timer >> retransmits >> uid >>
+            timeout >> inode))
+        continue;
+      if (inodes.count(inode) == 0) continue;
+      const auto colon = local.rfind(':');
+      if (colon != std::string::npos)
+        ports.insert(static_cast<std::uint16_t>(std::stoul(local.substr(colon + 1), nullptr, 16)));
+    }
+  }
+  return ports;
+}
+
 /// A capture of the UDP traffic on lo to and from one DDS domain's ports (7400 + 250 * domain
-/// .. + 249), with an AF_PACKET socket: the payloads, as bytes, in one string.
+/// .. + 249), with an AF_PACKET socket. Those ports lie in the kernel's ephemeral range
+/// (32768-60999), so another test's process may send from a port in it: finish() keeps the
+/// datagrams sent from a port one of the given processes holds.
 class LoopbackCapture {
  public:
   explicit LoopbackCapture(int domain)
@@ -95,12 +136,24 @@ class LoopbackCapture {
 
   /// Empty when capturing; else why not.
   [[nodiscard]] const std::string& error() const { return error_; }
-  /// Stops capturing and returns the payloads.
-  std::string finish(int* packets) {
+  /// Stops capturing; the payloads, as bytes in one string, of the datagrams sent from
+  /// `senders` (UDP ports). `foreign`: datagrams in the domain's port range sent from elsewhere.
+  std::string finish(const std::set<std::uint16_t>& senders, int* packets, int* foreign) {
     stop_ = true;
     if (thread_.joinable()) thread_.join();
-    *packets = packets_;
-    return payloads_;
+    std::string payloads;
+    *packets = 0;
+    *foreign = 0;
+    for (const auto& d : datagrams_) {
+      if (senders.count(d.source) == 0) {
+        ++*foreign;
+        continue;
+      }
+      ++*packets;
+      ++sizes_[d.payload.size()];
+      payloads += d.payload;
+    }
+    return payloads;
   }
 
  private:
@@ -120,10 +173,9 @@ class LoopbackCapture {
       const auto dst = ntohs(udp->dest);
       const bool ours = (src >= low_ && src <= high_) || (dst >= low_ && dst <= high_);
       if (!ours) continue;
-      ++packets_;
-      ++sizes_[static_cast<std::size_t>(n) - ihl - sizeof(udphdr)];
-      payloads_.append(reinterpret_cast<const char*>(buf.data() + ihl + sizeof(udphdr)),
-                       static_cast<std::size_t>(n) - ihl - sizeof(udphdr));
+      datagrams_.push_back(
+          {src, std::string(reinterpret_cast<const char*>(buf.data() + ihl + sizeof(udphdr)),
+                            static_cast<std::size_t>(n) - ihl - sizeof(udphdr))});
     }
   }
 
@@ -133,9 +185,12 @@ class LoopbackCapture {
   std::string error_;
   std::atomic<bool> stop_{false};
   std::thread thread_;
-  int packets_ = 0;
-  std::string payloads_;
-  std::map<std::size_t, int> sizes_;  ///< UDP payload size -> packets
+  struct Datagram {
+    std::uint16_t source;
+    std::string payload;
+  };
+  std::vector<Datagram> datagrams_;   ///< written by the capture thread until finish()
+  std::map<std::size_t, int> sizes_;  ///< UDP payload size -> packets kept by finish()
 
  public:
   /// The most frequent UDP payload size (the 25 Hz attitude sample's datagram). After finish().
@@ -264,8 +319,8 @@ class SecurityTest : public ShoreFixture {
 
   /// Captures this domain's loopback traffic while `start` starts boats, until `listed` holds
   /// and 3 s more; the payloads.
-  std::string capture_fleet(const std::function<void()>& start,
-                            const std::function<bool()>& listed) {
+  std::string capture_fleet(const std::function<void()>& start, const std::function<bool()>& listed,
+                            int* foreign_out = nullptr) {
     LoopbackCapture capture(domain_);
     if (!capture.error().empty()) {
       ADD_FAILURE() << capture.error();
@@ -274,11 +329,18 @@ class SecurityTest : public ShoreFixture {
     start();
     EXPECT_TRUE(eventually(listed, seconds(20)));
     std::this_thread::sleep_for(seconds(3));
+    std::vector<pid_t> fleet = {shore_->pid()};
+    for (const auto& boat : boats_) fleet.push_back(boat->pid());
+    const auto senders = udp_ports_of(fleet);
     int packets = 0;
-    std::string payloads = capture.finish(&packets);
+    int foreign = 0;
+    std::string payloads = capture.finish(senders, &packets, &foreign);
     EXPECT_GT(packets, 100) << "the capture saw almost nothing: it proves nothing";
-    std::printf("captured %d packets, %zu payload bytes, commonest datagram %zu bytes\n", packets,
-                payloads.size(), capture.commonest_size());
+    std::printf(
+        "captured %d packets from the fleet's %zu UDP ports, %zu payload bytes, commonest "
+        "datagram %zu bytes; %d datagrams in the domain's port range from other processes\n",
+        packets, senders.size(), payloads.size(), capture.commonest_size(), foreign);
+    if (foreign_out) *foreign_out = foreign;
     return payloads;
   }
 
@@ -412,14 +474,39 @@ TEST_F(SecurityTest, ExpiredCertificateIsRefused) {
   EXPECT_EQ(boats_by_id().count("charlie"), 0u) << get_json("/api/v1/boats").dump();
 }
 
+/// Sends one datagram holding `text` over loopback from port `from` to port `to` (another
+/// process's traffic, as the capture sees it). False if it could not.
+bool send_datagram(std::uint16_t from, std::uint16_t to, const std::string& text) {
+  const int fd = socket(AF_INET, SOCK_DGRAM, 0);
+  if (fd < 0) return false;
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  a.sin_port = htons(from);
+  bool ok = bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+  a.sin_port = htons(to);
+  ok = ok && sendto(fd, text.data(), text.size(), 0, reinterpret_cast<sockaddr*>(&a), sizeof a) ==
+                 static_cast<ssize_t>(text.size());
+  close(fd);
+  return ok;
+}
+
 TEST_F(SecurityTest, LoopbackCaptureShowsNoPlaintextBoatId) {
+  int foreign = 0;
   const std::string payloads = capture_fleet(
       [&] {
         start_node("alpha", "alpha");
         start_node("bravo", "bravo");
+        // Control: an unsecured process elsewhere naming alpha from a port in this domain's
+        // range (the range is in the kernel's ephemeral one; CI once caught exactly that from a
+        // parallel test) is not the fleet's wire. Participant ports are base + 10 + 2 i (+1),
+        // so base + 240 is a participant this test never has.
+        const auto base = static_cast<std::uint16_t>(7400 + 250 * domain_);
+        EXPECT_TRUE(send_datagram(base + 240, base + 241, "alpha bravo, in clear"));
       },
-      [&] { return listed_with_data("alpha") && listed_with_data("bravo"); });
+      [&] { return listed_with_data("alpha") && listed_with_data("bravo"); }, &foreign);
   ASSERT_FALSE(payloads.empty());
+  EXPECT_GE(foreign, 1) << "the control datagram was not seen: the capture's filter is untested";
   EXPECT_EQ(payloads.find("alpha"), std::string::npos);
   EXPECT_EQ(payloads.find("bravo"), std::string::npos);
   // The partition tag does travel in clear (in the permissions document of the handshake): a
