@@ -44,7 +44,7 @@ Butterworth butterworth(double dt, double inv_sqrt2_tau) {
   return {k2 * norm, 2.0 * (k2 - 1.0) * norm, (1.0 - M_SQRT2 * k + k2) * norm};
 }
 
-/// One step of the Butterworth on the 18 low-passed values, in transposed direct form II:
+/// One step of the Butterworth on the 21 low-passed values, in transposed direct form II:
 ///   y = b0 x + s0;  s0 = b1 x - a1 y + s1;  s1 = b2 x - a2 y  (b1 = 2 b0, b2 = b0).
 /// The values are independent, so they go two at a time (one SIMD pair each) through all three
 /// lines at once, each read and written once. As three Eigen assignments over the 3x5 blocks
@@ -52,69 +52,76 @@ Butterworth butterworth(double dt, double inv_sqrt2_tau) {
 /// ~340 instructions per update; this is ~195 fewer (callgrind). The same operations in the same
 /// order on every value, so the same results bit for bit: b1 x = (2 b0) x is formed as
 /// b0 x + b0 x (doubling is exact).
-void butterworth_step(const Butterworth& c, const Eigen::Matrix<double, 3, 6>& x,
-                      Eigen::Matrix<double, 3, 6>& y, Eigen::Matrix<double, 3, 6>& s0,
-                      Eigen::Matrix<double, 3, 6>& s1) {
+void butterworth_step(const Butterworth& c, const Eigen::Matrix<double, 3, 7>& x,
+                      Eigen::Matrix<double, 3, 7>& y, Eigen::Matrix<double, 3, 7>& s0,
+                      Eigen::Matrix<double, 3, 7>& s1) {
   using Pair = Eigen::Array2d;
   const double* xd = x.data();
   double* yd = y.data();
   double* s0d = s0.data();
   double* s1d = s1.data();
-  for (int i = 0; i < 18; i += 2) {
+  for (int i = 0; i < 20; i += 2) {
     const Pair bx = c.b0 * Eigen::Map<const Pair>(xd + i);
     const Pair yi = bx + Eigen::Map<const Pair>(s0d + i);
     Eigen::Map<Pair>(s0d + i) = ((bx + bx) - c.a1 * yi) + Eigen::Map<const Pair>(s1d + i);
     Eigen::Map<Pair>(s1d + i) = bx - c.a2 * yi;
     Eigen::Map<Pair>(yd + i) = yi;
   }
+  const double bx = c.b0 * xd[20];  // the odd one out, the same operations
+  const double yi = bx + s0d[20];
+  s0d[20] = ((bx + bx) - c.a1 * yi) + s1d[20];
+  s1d[20] = bx - c.a2 * yi;
+  yd[20] = yi;
 }
 
-/// One Kalman measurement update of the bias filter (state: the bias, then the gyro's scale;
-/// covariance st.cov, symmetric): M independent measurements z = h x + noise, each of variance
-/// w, innov = z - h x. Corrects the bias and the scale and updates the covariance. Written out: P
-/// H^T (4xM), S = H P H^T + w I (MxM, symmetric), K = P H^T S^-1, and P -= K (P H^T)^T formed on
+/// One Kalman measurement update of the bias filter (state: the bias, the gyro's scale, the
+/// accelerometer's skew; covariance st.cov, symmetric): M independent measurements z = h x +
+/// noise, each of variance w, innov = z - h x. Corrects the three and updates the covariance.
+/// Written out: P H^T (5xM), S = H P H^T + w I (MxM, symmetric), K = P H^T S^-1, and
+/// P -= K (P H^T)^T formed on
 /// its upper triangle and mirrored, so P stays exactly symmetric (the full product kept that to
 /// rounding only). As Eigen products GCC left them out-of-line calls per SIMD packet: the motion
 /// update's step alone cost 102 instructions more per update on the 25 Hz dinghy (callgrind,
 /// attitude_count). Always inlined: it runs on every sample, and M fixes the loops.
 template <int M>
 [[gnu::always_inline]] inline void kalman_update(TelltaleAttitudeFilter::State& st,
-                                                 const Eigen::Matrix<double, M, 4>& h,
+                                                 const Eigen::Matrix<double, M, 5>& h,
                                                  const Eigen::Matrix<double, M, 1>& innov,
                                                  double w) {
-  Eigen::Matrix4d& p = st.cov;
-  Eigen::Matrix<double, 4, M> pht;
-  for (int i = 0; i < 4; ++i) {
+  Eigen::Matrix<double, 5, 5>& p = st.cov;
+  Eigen::Matrix<double, 5, M> pht;
+  for (int i = 0; i < 5; ++i) {
     for (int j = 0; j < M; ++j) {
-      pht(i, j) = p(i, 0) * h(j, 0) + p(i, 1) * h(j, 1) + p(i, 2) * h(j, 2) + p(i, 3) * h(j, 3);
+      pht(i, j) = p(i, 0) * h(j, 0) + p(i, 1) * h(j, 1) + p(i, 2) * h(j, 2) + p(i, 3) * h(j, 3) +
+                  p(i, 4) * h(j, 4);
     }
   }
   Eigen::Matrix<double, M, M> sm;
   for (int a = 0; a < M; ++a) {
     for (int b = a; b < M; ++b) {
-      sm(a, b) =
-          h(a, 0) * pht(0, b) + h(a, 1) * pht(1, b) + h(a, 2) * pht(2, b) + h(a, 3) * pht(3, b);
+      sm(a, b) = h(a, 0) * pht(0, b) + h(a, 1) * pht(1, b) + h(a, 2) * pht(2, b) +
+                 h(a, 3) * pht(3, b) + h(a, 4) * pht(4, b);
       sm(b, a) = sm(a, b);
     }
     sm(a, a) += w;
   }
   const Eigen::Matrix<double, M, M> s_inv = sm.inverse();  // closed form for M <= 3
-  Eigen::Matrix<double, 4, M> k;
-  for (int i = 0; i < 4; ++i) {
+  Eigen::Matrix<double, 5, M> k;
+  for (int i = 0; i < 5; ++i) {
     for (int j = 0; j < M; ++j) {
       double v = 0.0;
       for (int m = 0; m < M; ++m) v += pht(i, m) * s_inv(m, j);
       k(i, j) = v;
     }
   }
-  Eigen::Vector4d dx;
-  for (int i = 0; i < 4; ++i) {
+  Eigen::Matrix<double, 5, 1> dx;
+  for (int i = 0; i < 5; ++i) {
     double v = 0.0;
     for (int m = 0; m < M; ++m) v += k(i, m) * innov(m);
     dx(i) = v;
   }
-  for (int i = 0; i < 4; ++i) {
-    for (int j = i; j < 4; ++j) {
+  for (int i = 0; i < 5; ++i) {
+    for (int j = i; j < 5; ++j) {
       double v = 0.0;
       for (int m = 0; m < M; ++m) v += k(i, m) * pht(j, m);
       p(i, j) -= v;
@@ -123,6 +130,7 @@ template <int M>
   }
   st.bias_rad_s += dx.head<3>();
   st.gyro_scale += dx(3);
+  st.acc_skew_s += dx(4);
 }
 
 /// A unit vector perpendicular to the unit vector u (continuity does not matter: each motion
@@ -150,11 +158,13 @@ template <int M>
   st.lp.block<3, 3>(0, 1) = r;
   st.lp.col(4) = r.lazyProduct(st.bias_rad_s);
   st.lp.col(5).setZero();
+  st.lp.col(6).setZero();  // R (f x omega) likewise: a seaway's rotations go both ways
   st.lp_s0 = (1.0 - b0) * st.lp;
   st.lp_s1 = (b0 - a2) * st.lp;
   st.lp_running = true;
   st.lp_elapsed_s = tau;
   st.bias_up_i = st.up_i;
+  st.bias_skew_lp = st.lp.col(6);
   st.bias_elapsed_s = 0.0;
 }
 
@@ -192,6 +202,7 @@ void TelltaleAttitudeFilter::initialise(const ImuSample& s) {
   const double var0 = params_.bias_sigma_init_rad_s * params_.bias_sigma_init_rad_s;
   state_.cov.topLeftCorner<3, 3>() = var0 * Eigen::Matrix3d::Identity();
   state_.cov(3, 3) = params_.gyro_scale_sigma_init * params_.gyro_scale_sigma_init;
+  state_.cov(4, 4) = params_.acc_skew_sigma_init_s * params_.acc_skew_sigma_init_s;
   state_.tau_scale =
       std::max(1.0, std::cbrt(params_.bias_sigma_init_rad_s / params_.bias_sigma_motion_rad_s));
   state_.gyro_rest_lp_rad_s = s.gyro_body_rad_s;
@@ -229,9 +240,9 @@ void TelltaleAttitudeFilter::start_wait(bool at_rest, bool gap, double dt) {
   st.start_fit = true;
   st.start_elapsed_s = 0.0;
   st.cov.topLeftCorner<3, 3>() = var0 * Eigen::Matrix3d::Identity();
-  // The start's filter has no scale: nothing ties the two.
-  st.cov.topRightCorner<3, 1>().setZero();
-  st.cov.bottomLeftCorner<1, 3>().setZero();
+  // The start's filter has no scale or skew: nothing ties them to the bias.
+  st.cov.topRightCorner<3, 2>().setZero();
+  st.cov.bottomLeftCorner<2, 3>().setZero();
   st.start_cov.setZero();
   st.start_cov(0, 0) = st.start_cov(1, 1) = a0 * a0;
   st.start_cov.block<3, 3>(2, 2) = st.cov.topLeftCorner<3, 3>();
@@ -332,7 +343,7 @@ void TelltaleAttitudeFilter::course_update(const Eigen::Vector3d& gyro_raw, bool
     st.cov.topLeftCorner<3, 3>() = st.start_cov.block<3, 3>(2, 2);
   } else {
     // H = (hb, 0) on (bias, scale): the scale moves with the bias it is correlated with.
-    const Eigen::RowVector4d h(hb.x(), hb.y(), hb.z(), 0.0);
+    const Eigen::Matrix<double, 1, 5> h(hb.x(), hb.y(), hb.z(), 0.0, 0.0);
     kalman_update<1>(st, h, Eigen::Matrix<double, 1, 1>(innov), w);
   }
   st.course_window_s = 0.0;
@@ -524,7 +535,10 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // back by half the interval's rotation (force_at_its_instant says why), for the start's line
   // fit and the low-pass alike: BROAD resampled to 25 Hz, with the coning term, mean
   // inclination error 1.35 -> 0.98 deg (docs/attitude.md has every rate).
-  const Eigen::Vector3d f_seen = gap ? f : force_at_its_instant(f, dtheta);
+  // The accelerometer's own skew (Params::acc_skew_sigma_init_s, a state): its sample describes
+  // the instant acc_skew_s before the gyro's, a further turn of omega * acc_skew_s.
+  const Eigen::Vector3d f_seen =
+      gap ? f : force_at_its_instant(f, dtheta + (2.0 * st.acc_skew_s) * gyro);
   // The course measures the bias about the vertical when it is known (course_update).
   const bool course_known = !gap && st.speed_m_s >= 0.0 &&
                             !std::isnan(st.yaw_rate_cog_rad_s) &&
@@ -593,11 +607,12 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   const Butterworth c = butterworth(dt, inv_sqrt2_tau);
   if (start_ends) end_start_fit(st, r, c.b0, c.a2, tau, p.g_m_s2);
   if (gap) st.lp_running = false;
-  Eigen::Matrix<double, 3, 6> x;
+  Eigen::Matrix<double, 3, 7> x;
   // (Written out: as Eigen assignments GCC left the block copy and the products out-of-line
   // calls once the update had grown by the lines above, +55 instructions per update.)
   const Eigen::Vector3d& b = st.bias_rad_s;
   const Eigen::Vector3d& wb = gyro_less_bias;
+  const Eigen::Vector3d fw = f_seen.cross(gyro);  // how a late force tilts (the skew's column)
   for (int i = 0; i < 3; ++i) {
     x(i, 0) = r(i, 0) * f_seen.x() + r(i, 1) * f_seen.y() + r(i, 2) * f_seen.z();
     x(i, 1) = r(i, 0);
@@ -605,6 +620,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
     x(i, 3) = r(i, 2);
     x(i, 4) = r(i, 0) * b.x() + r(i, 1) * b.y() + r(i, 2) * b.z();
     x(i, 5) = r(i, 0) * wb.x() + r(i, 1) * wb.y() + r(i, 2) * wb.z();
+    x(i, 6) = r(i, 0) * fw.x() + r(i, 1) * fw.y() + r(i, 2) * fw.z();
   }
   if (!st.lp_running) {
     // Fast start: the mean of everything since the (re)start, weighted by time. The first
@@ -638,6 +654,9 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // The scale's walk: back to its prior over gyro_scale_forgetting_s.
   const double ks0 = p.gyro_scale_sigma_init * p.gyro_scale_sigma_init;
   if (st.cov(3, 3) < ks0) st.cov(3, 3) += ks0 * dt / p.gyro_scale_forgetting_s;
+  // The skew's likewise.
+  const double ss0 = p.acc_skew_sigma_init_s * p.acc_skew_sigma_init_s;
+  if (st.cov(4, 4) < ss0) st.cov(4, 4) += ss0 * dt / p.acc_skew_forgetting_s;
   // Measurement noise chosen so that, updated on every sample, the covariance settles at the
   // sigma of that measurement: W = sigma^4 / V + sigma^2 (the fixed point of P' = P + V,
   // P'' = P' - P'^2 / (P' + W) at P'' = sigma^2).
@@ -648,7 +667,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
     const double w = sr2 * sr2 / v + sr2;
     // H = (I, 0) on (bias, scale): the scale is not measured (no rotation), but moves with the
     // bias it is correlated with, and that correlation shrinks as the bias is pinned down.
-    Eigen::Matrix<double, 3, 4> h = Eigen::Matrix<double, 3, 4>::Zero();
+    Eigen::Matrix<double, 3, 5> h = Eigen::Matrix<double, 3, 5>::Zero();
     h.leftCols<3>().setIdentity();
     const Eigen::Vector3d innov = st.gyro_rest_lp_rad_s - st.bias_rad_s;
     kalman_update<3>(st, h, innov, w);
@@ -663,6 +682,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   const bool motion = !at_rest && !steady && !gap && !acc_sat && l2 > 0.25 * p.g_m_s2 * p.g_m_s2;
   if (!motion) {
     st.bias_up_i = st.up_i;
+    st.bias_skew_lp = st.lp.col(6);
     st.bias_elapsed_s = 0.0;
   } else {
     st.bias_elapsed_s += dt;
@@ -681,6 +701,14 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
     // I. A rotation that goes back and forth (a boat's rolling, a pendulum) leaves that near 0
     // and teaches nothing; a one-way rotation across the vertical (a hand tumbling the sensor,
     // a turntable's tilted axis) measures it.
+    // The skew: the force is rotated into I as seen s_est after its instant, so the low-passed
+    // force carries (s_est - s_true) LP(R (f x omega)) on top of g up, a tilt of the vertical
+    // by that over g (across the vertical), and the vertical's drift over the span carries its
+    // change: (s_est - s_true) up x d/dt LP(R (f x omega)) / g. So the same drift measures
+    // s_true - s_est through -(up x dLP / dt) / g. A steady rotation holds the tilt and says
+    // nothing; its onset, its end and any change of its axis or rate do. It is not the scale's
+    // signature (the scale drifts the vertical for as long as the rotation lasts, the skew tilts
+    // it once), nor the bias's (which drifts it through R).
     const double span = st.bias_elapsed_s;
     const Eigen::Vector3d yv = st.bias_up_i.cross(st.up_i) / span;
     st.bias_up_i = st.up_i;
@@ -692,9 +720,12 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
     Eigen::Matrix<double, 2, 3> basis;
     basis.row(0) = h1.transpose();
     basis.row(1) = h2.transpose();
-    Eigen::Matrix<double, 2, 4> h;
+    Eigen::Matrix<double, 2, 5> h;
     h.leftCols<3>() = basis * h_i;
     h.col(3) = -(basis * st.lp.col(5));
+    const Eigen::Vector3d skew_lp_rate = (st.lp.col(6) - st.bias_skew_lp) / span;
+    h.col(4) = -(basis * st.up_i.cross(skew_lp_rate)) / p.g_m_s2;
+    st.bias_skew_lp = st.lp.col(6);
     Eigen::Vector2d e = basis * e_i;
     e = e.cwiseMax(-p.max_bias_rad_s).cwiseMin(p.max_bias_rad_s);
     // The same steady-state rule for one update per span: V over the span.
@@ -704,6 +735,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   if (course_known || st.course_window_s > 0.0) course_update(s.gyro_body_rad_s, course_known, dt);
   st.bias_rad_s = st.bias_rad_s.cwiseMax(-p.max_bias_rad_s).cwiseMin(p.max_bias_rad_s);
   st.gyro_scale = std::clamp(st.gyro_scale, -p.max_gyro_scale, p.max_gyro_scale);
+  st.acc_skew_s = std::clamp(st.acc_skew_s, -p.max_acc_skew_s, p.max_acc_skew_s);
 
   // --- What output() needs: the vertical seen in the body, and the body rate.
   st.up_body = r.transpose() * st.up_i;

@@ -25,6 +25,11 @@
 ///     so the drift is the bias error through LP(R) plus the scale error through LP(R omega).
 ///     It matters where the rotation is fast and one-way (a hand tumbling the sensor at
 ///     400 deg/s: 0.5 % of it is 2 deg/s of drift); a boat's rolling back and forth cancels it;
+///   - the skew between the accelerometer's and the gyro's signal chains (their digital filters
+///     delay them differently, a few ms on MEMS parts) is a fifth state of that filter: a force
+///     seen s late is seen from an attitude turned by omega s, so the low-passed force in I
+///     carries s LP(R (f x omega)), a tilt while a rotation lasts; its onset and end move the
+///     vertical, and that drift measures s;
 ///   - start: the low-pass starts as the mean of everything seen since (the best estimate of a
 ///     constant from a growing window) for tau_acc_s, as it does after a gap too long to
 ///     integrate. If within the first start_fit_s (and before any rest or gap) the GNSS speed
@@ -100,6 +105,15 @@ struct TelltaleAttitudeParams {
   double gyro_scale_sigma_init = 0.005;
   double gyro_scale_forgetting_s = 3600.0;
   double max_gyro_scale = 0.05;  ///< |k| clamp: beyond any MEMS sensitivity tolerance
+  /// The accelerometer's delay against the gyro's (s > 0: its sample describes an instant s
+  /// earlier than the gyro's mid-interval), a Kalman state beside the bias and the scale, learnt
+  /// in motion only (update says how). Prior sigma: the spread of the difference between a MEMS
+  /// part's two filter delays (1-4 ms on common parts, more at low output rates): 5 ms. Forgotten
+  /// back to it over acc_skew_forgetting_s (a configuration's figure: it changes only when the
+  /// sensor is set up again; the forgetting lets a wrong start be unlearnt). 0: not a state.
+  double acc_skew_sigma_init_s = 5e-3;
+  double acc_skew_forgetting_s = 3600.0;
+  double max_acc_skew_s = 0.02;                    ///< |s| clamp
   double gyro_range_rad_s = 250.0 * M_PI / 180.0;  ///< full scale (L3G4200D default 250 dps)
   double acc_range_m_s2 = 2.0 * kStandardGravity_m_s2;  ///< full scale (LSM303DLH default 2 g)
   double saturation_fraction = 0.98;                    ///< |reading| >= this * range -> saturated
@@ -158,21 +172,25 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
     Eigen::Vector3d dtheta_prev_rad = Eigen::Vector3d::Zero();
     /// The gyro's common scale error (Params::gyro_scale_sigma_init): rate = (1 + k)(gyro - bias).
     double gyro_scale = 0.0;
-    /// The covariance of (bias, scale), one Kalman filter on 4 states: the bias's 3x3 block in
-    /// (rad/s)^2 top left, the scale's variance at (3, 3), their covariance between.
-    Eigen::Matrix4d cov = Eigen::Matrix4d::Zero();
+    /// The accelerometer's skew against the gyro (s; Params::acc_skew_sigma_init_s).
+    double acc_skew_s = 0.0;
+    /// The covariance of (bias, scale, skew), one Kalman filter on 5 states: the bias's 3x3
+    /// block in (rad/s)^2 top left, the scale's variance at (3, 3), the skew's (s^2) at (4, 4),
+    /// their covariances between.
+    Eigen::Matrix<double, 5, 5> cov = Eigen::Matrix<double, 5, 5>::Zero();
     /// Low-passed in frame I, as one block: column 0 the specific force (m/s^2), 1..3 the
     /// rotation matrix body -> I, 4 R * bias (the motion-bias model), 5 R * (gyro - bias) (the
-    /// scale's: the rate in I). Output and two Butterworth
-    /// (transposed direct form II) states.
-    Eigen::Matrix<double, 3, 6> lp = Eigen::Matrix<double, 3, 6>::Zero();
-    Eigen::Matrix<double, 3, 6> lp_s0 = Eigen::Matrix<double, 3, 6>::Zero();
-    Eigen::Matrix<double, 3, 6> lp_s1 = Eigen::Matrix<double, 3, 6>::Zero();
+    /// scale's: the rate in I), 6 R * (f x omega) (the skew's: how a late force tilts). Output
+    /// and two Butterworth (transposed direct form II) states.
+    Eigen::Matrix<double, 3, 7> lp = Eigen::Matrix<double, 3, 7>::Zero();
+    Eigen::Matrix<double, 3, 7> lp_s0 = Eigen::Matrix<double, 3, 7>::Zero();
+    Eigen::Matrix<double, 3, 7> lp_s1 = Eigen::Matrix<double, 3, 7>::Zero();
     double tau_scale = 1.0;     ///< tau_acc_s / the time constant in use (>= 1, see update)
     double lp_elapsed_s = 0.0;  ///< time since the low-pass (re)started
     bool lp_running = false;    ///< false: still the growing mean of the fast start
     Eigen::Vector3d up_i = Eigen::Vector3d::UnitZ();       ///< the vertical in I (unit)
     Eigen::Vector3d bias_up_i = Eigen::Vector3d::UnitZ();  ///< up_i at the last motion update
+    Eigen::Vector3d bias_skew_lp = Eigen::Vector3d::Zero();  ///< lp column 6 then
     double bias_elapsed_s = 0.0;                           ///< time since then
     Eigen::Vector3d gyro_rest_lp_rad_s = Eigen::Vector3d::Zero();
     Eigen::Vector3d acc_rest_lp_m_s2 = Eigen::Vector3d::Zero();
