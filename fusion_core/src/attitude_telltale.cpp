@@ -576,7 +576,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // gyro is worth less and tau = tau_acc_s (sigma_motion / sigma_b)^(1/3), never longer than
   // tau_acc_s. sigma_b^2: the covariance's mean over the two axes across the vertical. The cube
   // root by one Newton step per sample from the last value (it changes slowly).
-  const Eigen::Vector3d up_b_prev = r.transpose() * st.up_i;
+  const Eigen::Vector3d up_b_prev = r.transpose().lazyProduct(st.up_i);
   const double sm2 = p.bias_sigma_motion_rad_s * p.bias_sigma_motion_rad_s;
   const auto bias_cov = st.cov.topLeftCorner<3, 3>();
   const double var_h = 0.5 * (bias_cov.trace() - up_b_prev.dot(bias_cov * up_b_prev));
@@ -738,7 +738,7 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   st.acc_skew_s = std::clamp(st.acc_skew_s, -p.max_acc_skew_s, p.max_acc_skew_s);
 
   // --- What output() needs: the vertical seen in the body, and the body rate.
-  st.up_body = r.transpose() * st.up_i;
+  st.up_body = r.transpose().lazyProduct(st.up_i);
   st.rate_rad_s = gyro;
   st.updated = true;
 }
