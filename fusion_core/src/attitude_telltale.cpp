@@ -78,11 +78,11 @@ void butterworth_step(const Butterworth& c, const Eigen::Matrix<double, 3, 7>& x
 /// accelerometer's skew; covariance st.cov, symmetric): M independent measurements z = h x +
 /// noise, each of variance w, innov = z - h x. Corrects the three and updates the covariance.
 /// Written out: P H^T (5xM), S = H P H^T + w I (MxM, symmetric), K = P H^T S^-1, and
-/// P -= K (P H^T)^T formed on
-/// its upper triangle and mirrored, so P stays exactly symmetric (the full product kept that to
-/// rounding only). As Eigen products GCC left them out-of-line calls per SIMD packet: the motion
-/// update's step alone cost 102 instructions more per update on the 25 Hz dinghy (callgrind,
-/// attitude_count). Always inlined: it runs on every sample, and M fixes the loops.
+/// P -= K (P H^T)^T formed on its upper triangle and mirrored, so P stays exactly symmetric (the
+/// full product kept that to rounding only). As Eigen products GCC left them out-of-line calls per
+/// SIMD packet: the motion update's step alone cost 102 instructions more per update on the 25 Hz
+/// dinghy (callgrind, attitude_count). Always inlined: it runs on every sample, and M fixes the
+/// loops.
 template <int M>
 [[gnu::always_inline]] inline void kalman_update(TelltaleAttitudeFilter::State& st,
                                                  const Eigen::Matrix<double, M, 5>& h,
@@ -342,7 +342,8 @@ void TelltaleAttitudeFilter::course_update(const Eigen::Vector3d& gyro_raw, bool
     st.start_cov -= k * ph.transpose();
     st.cov.topLeftCorner<3, 3>() = st.start_cov.block<3, 3>(2, 2);
   } else {
-    // H = (hb, 0) on (bias, scale): the scale moves with the bias it is correlated with.
+    // H = (hb, 0, 0) on (bias, scale, skew): the other two move with the bias they are
+    // correlated with.
     const Eigen::Matrix<double, 1, 5> h(hb.x(), hb.y(), hb.z(), 0.0, 0.0);
     kalman_update<1>(st, h, Eigen::Matrix<double, 1, 1>(innov), w);
   }
@@ -576,6 +577,8 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
   // gyro is worth less and tau = tau_acc_s (sigma_motion / sigma_b)^(1/3), never longer than
   // tau_acc_s. sigma_b^2: the covariance's mean over the two axes across the vertical. The cube
   // root by one Newton step per sample from the last value (it changes slowly).
+  // (A lazy product, here and for up_body: as `*` GCC made it an out-of-line call, 50
+  // instructions per update.)
   const Eigen::Vector3d up_b_prev = r.transpose().lazyProduct(st.up_i);
   const double sm2 = p.bias_sigma_motion_rad_s * p.bias_sigma_motion_rad_s;
   const auto bias_cov = st.cov.topLeftCorner<3, 3>();
@@ -665,8 +668,9 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
     // At rest the gyro's 0.5 s mean IS the bias (to its noise), all three axes.
     const double sr2 = p.bias_sigma_rest_rad_s * p.bias_sigma_rest_rad_s;
     const double w = sr2 * sr2 / v + sr2;
-    // H = (I, 0) on (bias, scale): the scale is not measured (no rotation), but moves with the
-    // bias it is correlated with, and that correlation shrinks as the bias is pinned down.
+    // H = (I, 0, 0) on (bias, scale, skew): the scale and the skew are not measured (no
+    // rotation), but move with the bias they are correlated with, and that correlation shrinks
+    // as the bias is pinned down.
     Eigen::Matrix<double, 3, 5> h = Eigen::Matrix<double, 3, 5>::Zero();
     h.leftCols<3>().setIdentity();
     const Eigen::Vector3d innov = st.gyro_rest_lp_rad_s - st.bias_rad_s;
@@ -701,8 +705,9 @@ void TelltaleAttitudeFilter::update(const ImuSample& s) {
     // I. A rotation that goes back and forth (a boat's rolling, a pendulum) leaves that near 0
     // and teaches nothing; a one-way rotation across the vertical (a hand tumbling the sensor,
     // a turntable's tilted axis) measures it.
-    // The skew: the force is rotated into I as seen s_est after its instant, so the low-passed
-    // force carries (s_est - s_true) LP(R (f x omega)) on top of g up, a tilt of the vertical
+    // The skew: the force is turned back by omega s_est beyond the half interval, where its
+    // sample asks for omega s_true, so the low-passed force carries
+    // (s_est - s_true) LP(R (f x omega)) on top of g up, a tilt of the vertical
     // by that over g (across the vertical), and the vertical's drift over the span carries its
     // change: (s_est - s_true) up x d/dt LP(R (f x omega)) / g. So the same drift measures
     // s_true - s_est through -(up x dLP / dt) / g. A steady rotation holds the tilt and says
