@@ -199,103 +199,32 @@ TEST(TelltaleAttitudeFilter, AGapLowersQualityAndRecovers) {
   EXPECT_NEAR(f.output().heel_rad / kDeg, -8.0, 0.05);
 }
 
-// Given a gyro that reads 0.6 % low (BROAD trial 08's IMU, whose tilt error over each burst of
-// fast rotation shrinks from 3-14 deg to 1-2 deg when its rates are scaled up by 0.5-0.6 %,
-// integrating the gyro alone from the optical truth) and a bias, still 5 s, then tumbling
-// one way at 1 rev/s about a horizontal axis through the sensor (the accelerometer reads
-// gravity exactly), when the filter runs, then it learns the common scale (the rate it
-// integrates is 1 / 0.994 of the reading, k = +0.60 %) and holds the tilt; with the scale's
-// state switched off (its prior 0) the same run lags the vertical by several degrees: 0.6 % of
-// 360 deg/s is 2.2 deg/s of drift, which the 3 s low-pass follows with a lag. The scale's own
-// test: the accelerometer's skew is not a state here (one onset of one rotation that never ends
-// cannot tell a skew from the scale's first seconds: the next test).
-TEST(TelltaleAttitudeFilter, LearnsTheGyrosCommonScaleFromOneWayRotation) {
-  const auto run = [](double scale_sigma, double& k_out) {
-    TelltaleAttitudeParams p;
-    p.gyro_range_rad_s = 2000.0 * kDeg;  // a tumbling hand's range (BROAD's IMU: +-2000 deg/s)
-    p.acc_range_m_s2 = 16.0 * kG;
-    p.gyro_scale_sigma_init = scale_sigma;
-    p.acc_skew_sigma_init_s = 0.0;
-    p.sensor_delay_s = 0.0;  // these samples are exact: no sensor delay
-    TelltaleAttitudeFilter f(p);
-    const Eigen::Vector3d bias(0.01, -0.02, 0.005);
-    constexpr double kRate = 2.0 * M_PI;  // rad/s about the body's x axis, horizontal
-    constexpr double kDt = 0.01;
-    double worst_deg = 0.0;
-    for (int n = 0; n <= 6500; ++n) {
-      const double t = n * kDt;
-      const double spin_s = std::max(0.0, t - 5.0);
-      const double angle = kRate * spin_s;  // heel, from the truth's rotation about x
-      const double rate = t > 5.0 ? kRate : 0.0;
-      // Both sensors read their mean over the interval that ends at t, as the simulator's do:
-      // the rate, and gravity seen from the body turning through [angle - rate dt, angle].
-      const double a0 = angle - rate * kDt;
-      const Eigen::Vector3d up =
-          rate > 0.0 ? Eigen::Vector3d(0.0, (std::cos(a0) - std::cos(angle)) / (rate * kDt),
-                                       (std::sin(angle) - std::sin(a0)) / (rate * kDt))
-                     : Eigen::Vector3d(0.0, std::sin(angle), std::cos(angle));
-      f.update({t, 0.994 * Eigen::Vector3d(rate, 0.0, 0.0) + bias, kG * up});
-      if (t < 55.0) continue;  // scored over the last 10 s
-      const AttitudeOutput o = f.output();
-      // The truth's up (0, sin a, cos a) is heel a, pitch 0.
-      worst_deg =
-          std::max(worst_deg, inclination_error_rad(o.heel_rad, o.pitch_rad, angle, 0.0) / kDeg);
-    }
-    k_out = f.state().gyro_scale;
-    return worst_deg;
-  };
-  double k = 0.0;
-  const double with_scale = run(TelltaleAttitudeParams{}.gyro_scale_sigma_init, k);
-  // About one axis the bias along it drifts the vertical as the scale does (both along that
-  // axis, fixed in I); the rest before the spin pins the bias, so k is learnt to what is left
-  // of it (measured: 0.632 %, 0.34 deg worst; without the state 5.3 deg).
-  EXPECT_NEAR(k, 1.0 / 0.994 - 1.0, 0.001);
-  EXPECT_LT(with_scale, 0.5);
-  double k_off = 0.0;
-  const double without = run(0.0, k_off);
-  std::printf("  k %.4f %%, worst %.2f deg; without the state %.2f deg\n", 100.0 * k, with_scale,
-              without);
-  EXPECT_EQ(k_off, 0.0);
-  EXPECT_GT(without, 2.0);
-}
-
-// The sensor tumbled about a horizontal axis (body x) at 1 rev/s one way for 2 s, held 1 s,
-// back for 2 s, held 1 s, after 5 s still; both sensors read their mean over the interval
-// ending at each 100 Hz sample, the accelerometer's interval `skew_s` earlier than the gyro's
-// (its filter delays it that much more). A force seen 4 ms late at 360 deg/s is 1.4 deg of tilt
-// while the rotation lasts. The filter learns the skew from the rotations' starts and stops and
-// holds the tilt; without the state it is that tilt behind.
-struct SkewRun {
+/// A sensor tumbled about a horizontal axis through it (body x): still for 5 s, then at the rate
+/// `rate(t)` (rad/s), its heel `angle(t)` the rate's integral. Both sensors read their mean over
+/// the interval that ends at each 100 Hz sample, as the simulator's do (numerically: the rate
+/// steps inside some intervals); the gyro reads `gyro_gain` of the rate plus a bias, the
+/// accelerometer's interval ends `skew_s` earlier than the gyro's (its filter delays it that much
+/// more). Scored from `scored_from_s` to `end_s`.
+struct TumbleRun {
+  double gyro_scale = 0.0;  ///< the filter's state at the end
   double skew_s = 0.0;
   double rms_deg = 0.0;
   double worst_deg = 0.0;
 };
-SkewRun run_skewed_tumbling(double skew_s, double skew_sigma_s) {
-  TelltaleAttitudeParams p;
-  p.gyro_range_rad_s = 2000.0 * kDeg;
+template <class Rate, class Angle>
+TumbleRun run_tumble(TelltaleAttitudeParams p, Rate rate, Angle angle, double gyro_gain,
+                     double skew_s, double scored_from_s, double end_s) {
+  p.gyro_range_rad_s = 2000.0 * kDeg;  // a tumbling hand's range (BROAD's IMU: +-2000 deg/s)
   p.acc_range_m_s2 = 16.0 * kG;
-  p.sensor_delay_s = 0.0;  // exact samples
-  p.acc_skew_sigma_init_s = skew_sigma_s;
+  p.sensor_delay_s = 0.0;  // exact samples: no sensor delay
   TelltaleAttitudeFilter f(p);
   const Eigen::Vector3d bias(0.01, -0.02, 0.005);
-  constexpr double kRate = 2.0 * M_PI;
-  const auto cycle = [](double t) { return std::fmod(t - 5.0, 6.0); };
-  const auto rate = [&](double t) {
-    if (t < 5.0) return 0.0;
-    const double c = cycle(t);
-    return c < 2.0 ? kRate : c < 3.0 ? 0.0 : c < 5.0 ? -kRate : 0.0;
-  };
-  const auto angle = [&](double t) {  // heel: the integral of the rate
-    if (t < 5.0) return 0.0;
-    const double c = cycle(t);
-    return c < 2.0 ? kRate * c : c < 3.0 ? 2.0 * kRate : c < 5.0 ? kRate * (5.0 - c) : 0.0;
-  };
   constexpr double kDt = 0.01;
-  constexpr int kSub = 40;  // the interval means, numerically (the rate steps inside some)
-  SkewRun out;
+  constexpr int kSub = 40;
+  TumbleRun out;
   double se = 0.0;
   int n = 0;
-  for (int k = 1; k <= 9000; ++k) {
+  for (int k = 1; k * kDt <= end_s + 1e-9; ++k) {
     const double t = k * kDt;
     double w = 0.0;
     Eigen::Vector3d up = Eigen::Vector3d::Zero();
@@ -305,24 +234,81 @@ SkewRun run_skewed_tumbling(double skew_s, double skew_sigma_s) {
       const double a = angle(tj - skew_s);
       up += Eigen::Vector3d(0.0, std::sin(a), std::cos(a)) / kSub;
     }
-    f.update({t, Eigen::Vector3d(w, 0.0, 0.0) + bias, kG * up});
-    if (t < 70.0) continue;  // scored over the last 20 s
+    f.update({t, gyro_gain * Eigen::Vector3d(w, 0.0, 0.0) + bias, kG * up});
+    if (t < scored_from_s) continue;
     const AttitudeOutput o = f.output();
+    // The truth's up (0, sin a, cos a) is heel a, pitch 0.
     const double e = inclination_error_rad(o.heel_rad, o.pitch_rad, angle(t), 0.0) / kDeg;
     out.worst_deg = std::max(out.worst_deg, e);
     se += e * e;
     ++n;
   }
   out.rms_deg = std::sqrt(se / n);
+  out.gyro_scale = f.state().gyro_scale;
   out.skew_s = f.state().acc_skew_s;
   return out;
+}
+
+// Given a gyro that reads 0.6 % low (BROAD trial 08's IMU, whose tilt error over each burst of
+// fast rotation shrinks from 3-14 deg to 1-2 deg when its rates are scaled up by 0.5-0.6 %,
+// integrating the gyro alone from the optical truth) and a bias, still 5 s, then tumbling
+// one way at 1 rev/s (the accelerometer reads gravity exactly), when the filter runs, then it
+// learns the common scale (the rate it integrates is 1 / 0.994 of the reading, k = +0.60 %) and
+// holds the tilt; with the scale's state switched off (its prior 0) the same run lags the
+// vertical by several degrees: 0.6 % of 360 deg/s is 2.2 deg/s of drift, which the 3 s low-pass
+// follows with a lag. The scale's own test: the accelerometer's skew is not a state here (one
+// onset of one rotation that never ends cannot tell a skew from the scale's first seconds: the
+// next test).
+TEST(TelltaleAttitudeFilter, LearnsTheGyrosCommonScaleFromOneWayRotation) {
+  constexpr double kRate = 2.0 * M_PI;
+  const auto rate = [](double t) { return t > 5.0 ? kRate : 0.0; };
+  const auto angle = [](double t) { return kRate * std::max(0.0, t - 5.0); };
+  const auto run = [&](double scale_sigma) {
+    TelltaleAttitudeParams p;
+    p.gyro_scale_sigma_init = scale_sigma;
+    p.acc_skew_sigma_init_s = 0.0;
+    return run_tumble(p, rate, angle, 0.994, 0.0, 55.0, 65.0);  // scored over the last 10 s
+  };
+  const TumbleRun with = run(TelltaleAttitudeParams{}.gyro_scale_sigma_init);
+  // About one axis the bias along it drifts the vertical as the scale does (both along that
+  // axis, fixed in I); the rest before the spin pins the bias, so k is learnt to what is left
+  // of it (measured: 0.632 %, 0.34 deg worst; without the state 5.3 deg).
+  EXPECT_NEAR(with.gyro_scale, 1.0 / 0.994 - 1.0, 0.001);
+  EXPECT_LT(with.worst_deg, 0.5);
+  const TumbleRun without = run(0.0);
+  std::printf("  k %.4f %%, worst %.2f deg; without the state %.2f deg\n", 100.0 * with.gyro_scale,
+              with.worst_deg, without.worst_deg);
+  EXPECT_EQ(without.gyro_scale, 0.0);
+  EXPECT_GT(without.worst_deg, 2.0);
+}
+
+// The tumble one way for 2 s, held 1 s, back for 2 s, held 1 s, with the accelerometer `skew_s`
+// late. A force seen 4 ms late at 360 deg/s is 1.4 deg of tilt while the rotation lasts. The
+// filter learns the skew from the rotations' starts and stops and holds the tilt; without the
+// state it is that tilt behind.
+TumbleRun run_skewed_tumbling(double skew_s, double skew_sigma_s) {
+  constexpr double kRate = 2.0 * M_PI;
+  const auto cycle = [](double t) { return std::fmod(t - 5.0, 6.0); };
+  const auto rate = [&](double t) {
+    if (t < 5.0) return 0.0;
+    const double c = cycle(t);
+    return c < 2.0 ? kRate : c < 3.0 ? 0.0 : c < 5.0 ? -kRate : 0.0;
+  };
+  const auto angle = [&](double t) {
+    if (t < 5.0) return 0.0;
+    const double c = cycle(t);
+    return c < 2.0 ? kRate * c : c < 3.0 ? 2.0 * kRate : c < 5.0 ? kRate * (5.0 - c) : 0.0;
+  };
+  TelltaleAttitudeParams p;
+  p.acc_skew_sigma_init_s = skew_sigma_s;
+  return run_tumble(p, rate, angle, 1.0, skew_s, 70.0, 90.0);  // scored over the last 20 s
 }
 
 TEST(TelltaleAttitudeFilter, LearnsTheAccelerometersSkewFromRotationsThatStartAndStop) {
   const double sigma = TelltaleAttitudeParams{}.acc_skew_sigma_init_s;
   for (const double skew : {-4e-3, 4e-3}) {
-    const SkewRun with = run_skewed_tumbling(skew, sigma);
-    const SkewRun without = run_skewed_tumbling(skew, 0.0);
+    const TumbleRun with = run_skewed_tumbling(skew, sigma);
+    const TumbleRun without = run_skewed_tumbling(skew, 0.0);
     std::printf(
         "  skew %+.1f ms: learnt %+.2f ms, worst %.2f deg (rms %.2f); without the state "
         "%.2f (%.2f)\n",
@@ -335,7 +321,7 @@ TEST(TelltaleAttitudeFilter, LearnsTheAccelerometersSkewFromRotationsThatStartAn
     EXPECT_GT(without.worst_deg, 0.3);
   }
   // A sensor without skew: the state stays where it started (the motion says 0).
-  const SkewRun none = run_skewed_tumbling(0.0, sigma);
+  const TumbleRun none = run_skewed_tumbling(0.0, sigma);
   EXPECT_NEAR(none.skew_s, 0.0, 0.5e-3);
   EXPECT_LT(none.worst_deg, 0.05);
 }

@@ -28,11 +28,8 @@ bool FootIns::update(const ImuSample& s, double dt_s) {
   // The sample's rate over the interval that ends at it (a MEMS gyro's sample is close to the
   // mean rate over it) with the coning term, as a rotation of exact angle.
   const Eigen::Vector3d dtheta = w * dt_s;
-  const Eigen::Vector3d phi = coned_rotation_vector(dtheta_prev_rad_, dtheta);
+  q_ = (q_ * rotation_of(coned_rotation_vector(dtheta_prev_rad_, dtheta))).normalized();
   dtheta_prev_rad_ = dtheta;
-  const double angle = phi.norm();
-  if (angle > 1e-12)
-    q_ = (q_ * Eigen::Quaterniond(Eigen::AngleAxisd(angle, phi / angle))).normalized();
 
   const bool still = w.norm() < params_.stance_gyro_rad_s &&
                      std::abs(f.norm() - g_m_s2_) < params_.stance_acc_m_s2;

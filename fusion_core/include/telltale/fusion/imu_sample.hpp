@@ -126,6 +126,14 @@ struct ImuGateResult {
   return r;
 }
 
+/// The rotation of rotation vector `theta` (rad) as a quaternion, of exact angle. Identity for a
+/// negligible turn.
+[[nodiscard]] inline Eigen::Quaterniond rotation_of(const Eigen::Vector3d& theta) {
+  const double angle = theta.norm();
+  if (!(angle > 1e-12)) return Eigen::Quaterniond::Identity();
+  return Eigen::Quaterniond(Eigen::AngleAxisd(angle, theta / angle));
+}
+
 /// The body's rotation over one sample interval from the rates at both ends (trapezoidal rate,
 /// exact rotation): q such that v_reference = q v_body_after for a vector expressed in the body
 /// frame before (attitude_after = attitude_before * q). A world-fixed vector's coordinates turn
@@ -133,10 +141,7 @@ struct ImuGateResult {
 [[nodiscard]] inline Eigen::Quaterniond interval_rotation(const Eigen::Vector3d& rate_before,
                                                           const Eigen::Vector3d& rate_after,
                                                           double dt_s) {
-  const Eigen::Vector3d theta = 0.5 * (rate_before + rate_after) * dt_s;
-  const double angle = theta.norm();
-  if (!(angle > 1e-12)) return Eigen::Quaterniond::Identity();
-  return Eigen::Quaterniond(Eigen::AngleAxisd(angle, theta / angle));
+  return rotation_of(0.5 * (rate_before + rate_after) * dt_s);
 }
 
 /// Two rules of a strapdown integration that follow from how a sample is made (each sample the
