@@ -47,6 +47,7 @@ bool GaitPhaseStepDetector::update_foot(const ImuSample& s, double dt, StepEvent
   const double w_raw = s.gyro_body_rad_s.norm();
   const double w = rate_lp_.step(w_raw, dt);
   const double acc = std::abs(s.acc_body_m_s2.norm() - kG);
+  if (acc >= params_.stance_acc_m_s2) force_moved_t_s_ = s.t_s;
   if (!in_swing_) {
     if (w <= params_.swing_enter_rad_s) return false;
     in_swing_ = true;
@@ -77,7 +78,12 @@ bool GaitPhaseStepDetector::update_foot(const ImuSample& s, double dt, StepEvent
   // at |f| = g, and the smoothed rate lags into the push-off that follows; a swing both turns
   // and accelerates.
   if (w_raw >= stance) swing_acc_m_s2_ = std::max(swing_acc_m_s2_, acc);
-  if (w >= stance) return false;
+  // Stance is the foot still: it neither turns nor accelerates. The rate alone does not say so:
+  // late in a running swing the foot has stopped turning (level for the landing) while it still
+  // decelerates at 3-6 g, and the slap at its landing then reads as a swing of its own. In the
+  // air ||f| - g| passes through 0 in a few ms; on the ground it stays near 0 once the impact
+  // has rung out.
+  if (w >= stance || s.t_s - force_moved_t_s_ < params_.stance_hold_s) return false;
   in_swing_ = false;
   const bool turned = swing_angle_rad_ >= params_.min_swing_deg * M_PI / 180.0 &&
                       swing_peak_rad_s_ >= params_.min_peak_rad_s;
@@ -88,11 +94,16 @@ bool GaitPhaseStepDetector::update_foot(const ImuSample& s, double dt, StepEvent
   // One foot steps once per gait cycle: a second swing sooner than `interval_fraction` of the
   // recent cycle is the same step in two motions (heel-off then swing, or a landing that
   // settles); the cycle is forgotten after a pause, so a new walk at any pace starts afresh.
-  // The spacing is between landings (a swing's rate may not reverse, its heel strike unknown).
+  // The spacing is between the steps' times: the heel strike, or the landing of a swing whose
+  // rate never reversed. The landing alone (the last moment the rate was half the swing's peak)
+  // is no fixed phase of the cycle: early in a swing whose peak is the toe-off's burst (a jog),
+  // late in one that turns as fast through the swing (a walk), so at a change of pace two
+  // landings came 0.5 s apart for heel strikes 0.82 s apart.
   const double hs = params_.report_heel_strike ? heel_strike_t_s() : -1.0;
   const double trace = swing_cov_.trace();
   if (trace > 0.0) axis_cov_ = params_.axis_keep * axis_cov_ + swing_cov_ / trace;
-  const double since = landing_t_s_ - last_landing_t_s_;
+  const double t_step = hs >= 0.0 ? hs : landing_t_s_;
+  const double since = t_step - last_step_t_s_;
   if (since > params_.pause_s) cycle_s_ = 0.0;
   if (have_step_ &&
       since < std::max(params_.min_step_interval_s, params_.interval_fraction * cycle_s_)) {
@@ -101,8 +112,7 @@ bool GaitPhaseStepDetector::update_foot(const ImuSample& s, double dt, StepEvent
   }
   if (have_step_ && since <= params_.pause_s)
     cycle_s_ = cycle_s_ > 0.0 ? cycle_s_ + 0.3 * (since - cycle_s_) : since;
-  last_landing_t_s_ = landing_t_s_;
-  return emit(hs >= 0.0 ? hs : landing_t_s_, event);
+  return emit(t_step, event);
 }
 
 double GaitPhaseStepDetector::heel_strike_t_s() const {

@@ -41,6 +41,17 @@ double minjerk(double x) {
   x = std::clamp(x, 0.0, 1.0);
   return x * x * x * (10.0 + x * (-15.0 + 6.0 * x));
 }
+/// Into a turning point: 0 -> 1 from rest (zero rate and angular acceleration), arriving at zero
+/// rate but still decelerating (f''(1) = -12). A foot rolling onto its toes reaches its largest
+/// plantar flexion just after toe-off and turns straight back into the swing: its rate crosses
+/// zero there, it does not dwell at zero as a minimum-jerk end would.
+double into_turn(double x) {
+  x = std::clamp(x, 0.0, 1.0);
+  return x * x * x * (4.0 - 3.0 * x);
+}
+/// Out of a turning point: its mirror image, 0 -> 1 leaving zero rate already accelerating
+/// (f''(0) = 12), arriving at rest.
+double out_of_turn(double x) { return 1.0 - into_turn(1.0 - x); }
 double minjerk_acc(double x) {  // second derivative with respect to x
   if (x <= 0.0 || x >= 1.0) return 0.0;
   return 60.0 * x - 180.0 * x * x + 120.0 * x * x * x;
@@ -529,11 +540,11 @@ class Simulator {
           pitch = -hs * (1.0 - minjerk(u / u_slap));
           height = lift * std::sin(-pitch);
         } else if (u >= u_heel_off) {
-          pitch = to * minjerk((u - u_heel_off) / (beta - u_heel_off));
+          pitch = to * into_turn((u - u_heel_off) / (beta - u_heel_off));
         }
       } else {
         const double v = (u - beta) / (1.0 - beta);
-        pitch = to + (-hs - to) * minjerk(v);
+        pitch = to + (-hs - to) * out_of_turn(v);
         s_toe += (s_next - st.s0) * minjerk(v);
         const double s = std::sin(M_PI * v);
         height = row.clearance_m * s * s + lift * std::sin(hs) * minjerk(v);

@@ -22,18 +22,21 @@ namespace telltale::fusion {
 /// heel-to-toe); in swing it turns about the medio-lateral axis by 30-100 deg (toe-off, swing,
 /// heel strike) and its specific force leaves 1 g (push-off, swing, impact). So: a swing starts
 /// when the smoothed |w| exceeds `swing_enter_rad_s`, ends when it falls below the stance level
-/// (`stance_abs_rad_s`, or `stance_fraction` x this swing's peak), and is a step when it turned
-/// through `min_swing_deg`, peaked at `min_peak_rad_s` and |f| left g by `min_acc_m_s2` -- small
-/// enough for the short first step from standing and the closing step, well above a weight shift
-/// while standing (< 0.3 rad/s, < 0.5 m/s^2 on the IPOL recordings). The event time is the
+/// (`stance_abs_rad_s`, or `stance_fraction` x this swing's peak) with the foot's specific force
+/// held within `stance_acc_m_s2` of g for `stance_hold_s` (a foot that has stopped turning in
+/// the air still decelerates at several g; on the ground, once the impact has rung out, it reads
+/// gravity alone: on the IPOL feet any level from 2 to 5 m/s^2 counts the same), and is a step when
+/// it turned through `min_swing_deg`, peaked at `min_peak_rad_s` and |f| left g by `min_acc_m_s2`
+/// -- small enough for the short first step from standing and the closing step, well above a weight
+/// shift while standing (< 0.3 rad/s, < 0.5 m/s^2 on the IPOL recordings). The event time is the
 /// heel strike: the swing turns the foot about its medio-lateral axis (toes up through the swing,
 /// the largest rotation of the cycle); at the end of the swing the rate about that axis reverses
 /// as the heel is lowered, and the heel meets the ground within a few hundredths of a second:
 /// the step is reported at the largest |f| (the impact) within `impact_window_s` after the
 /// reversal (the axis: the principal direction of the swings' rates, learnt over the steps).
 /// A swing whose rate never reverses is reported at its landing (the last moment the rate was
-/// above half the swing's peak, 0.1-0.2 s after the heel strike), which also sets the spacing.
-/// A foot cannot start a new step less than `min_step_interval_s` after its last one (the other
+/// above half the swing's peak, 0.1-0.2 s after the heel strike).
+/// A foot cannot step less than `min_step_interval_s` after its last step's time (the other
 /// foot swings in between: 2.5 cycles/s is beyond a sprint), nor sooner than
 /// `interval_fraction` of its recent cycle: that merges a landing that settles in two motions.
 /// The force excursion counts only while the foot turns (a heel rising over the toes turns at
@@ -76,6 +79,8 @@ struct GaitPhaseStepParams {
   double swing_enter_rad_s = 1.0;    ///< smoothed |w| that starts a swing, rad/s
   double stance_abs_rad_s = 0.5;     ///< smoothed |w| below this is stance, rad/s
   double stance_fraction = 0.25;     ///< ...or below this x the swing's peak |w|
+  double stance_acc_m_s2 = 3.0;      ///< ...and ||f| - g| below this (0.3 g), m/s^2
+  double stance_hold_s = 0.04;       ///< ...for this long, s
   double min_swing_deg = 11.5;       ///< smallest rotation of a step's swing, deg
   double min_peak_rad_s = 1.0;       ///< smallest peak smoothed |w| of a swing, rad/s
   double min_acc_m_s2 = 2.0;         ///< smallest ||f| - g| during a swing, m/s^2
@@ -145,6 +150,7 @@ class GaitPhaseStepDetector final : public StepDetector {
   Params params_;
   StepDiagnostics diag_;
   LowPass2 rate_lp_;
+  double force_moved_t_s_ = -1e9;  ///< last sample whose ||f| - g| was stance_acc_m_s2 or more
   LowPass2 vertical_lp_;
   bool have_t_ = false;
   double last_t_s_ = 0.0;
@@ -156,7 +162,6 @@ class GaitPhaseStepDetector final : public StepDetector {
   double swing_angle_rad_ = 0.0;
   double swing_acc_m_s2_ = 0.0;
   double landing_t_s_ = 0.0;
-  double last_landing_t_s_ = -1e9;  ///< landing of the last step (the spacing rule's time)
   /// The swing's samples (rate, |f|) in a ring: the heel strike is sought at its end.
   static constexpr std::size_t kSwingCapacity = 512;  ///< 1.3 s at 400 Hz, 5 s at 100 Hz
   std::array<double, kSwingCapacity> swing_t_s_{};
