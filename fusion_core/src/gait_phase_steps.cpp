@@ -46,9 +46,17 @@ bool GaitPhaseStepDetector::update_foot(const ImuSample& s, double dt, StepEvent
   // not split a swing, while a stance of 0.1 s still shows.
   const double w_raw = s.gyro_body_rad_s.norm();
   const double w = rate_lp_.step(w_raw, dt);
-  const double acc = std::abs(s.acc_body_m_s2.norm() - kG);
+  // ||f| - g| against the accelerometer's own reading of gravity, learnt while the foot stands
+  // still (a 2-6 % scale error, 0.2-0.6 m/s^2, is common), so that "still" means the same on
+  // every sensor.
+  const double f_norm = s.acc_body_m_s2.norm();
+  const double acc = std::abs(f_norm - g_own_m_s2_);
   if (acc >= params_.stance_acc_m_s2) force_moved_t_s_ = s.t_s;
   if (!in_swing_) {
+    // Learnt while the foot does not turn (not while its force is still: that is judged
+    // against this g, and a sensor reading 20 % high would never seem still).
+    if (w < params_.stance_abs_rad_s && params_.g_tau_s > 0.0)
+      g_own_m_s2_ += dt / (params_.g_tau_s + dt) * (f_norm - g_own_m_s2_);
     if (w <= params_.swing_enter_rad_s) return false;
     in_swing_ = true;
     swing_peak_rad_s_ = w;
@@ -65,7 +73,7 @@ bool GaitPhaseStepDetector::update_foot(const ImuSample& s, double dt, StepEvent
   const std::size_t tail = (swing_head_ + swing_size_++) % kSwingCapacity;
   swing_t_s_[tail] = s.t_s;
   swing_gyro_rad_s_[tail] = s.gyro_body_rad_s;
-  swing_force_m_s2_[tail] = s.acc_body_m_s2.norm();
+  swing_force_m_s2_[tail] = f_norm;
   swing_cov_ += s.gyro_body_rad_s * s.gyro_body_rad_s.transpose();
   swing_angle_rad_ += w * dt;
   swing_peak_rad_s_ = std::max(swing_peak_rad_s_, w);
@@ -80,9 +88,10 @@ bool GaitPhaseStepDetector::update_foot(const ImuSample& s, double dt, StepEvent
   if (w_raw >= stance) swing_acc_m_s2_ = std::max(swing_acc_m_s2_, acc);
   // Stance is the foot still: it neither turns nor accelerates. The rate alone does not say so:
   // late in a running swing the foot has stopped turning (level for the landing) while it still
-  // decelerates at 3-6 g, and the slap at its landing then reads as a swing of its own. In the
-  // air ||f| - g| passes through 0 in a few ms; on the ground it stays near 0 once the impact
-  // has rung out.
+  // decelerates at 3-6 g, and the slap at its landing then reads as a swing of its own; a foot
+  // pivoting on its ball in a turn turns slowly while it is loaded and moving. In the air
+  // ||f| - g| passes through 0 in a few ms; a foot flat on the ground holds it near 0 once the
+  // impact has rung out.
   if (w >= stance || s.t_s - force_moved_t_s_ < params_.stance_hold_s) return false;
   in_swing_ = false;
   const bool turned = swing_angle_rad_ >= params_.min_swing_deg * M_PI / 180.0 &&

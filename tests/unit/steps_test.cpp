@@ -639,6 +639,32 @@ TEST(GaitPhaseStepDetector, FootReportsTheHeelStrike) {
   }
 }
 
+// Given simulated walkers and joggers whose foot accelerometer reads 20 % low or 25 % high (a
+// sensitivity or full-scale setting gone wrong; the IPOL left feet read 2-7 % high), when
+// gait-phase counts their steps, then every step is counted: the foot's stance is judged against
+// the accelerometer's own g, learnt while the foot does not turn. With g fixed at 9.81 m/s^2
+// (g_tau_s 0) the swings of the sensor reading high never end and most steps are lost.
+TEST(GaitPhaseStepDetector, FootCountsEveryStepWhateverItsAccelerometersScale) {
+  for (const char* gait : {"walk", "jog"}) {
+    for (int p = 1; p <= 3; ++p) {
+      const auto seed = static_cast<std::uint64_t>(p);
+      const auto run =
+          sim::simulate_gait(*sim::make_gait_scenario(std::string("foot-") + gait, seed),
+                             sim::random_person(seed), seed);
+      for (double scale : {0.8, 1.25}) {
+        std::vector<ImuSample> samples;
+        for (const auto& s : run.samples) {
+          samples.push_back(s.imu);
+          samples.back().acc_body_m_s2 *= scale;
+        }
+        GaitPhaseStepDetector d;
+        EXPECT_EQ(count_samples(d, samples), run.foot_step_times_s.size())
+            << gait << " walker " << p << " scale " << scale;
+      }
+    }
+  }
+}
+
 // --- real phone traces --------------------------------------------------------------------------
 // Oxford step counter traces (CC BY 4.0, see tests/data/oxford_steps/README.md): 24 traces,
 // 7 carrying positions, 3 phones, accelerometer only. Metric of the dataset: mean count accuracy.

@@ -21,13 +21,15 @@ namespace telltale::fusion {
 /// standing, below ~0.25 x the swing's peak rate in a brisk walk, whose stance still rolls
 /// heel-to-toe); in swing it turns about the medio-lateral axis by 30-100 deg (toe-off, swing,
 /// heel strike) and its specific force leaves 1 g (push-off, swing, impact). So: a swing starts
-/// when the smoothed |w| exceeds `swing_enter_rad_s`, ends when it falls below the stance level
-/// (`stance_abs_rad_s`, or `stance_fraction` x this swing's peak) with the foot's specific force
-/// held within `stance_acc_m_s2` of g for `stance_hold_s` (a foot that has stopped turning in
-/// the air still decelerates at several g; on the ground, once the impact has rung out, it reads
-/// gravity alone: on the IPOL feet any level from 2 to 5 m/s^2 counts the same), and is a step when
-/// it turned through `min_swing_deg`, peaked at `min_peak_rad_s` and |f| left g by `min_acc_m_s2`
-/// -- small enough for the short first step from standing and the closing step, well above a weight
+/// when the smoothed |w| exceeds `swing_enter_rad_s` and ends when the foot is still again: the
+/// rate below the stance level (`stance_abs_rad_s`, or `stance_fraction` x this swing's peak)
+/// and |f| within `stance_acc_m_s2` of the accelerometer's own g (|f| averaged over `g_tau_s` of
+/// stance: the IPOL left feet read 10.0-10.5 m/s^2 standing) for `stance_hold_s`. A foot that
+/// has stopped turning in the air still decelerates at several g, one pivoting on its ball in a
+/// turn before it swings is loaded and moving; a foot flat on the ground reads gravity alone
+/// once the impact has rung out. A swing is a step when it turned through `min_swing_deg`,
+/// peaked at `min_peak_rad_s` and |f| left g by `min_acc_m_s2` -- small enough for the short
+/// first step from standing and the closing step, well above a weight
 /// shift while standing (< 0.3 rad/s, < 0.5 m/s^2 on the IPOL recordings). The event time is the
 /// heel strike: the swing turns the foot about its medio-lateral axis (toes up through the swing,
 /// the largest rotation of the cycle); at the end of the swing the rate about that axis reverses
@@ -79,8 +81,9 @@ struct GaitPhaseStepParams {
   double swing_enter_rad_s = 1.0;    ///< smoothed |w| that starts a swing, rad/s
   double stance_abs_rad_s = 0.5;     ///< smoothed |w| below this is stance, rad/s
   double stance_fraction = 0.25;     ///< ...or below this x the swing's peak |w|
-  double stance_acc_m_s2 = 3.0;      ///< ...and ||f| - g| below this (0.3 g), m/s^2
+  double stance_acc_m_s2 = 2.0;      ///< ...and ||f| - own g| below this, m/s^2
   double stance_hold_s = 0.04;       ///< ...for this long, s
+  double g_tau_s = 2.0;              ///< |f| averaged over stances: the accelerometer's own g, s
   double min_swing_deg = 11.5;       ///< smallest rotation of a step's swing, deg
   double min_peak_rad_s = 1.0;       ///< smallest peak smoothed |w| of a swing, rad/s
   double min_acc_m_s2 = 2.0;         ///< smallest ||f| - g| during a swing, m/s^2
@@ -150,6 +153,7 @@ class GaitPhaseStepDetector final : public StepDetector {
   Params params_;
   StepDiagnostics diag_;
   LowPass2 rate_lp_;
+  double g_own_m_s2_ = kStandardGravity_m_s2;  ///< |f| of this accelerometer with the foot still
   double force_moved_t_s_ = -1e9;  ///< last sample whose ||f| - g| was stance_acc_m_s2 or more
   LowPass2 vertical_lp_;
   bool have_t_ = false;
