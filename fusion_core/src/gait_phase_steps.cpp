@@ -8,11 +8,6 @@
 #include "telltale/fusion/small_median.hpp"
 
 namespace telltale::fusion {
-namespace {
-
-constexpr double kG = kStandardGravity_m_s2;
-
-}  // namespace
 
 GaitPhaseStepDetector::GaitPhaseStepDetector(Params params)
     : params_(params), rate_lp_(params.rate_cutoff_hz), vertical_lp_(params.vertical_cutoff_hz) {}
