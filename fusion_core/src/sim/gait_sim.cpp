@@ -513,7 +513,7 @@ class Simulator {
             Eigen::Vector3d& impact_w) const {
     impact_w.setZero();
     auto k = step_index(t);
-    double s_toe = 0, height = 0, pitch = 0;
+    double s_toe = 0, height = 0, pitch = 0, roll = 0, yaw = 0;
     const double lift = 0.26 * p_.height_m / 1.75;  // foot length, m
     if (k < 0) {
       s_toe = 0.3;
@@ -538,6 +538,7 @@ class Simulator {
       if (u < beta) {
         if (u < u_slap && !first) {
           pitch = -hs * (1.0 - minjerk(u / u_slap));
+          roll = p_.strike_roll_deg * kDeg * (1.0 - minjerk(u / u_slap));
           height = lift * std::sin(-pitch);
         } else if (u >= u_heel_off) {
           pitch = to * into_turn((u - u_heel_off) / (beta - u_heel_off));
@@ -548,6 +549,8 @@ class Simulator {
         s_toe += (s_next - st.s0) * minjerk(v);
         const double s = std::sin(M_PI * v);
         height = row.clearance_m * s * s + lift * std::sin(hs) * minjerk(v);
+        roll = (p_.swing_roll_deg * s * s + p_.strike_roll_deg * minjerk(v)) * kDeg;
+        yaw = p_.swing_yaw_deg * kDeg * s * s;
       }
       // Heel-strike and foot-flat impacts (decaying ringing of shoe and tissue).
       const double speed = (s_next - st.s0) / tc;
@@ -564,7 +567,7 @@ class Simulator {
     double heading, x, y;
     const Eigen::Matrix3d r_wf = walk_frame(s_toe, &heading, nullptr, &x, &y);
     pos = Eigen::Vector3d(x, y, height) + r_wf * Eigen::Vector3d(0.0, 0.1, 0.0);
-    r_ws = r_wf * rot_z(-7.0 * kDeg) * rot_y(pitch);  // 7 deg toe-out
+    r_ws = r_wf * rot_z(-7.0 * kDeg + yaw) * rot_y(pitch) * rot_x(roll);  // 7 deg toe-out
     impact_w = r_wf * impact_w;
   }
 
@@ -705,6 +708,10 @@ Person random_person(std::uint64_t seed) {
     p.mount_yaw_deg[i] = 2.0 * rng.normal();
     p.mount_tilt_deg[i] = 6.0 * rng.normal();
   }
+  // Drawn last, so that every person's other figures stay what they were.
+  p.swing_roll_deg = rng.uniform(4.0, 12.0);
+  p.swing_yaw_deg = rng.uniform(3.0, 9.0);
+  p.strike_roll_deg = rng.uniform(2.0, 8.0);
   return p;
 }
 

@@ -77,6 +77,13 @@ struct Person {
   double arm_swing_deg = 30.0;    ///< amplitude of the arm pendulum (arm-swing pose)
   double toe_off_deg = 35.0;      ///< peak toe-down pitch at toe-off
   double heel_strike_deg = 20.0;  ///< toe-up pitch at heel strike
+  /// The foot's turns off its pitch (a real foot's swing turns about its long axis and the
+  /// vertical at 0.3-1 x its pitch rate, IPOL feet): inversion at mid-swing (deg), the toes'
+  /// swing in and out at mid-swing (deg), and the inversion it lands with, everted flat by foot
+  /// flat (deg).
+  double swing_roll_deg = 8.0;
+  double swing_yaw_deg = 6.0;
+  double strike_roll_deg = 5.0;
   double mount_yaw_deg[kPoseCount] = {0, 0, 0, 0};   ///< phone yaw misalignment per pose
   double mount_tilt_deg[kPoseCount] = {0, 0, 0, 0};  ///< phone tilt misalignment per pose
 };
