@@ -103,9 +103,11 @@ bool GaitPhaseStepDetector::update_foot(const ImuSample& s, double dt, StepEvent
   // is no fixed phase of the cycle: early in a swing whose peak is the toe-off's burst (a jog),
   // late in one that turns as fast through the swing (a walk), so at a change of pace two
   // landings came 0.5 s apart for heel strikes 0.82 s apart.
-  const double hs = params_.report_heel_strike ? heel_strike_t_s() : -1.0;
+  Eigen::Vector3d toes_up = Eigen::Vector3d::Zero();
+  const double hs = params_.report_heel_strike ? heel_strike_t_s(toes_up) : -1.0;
   const double trace = swing_cov_.trace();
   if (trace > 0.0) axis_cov_ = params_.axis_keep * axis_cov_ + swing_cov_ / trace;
+  toes_up_ = params_.axis_keep * toes_up_ + toes_up;
   const double t_step = hs >= 0.0 ? hs : landing_t_s_;
   const double since = t_step - last_step_t_s_;
   if (since > params_.pause_s) cycle_s_ = 0.0;
@@ -119,37 +121,52 @@ bool GaitPhaseStepDetector::update_foot(const ImuSample& s, double dt, StepEvent
   return emit(t_step, event);
 }
 
-double GaitPhaseStepDetector::heel_strike_t_s() const {
+double GaitPhaseStepDetector::heel_strike_t_s(Eigen::Vector3d& toes_up) const {
   // Toes down at push-off, toes up through the swing (the largest rotation of the cycle), toes
   // down again as the heel is lowered: the swing's end is where the rate about the medio-lateral
-  // axis leaves the sign of the run that turned the foot through the largest angle. The heel
-  // then meets the ground: the impact is the largest |f| shortly after (the annotated heel
+  // axis leaves the sign of the toes-up run that turned the foot through the largest angle. The
+  // heel then meets the ground: the impact is the largest |f| shortly after (the annotated heel
   // strikes of the IPOL recordings are 0.02-0.08 s after the reversal).
+  // Which sense is toes up: the sense of the swings' largest runs, learnt over the steps
+  // (`toes_up_`), because a swing that begins with a pivot on the ball of the foot in a turn
+  // turns the foot the other way first, sometimes further than the swing itself (IPOL 2-3_lf at
+  // 18.1-18.9 s), and that run ends at the toe-off. Until the swings have agreed on it
+  // (`toes_up_sure`: a walk's first step from standing can roll the foot further over its toes
+  // than it swings), the largest run of either sense.
+  toes_up.setZero();
   if (swing_size_ < 3) return -1.0;
   const double trace = swing_cov_.trace();
   const Eigen::Matrix3d cov =
       trace > 0.0 ? Eigen::Matrix3d(axis_cov_ + swing_cov_ / trace) : axis_cov_;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
   eig.computeDirect(cov);
-  const Eigen::Vector3d axis = eig.eigenvectors().col(2);  // the largest eigenvalue's
+  Eigen::Vector3d axis = eig.eigenvectors().col(2);  // the largest eigenvalue's
+  if (axis.dot(toes_up_) < 0.0) axis = -axis;
+  const bool sense_known = axis.dot(toes_up_) >= params_.toes_up_sure;
   const auto at = [this](std::size_t i) { return (swing_head_ + i) % kSwingCapacity; };
-  double best = 0.0, area = 0.0;
-  std::size_t best_last = swing_size_;  // last sample of the largest run
+  double best = 0.0, largest = 0.0, area = 0.0;
+  std::size_t best_last = swing_size_;  // last sample of the largest toes-up run
   int sign = 0;
+  const auto end_run = [&](std::size_t last) {
+    if (std::abs(area) > std::abs(largest)) largest = area;
+    if ((!sense_known || area > 0.0) && std::abs(area) > best) {
+      best = std::abs(area);
+      best_last = last;
+    }
+  };
   for (std::size_t i = 0; i < swing_size_; ++i) {
     const double p = swing_gyro_rad_s_[at(i)].dot(axis);
     const int sg = p > 0.0 ? 1 : p < 0.0 ? -1 : sign;
     if (sg != sign) {
-      if (std::abs(area) > best) {
-        best = std::abs(area);
-        best_last = i - 1;
-      }
+      if (sign != 0) end_run(i - 1);
       sign = sg;
       area = 0.0;
     }
     if (i > 0) area += p * (swing_t_s_[at(i)] - swing_t_s_[at(i - 1)]);
   }
-  if (std::abs(area) > best || best_last + 1 >= swing_size_) return -1.0;  // never reversed
+  end_run(swing_size_ - 1);  // the run still going: no reversal after it in this swing
+  if (largest != 0.0) toes_up = largest > 0.0 ? axis : Eigen::Vector3d(-axis);
+  if (best_last + 1 >= swing_size_) return -1.0;  // never reversed
   const std::size_t a = at(best_last), b = at(best_last + 1);
   const double pa = swing_gyro_rad_s_[a].dot(axis), pb = swing_gyro_rad_s_[b].dot(axis);
   const double f = pa != pb ? pa / (pa - pb) : 0.0;

@@ -91,6 +91,9 @@ struct GaitPhaseStepParams {
   bool report_heel_strike = true;    ///< report the heel strike (false: the landing)
   double impact_window_s = 0.05;     ///< the impact is sought this long after the reversal, s
   double axis_keep = 0.9;            ///< memory of the medio-lateral axis, per step
+  /// The toes-up sense is used once the swings' largest runs add up to this along the axis (each
+  /// counts 1, forgotten by axis_keep a step: two or three swings that agree).
+  double toes_up_sure = 2.0;
   double min_step_interval_s = 0.4;  ///< same foot, between step events, s
   double interval_fraction = 0.6;    ///< ...and at least this x the recent gait cycle
   // Body.
@@ -147,8 +150,9 @@ class GaitPhaseStepDetector final : public StepDetector {
   /// Body: the oldest held step that may go, as `event`.
   bool release_body_step(StepEvent& event);
   /// Foot: the heel strike of the swing just ended, or -1 when the rate about the medio-lateral
-  /// axis never reversed.
-  [[nodiscard]] double heel_strike_t_s() const;
+  /// axis never reversed; `toes_up` is the sense of this swing's largest run (the axis or its
+  /// opposite).
+  [[nodiscard]] double heel_strike_t_s(Eigen::Vector3d& toes_up) const;
 
   Params params_;
   StepDiagnostics diag_;
@@ -177,6 +181,8 @@ class GaitPhaseStepDetector final : public StepDetector {
   /// The steps' swings, each of unit trace, forgotten by `axis_keep` a step: the foot's
   /// medio-lateral axis in the sensor frame is its principal direction.
   Eigen::Matrix3d axis_cov_ = Eigen::Matrix3d::Zero();
+  /// The sense of the swings' largest runs about that axis (toes up), forgotten as it is.
+  Eigen::Vector3d toes_up_ = Eigen::Vector3d::Zero();
   double cycle_s_ = 0.0;  ///< recent interval between this foot's steps (0: none since a pause)
   // Body: gravity in the sensor frame and the oscillation's extremes.
   Eigen::Vector3d gravity_m_s2_ = Eigen::Vector3d::Zero();
