@@ -73,6 +73,25 @@ TEST(GaitSim, PhoneRateStaysPhysicalWhenTheWalkStartsAndStops) {
   }
 }
 
+// The foot's closing heel strike slaps it flat as every heel strike does: around it the gyro
+// reads no more than the swings before it turned the foot (the foot once snapped flat in one
+// sample there, 35 rad/s for 4 ms, 20 deg of rotation that never happened).
+TEST(GaitSim, FootRateStaysPhysicalWhenTheWalkStops) {
+  for (const char* name : {"foot-slow-walk", "foot-walk", "foot-run"}) {
+    for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+      const auto run = simulate_gait(*make_gait_scenario(name, seed), random_person(seed), seed);
+      const double t_close = run.foot_step_times_s.back();
+      double walk = 0.0, closing = 0.0;
+      for (const auto& s : run.samples) {
+        const double w = s.imu.gyro_body_rad_s.norm();
+        if (s.imu.t_s < t_close - 0.5) walk = std::max(walk, w);
+        if (std::abs(s.imu.t_s - t_close) < 0.2) closing = std::max(closing, w);
+      }
+      EXPECT_LT(closing, walk) << name << " seed " << seed;
+    }
+  }
+}
+
 // Walking: the truth counts, distance and foot/body relation add up, and the mean vertical
 // specific force over the walk is g (no net vertical acceleration).
 TEST(GaitSim, TruthBookkeepingAddsUp) {

@@ -517,24 +517,31 @@ class Simulator {
     const double lift = 0.26 * p_.height_m / 1.75;  // foot length, m
     if (k < 0) {
       s_toe = 0.3;
-    } else if (k >= static_cast<std::ptrdiff_t>(steps_.size())) {
-      s_toe = s_end_ + 0.3;
     } else {
-      if (k % 2 == 1) --k;  // the left foot's cycle starts at even steps
-      const Step& st = steps_[static_cast<std::size_t>(k)];
+      // The left foot's cycle: from its heel strike (even steps) to its next. After the walk's
+      // closing heel strike (t_end_) the foot stays on the ground: a cycle that never lifts,
+      // whose heel strike still slaps the foot flat and rings (until December 2026 the foot
+      // snapped flat in one sample there: 35 rad/s for 4 ms).
+      const bool closing = k >= static_cast<std::ptrdiff_t>(steps_.size());
+      if (!closing && k % 2 == 1) --k;
+      const Step& st = closing ? steps_.back() : steps_[static_cast<std::size_t>(k)];
       const std::size_t k2 = static_cast<std::size_t>(k) + 2;
-      const double t_next = k2 < steps_.size() ? steps_[k2].t0 : t_end_;
-      const double s_next = k2 < steps_.size() ? steps_[k2].s0 : s_end_;
+      const double t0 = closing ? t_end_ : st.t0;
+      const double s0 = closing ? s_end_ : st.s0;
+      const double t_next = closing              ? t_end_ + 2.0 * st.period_s
+                            : k2 < steps_.size() ? steps_[k2].t0
+                                                 : t_end_;
+      const double s_next = closing ? s_end_ : k2 < steps_.size() ? steps_[k2].s0 : s_end_;
       const GaitRow& row = kGaitTable[static_cast<std::size_t>(st.gait)];
-      const double tc = t_next - st.t0;
-      const double u = (t - st.t0) / tc;
+      const double tc = t_next - t0;
       const double beta = row.stance_fraction;
       const double hs = (row.running ? 0.5 : 1.0) * p_.heel_strike_deg * kDeg;
       const double to = (row.running ? 1.15 : 1.0) * p_.toe_off_deg * kDeg;
       const double u_slap = row.running ? 0.05 : 0.10;
+      const double u = closing ? std::min((t - t0) / tc, u_slap) : (t - t0) / tc;  // flat after
       const double u_heel_off = beta - (row.running ? 0.15 : 0.22);
       const bool first = k == 0;  // the walk starts from a standing foot: no heel strike
-      s_toe = st.s0 + 0.3;
+      s_toe = s0 + 0.3;
       if (u < beta) {
         if (u < u_slap && !first) {
           pitch = -hs * (1.0 - minjerk(u / u_slap));
@@ -546,20 +553,20 @@ class Simulator {
       } else {
         const double v = (u - beta) / (1.0 - beta);
         pitch = to + (-hs - to) * out_of_turn(v);
-        s_toe += (s_next - st.s0) * minjerk(v);
+        s_toe += (s_next - s0) * minjerk(v);
         const double s = std::sin(M_PI * v);
         height = row.clearance_m * s * s + lift * std::sin(hs) * minjerk(v);
         roll = (p_.swing_roll_deg * s * s + p_.strike_roll_deg * minjerk(v)) * kDeg;
         yaw = p_.swing_yaw_deg * kDeg * s * s;
       }
       // Heel-strike and foot-flat impacts (decaying ringing of shoe and tissue).
-      const double speed = (s_next - st.s0) / tc;
+      const double speed = closing ? (s_end_ - steps_.back().s0) / st.period_s : (s_next - s0) / tc;
       const double amp = (row.running ? 9.0 : 6.0) * speed + 5.0;
-      const double t_in = t - st.t0;
+      const double t_in = t - t0;
       if (!first) {
         impact_w.z() += amp * std::exp(-t_in / 0.012) * std::sin(kTwoPi * 30.0 * t_in);
         impact_w.x() -= 0.5 * amp * std::exp(-t_in / 0.012) * std::sin(kTwoPi * 25.0 * t_in);
-        const double t_ff = t - (st.t0 + u_slap * tc);
+        const double t_ff = t - (t0 + u_slap * tc);
         if (t_ff > 0.0)
           impact_w.z() += 0.4 * amp * std::exp(-t_ff / 0.01) * std::sin(kTwoPi * 35.0 * t_ff);
       }
