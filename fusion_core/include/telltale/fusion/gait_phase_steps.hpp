@@ -35,7 +35,9 @@ namespace telltale::fusion {
 /// the largest rotation of the cycle); at the end of the swing the rate about that axis reverses
 /// as the heel is lowered, and the heel meets the ground within a few hundredths of a second:
 /// the step is reported at the largest |f| (the impact) within `impact_window_s` after the
-/// reversal (the axis: the principal direction of the swings' rates, learnt over the steps).
+/// reversal (the axis: the principal direction of the swings' rates, learnt over the steps;
+/// the run: of the toes-up sense, that of the swings' largest runs, so that a pivot on the ball
+/// of the foot before a swing, which turns it the other way, is not taken for the swing).
 /// A swing whose rate never reverses is reported at its landing (the last moment the rate was
 /// above half the swing's peak, 0.1-0.2 s after the heel strike).
 /// A foot cannot step less than `min_step_interval_s` after its last step's time (the other
