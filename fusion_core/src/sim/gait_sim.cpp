@@ -515,7 +515,7 @@ class Simulator {
     auto k = step_index(t);
     double s_toe = 0, height = 0, pitch = 0, roll = 0, yaw = 0;
     const double lift = 0.26 * p_.height_m / 1.75;  // foot length, m
-    if (k < 0) {
+    if (k < 0 || steps_.empty()) {
       s_toe = 0.3;
     } else {
       // The left foot's cycle: from its heel strike (even steps) to its next. After the walk's
