@@ -45,13 +45,12 @@ bool GaitPhaseStepDetector::update_foot(const ImuSample& s, double dt, StepEvent
   // still (a 2-6 % scale error, 0.2-0.6 m/s^2, is common), so that "still" means the same on
   // every sensor.
   const double f_norm = s.acc_body_m_s2.norm();
-  const double acc = std::abs(f_norm - g_own_m_s2_);
+  const double acc = std::abs(f_norm - g_.g_m_s2);
   if (acc >= params_.stance_acc_m_s2) force_moved_t_s_ = s.t_s;
   if (!in_swing_) {
     // Learnt while the foot does not turn (not while its force is still: that is judged
     // against this g, and a sensor reading 20 % high would never seem still).
-    if (w < params_.stance_abs_rad_s && params_.g_tau_s > 0.0)
-      g_own_m_s2_ += dt / (params_.g_tau_s + dt) * (f_norm - g_own_m_s2_);
+    if (w < params_.stance_abs_rad_s) g_.still(f_norm, dt, params_.g_tau_s);
     if (w <= params_.swing_enter_rad_s) return false;
     in_swing_ = true;
     swing_peak_rad_s_ = w;

@@ -32,7 +32,7 @@ bool FootIns::update(const ImuSample& s, double dt_s) {
   dtheta_prev_rad_ = dtheta;
 
   const bool still = w.norm() < params_.stance_gyro_rad_s &&
-                     std::abs(f.norm() - g_m_s2_) < params_.stance_acc_m_s2;
+                     std::abs(f.norm() - g_.g_m_s2) < params_.stance_acc_m_s2;
   still_s_ = still ? still_s_ + dt_s : 0.0;
   if (waiting_) {
     if (still_s_ < params_.stance_min_s) return false;
@@ -45,7 +45,7 @@ bool FootIns::update(const ImuSample& s, double dt_s) {
       // a horizontal axis: the yaw stays), and learn the accelerometer's g.
       q_ = Eigen::Quaterniond::FromTwoVectors(q_ * f, Eigen::Vector3d::UnitZ()) * q_;
       q_.normalize();
-      g_m_s2_ += std::min(1.0, dt_s / params_.g_tau_s) * (f.norm() - g_m_s2_);
+      g_.still(f.norm(), dt_s, params_.g_tau_s);
       return false;
     }
     stance_ = false;  // the swing begins at this sample
@@ -55,7 +55,7 @@ bool FootIns::update(const ImuSample& s, double dt_s) {
   }
   // Swing: navigate. The specific force in the world less gravity is the acceleration.
   const Eigen::Vector3d a =
-      q_ * force_at_its_instant(f, dtheta) - Eigen::Vector3d(0.0, 0.0, g_m_s2_);
+      q_ * force_at_its_instant(f, dtheta) - Eigen::Vector3d(0.0, 0.0, g_.g_m_s2);
   v_ += a * dt_s;
   p_ += v_ * dt_s;
   swing_s_ += dt_s;

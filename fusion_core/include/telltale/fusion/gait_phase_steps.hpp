@@ -6,6 +6,7 @@
 #include <array>
 #include <cstddef>
 
+#include "telltale/fusion/imu_sample.hpp"
 #include "telltale/fusion/steps.hpp"
 
 namespace telltale::fusion {
@@ -159,7 +160,7 @@ class GaitPhaseStepDetector final : public StepDetector {
   Params params_;
   StepDiagnostics diag_;
   LowPass2 rate_lp_;
-  double g_own_m_s2_ = kStandardGravity_m_s2;  ///< |f| of this accelerometer with the foot still
+  OwnGravity g_;                   ///< learnt while the foot does not turn
   double force_moved_t_s_ = -1e9;  ///< last sample whose ||f| - g| was stance_acc_m_s2 or more
   LowPass2 vertical_lp_;
   bool have_t_ = false;

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -174,5 +175,17 @@ struct ImuGateResult {
   const Eigen::Vector3d fa = f.cross(a);
   return f + fa - 0.5 * a.cross(fa);
 }
+
+/// The accelerometer's own reading of gravity: |f| averaged over `tau_s` while the sensor is
+/// still, so that "|f| near g" means the same on every part (a MEMS accelerometer's scale error
+/// of 2-6 % is 0.2-0.6 m/s^2; the IPOL left feet read 10.0-10.5 m/s^2 standing). The foot's INS
+/// and the foot's step detector judge stillness against it; each says when it is still.
+struct OwnGravity {
+  double g_m_s2 = kStandardGravity_m_s2;
+  /// A still sample of |f| (m/s^2), dt_s after the last; tau_s <= 0 keeps the standard value.
+  void still(double f_norm_m_s2, double dt_s, double tau_s) {
+    if (tau_s > 0.0) g_m_s2 += std::min(1.0, dt_s / tau_s) * (f_norm_m_s2 - g_m_s2);
+  }
+};
 
 }  // namespace telltale::fusion

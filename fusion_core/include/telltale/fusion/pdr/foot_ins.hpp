@@ -80,7 +80,7 @@ class FootIns {
   Eigen::Vector3d v_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d p_ = Eigen::Vector3d::Zero();  ///< since the last stance
   Eigen::Vector2d stride_m_ = Eigen::Vector2d::Zero();
-  double g_m_s2_ = kStandardGravity_m_s2;
+  OwnGravity g_;          ///< learnt over the stances
   double still_s_ = 0.0;  ///< how long the stance test has held
   double swing_s_ = 0.0;  ///< since the last stance ended
   bool stance_ = true;    ///< a walk starts from standing
