@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <type_traits>
 
 #include "telltale/fusion/attitude_speed.hpp"
 #include "telltale/fusion/resample.hpp"
@@ -109,6 +111,19 @@ InclinationTrial resample_trial(const InclinationTrial& trial, double rate_hz) {
     out.scored.push_back(trial.scored[r.last]);
   }
   return out;
+}
+
+std::size_t first_scored(const InclinationTrial& trial) {
+  const auto it = std::find(trial.scored.begin(), trial.scored.end(), 1);
+  return static_cast<std::size_t>(it - trial.scored.begin());
+}
+
+InclinationTrial trial_from(const InclinationTrial& trial, std::size_t from) {
+  const auto cut = [from](const auto& v) {
+    using V = std::decay_t<decltype(v)>;
+    return from >= v.size() ? V{} : V(v.begin() + static_cast<std::ptrdiff_t>(from), v.end());
+  };
+  return {cut(trial.imu), cut(trial.heel_true_rad), cut(trial.pitch_true_rad), cut(trial.scored)};
 }
 
 double inclination_rmse_deg(AttitudeFilter& filter, const InclinationTrial& trial) {

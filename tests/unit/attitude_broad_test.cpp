@@ -174,6 +174,62 @@ TEST(Broad, AtThePapersRateTheStrapdownFollowsFastRotation) {
   EXPECT_LT(e08, 1.5);
 }
 
+/// Every trial of tests/data/broad: the seven and 29.
+std::vector<std::string> all_trials() {
+  std::vector<std::string> v(std::begin(kTrials), std::end(kTrials));
+  v.emplace_back("29_disturbed_stationary_magnet_B");
+  return v;
+}
+
+// Started in motion (at each trial's first movement row, nothing learnt at the rest the
+// recording begins with; `fusion_cli eval attitude` prints every filter so): until tau has
+// passed, the low-pass is the growing mean of everything since the start, whose drift is not
+// the Butterworth's response to a bias, scale or skew, so the motion update does not learn from
+// it. Measured 0.26, 0.78, 0.77, 0.65, 9.16, 0.77, 0.77, 2.84 deg (mean 2.00; 16's hand shakes
+// the sensor at 1-2 g from its first sample, before any bias is known). Bound: the slow rotation,
+// the slow translation and the tapping (02, 11, 25) under 1.0 deg each, the mean under 2.2. Seen
+// failing with the motion update running on the growing mean: 0.66, 1.61, 1.88 on those three
+// (the skew learnt 16 ms in the first second and unlearnt over a minute), mean 2.39.
+TEST(Broad, StartedInMotionTheFilterLearnsNothingFromItsGrowingMean) {
+  double sum = 0.0;
+  const auto trials = all_trials();
+  for (const auto& trial : trials) {
+    const InclinationTrial data = read_trial(trial);
+    TelltaleAttitudeFilter filter;
+    const double e = inclination_rmse_deg(filter, trial_from(data, first_scored(data)));
+    std::printf("  %s started in motion: %.3f deg\n", trial.c_str(), e);
+    sum += e;
+    if (trial.starts_with("02") || trial.starts_with("11") || trial.starts_with("25")) {
+      EXPECT_LT(e, 1.0) << trial;
+    }
+  }
+  EXPECT_LT(sum / static_cast<double>(trials.size()), 2.2);
+}
+
+// A node restarted in motion with the calibration it had learnt (warm_start; the boat node keeps
+// it in a file across restarts): each trial's filter run over the rest before its first
+// movement row, then a new filter started there from its calibration(). Measured 0.31, 0.58,
+// 0.80, 0.44, 0.46, 0.38, 0.36, 0.82 deg (mean 0.52; never stopped: 0.49). Bound: mean <= 0.6,
+// every trial < 1.0. Seen failing with the calibration not handed over (a cold start: mean 2.00,
+// 16 9.16).
+TEST(Broad, RestartedWithItsCalibrationTheFilterIsAsGoodAsNeverStopped) {
+  double sum = 0.0;
+  const auto trials = all_trials();
+  for (const auto& trial : trials) {
+    const InclinationTrial data = read_trial(trial);
+    const std::size_t from = first_scored(data);
+    TelltaleAttitudeFilter before;
+    for (std::size_t i = 0; i < from; ++i) before.update(data.imu[i]);
+    TelltaleAttitudeFilter after;
+    ASSERT_TRUE(after.warm_start(before.calibration(), 0.0));
+    const double e = inclination_rmse_deg(after, trial_from(data, from));
+    std::printf("  %s restarted in motion: %.3f deg\n", trial.c_str(), e);
+    EXPECT_LT(e, 1.0) << trial;
+    sum += e;
+  }
+  EXPECT_LE(sum / static_cast<double>(trials.size()), 0.6);
+}
+
 // The boat node stamps samples with Unix time, the recordings from 0: the filter must read the
 // same tilt either way. Its durations come from differences of time stamps, which at Unix time
 // carry 2^-22 s of rounding (7e-5 of a 286 Hz interval): measured 0.0016 deg at most over the

@@ -343,6 +343,68 @@ TEST(TelltaleAttitudeFilter, StateRoundTripsExactly) {
   }
 }
 
+// A restart's calibration (warm_start): the bias, scale and skew start where they were, their
+// variances grown by the filter's own walks over the time the node was off; a variance that
+// reaches its prior is the prior again, uncorrelated. A calibration this filter could not have
+// learnt is refused and the priors stay. Seen failing with the age ignored (the variance stays
+// at 1e-8) and with a bias beyond the clamp taken.
+TEST(TelltaleAttitudeFilter, WarmStartGrowsTheCalibrationByItsAgeAndRefusesTheImpossible) {
+  const TelltaleAttitudeParams p;
+  TelltaleCalibration c;
+  c.bias_rad_s = {0.01, -0.02, 0.003};
+  c.gyro_scale = 0.004;
+  c.acc_skew_s = -0.003;
+  c.cov.diagonal() << 1e-8, 1e-8, 1e-8, 1e-6, 4e-6;
+  c.cov(0, 3) = c.cov(3, 0) = 5e-8;
+  ImuSample s;
+  s.t_s = 0.0;
+  s.acc_body_m_s2 = {0.0, 0.0, kG};
+  {
+    TelltaleAttitudeFilter f;
+    ASSERT_TRUE(f.warm_start(c, 600.0));
+    f.update(s);  // the first sample starts the filter from it
+    const TelltaleCalibration got = f.calibration();
+    EXPECT_EQ(got.bias_rad_s, c.bias_rad_s);
+    EXPECT_EQ(got.gyro_scale, c.gyro_scale);
+    EXPECT_EQ(got.acc_skew_s, c.acc_skew_s);
+    const double sm2 = p.bias_sigma_motion_rad_s * p.bias_sigma_motion_rad_s;
+    EXPECT_NEAR(got.cov(0, 0), 1e-8 + sm2 * 600.0 / p.bias_forgetting_s, 1e-15);
+    EXPECT_EQ(got.cov(0, 3), 5e-8);
+  }
+  {
+    // A day off: every variance back at its prior, the correlation gone.
+    TelltaleAttitudeFilter f;
+    ASSERT_TRUE(f.warm_start(c, 86400.0 * 30));
+    f.update(s);
+    const TelltaleCalibration got = f.calibration();
+    EXPECT_EQ(got.cov(0, 0), p.bias_sigma_init_rad_s * p.bias_sigma_init_rad_s);
+    EXPECT_EQ(got.cov(3, 3), p.gyro_scale_sigma_init * p.gyro_scale_sigma_init);
+    EXPECT_EQ(got.cov(0, 3), 0.0);
+  }
+  const auto refused = [&](TelltaleCalibration bad, double age_s) {
+    TelltaleAttitudeFilter f;
+    const bool taken = f.warm_start(bad, age_s);
+    f.update(s);
+    const TelltaleCalibration got = f.calibration();
+    return !taken && got.bias_rad_s.isZero() && got.gyro_scale == 0.0 &&
+           got.cov(0, 0) == p.bias_sigma_init_rad_s * p.bias_sigma_init_rad_s;
+  };
+  TelltaleCalibration bad = c;
+  bad.bias_rad_s.x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_TRUE(refused(bad, 0.0));
+  bad = c;
+  bad.bias_rad_s.y() = 2.0 * p.max_bias_rad_s;
+  EXPECT_TRUE(refused(bad, 0.0));
+  bad = c;
+  bad.gyro_scale = 2.0 * p.max_gyro_scale;
+  EXPECT_TRUE(refused(bad, 0.0));
+  bad = c;
+  bad.cov(2, 2) = -1e-9;
+  EXPECT_TRUE(refused(bad, 0.0));
+  EXPECT_TRUE(refused(c, -1.0));
+  EXPECT_TRUE(refused(c, std::numeric_limits<double>::infinity()));
+}
+
 // The GNSS speed is held between fixes and forgotten when old; the rates come from two fixes,
 // the course's the short way round through north; a no-fix forgets everything.
 TEST(GroundSpeedHold, HoldsRatesAndForgets) {

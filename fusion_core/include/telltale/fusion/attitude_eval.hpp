@@ -53,6 +53,13 @@ struct InclinationTrial {
 /// trial is returned as it is.
 [[nodiscard]] InclinationTrial resample_trial(const InclinationTrial& trial, double rate_hz);
 
+/// The index of the trial's first scored row (its size if none is scored).
+[[nodiscard]] std::size_t first_scored(const InclinationTrial& trial);
+
+/// The trial from row `from` on (empty past its end): a filter run on it from the first scored
+/// row starts in motion, with nothing learnt at the rest a recording begins with.
+[[nodiscard]] InclinationTrial trial_from(const InclinationTrial& trial, std::size_t from);
+
 /// RMS inclination error (deg) of the filter over the scored rows of the trial.
 [[nodiscard]] double inclination_rmse_deg(AttitudeFilter& filter, const InclinationTrial& trial);
 

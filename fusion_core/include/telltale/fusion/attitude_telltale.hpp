@@ -38,7 +38,9 @@
 ///     least-squares line through the specific force in I (intercept: the tilt, slope: the
 ///     bias), its acceleration noise measured as it goes; the low-pass then takes over in its
 ///     steady state with that bias and covariance. Without GNSS (a phone, a bench) the line
-///     fit never runs;
+///     fit never runs. Nothing is learnt from the drift until the growing mean has become the
+///     Butterworth (its drift is not the model's). A restart may begin from the calibration the
+///     filter had learnt (warm_start) instead of the datasheet's spread;
 ///   - the boat's own acceleration, when its speed is known (set_speed, from GNSS): a boat
 ///     turning at w about the vertical at speed v accelerates at w v toward the inside of the
 ///     turn, and speeding up at dv/dt along its heading. A tack's few seconds of that are one
@@ -160,6 +162,18 @@ struct TelltaleAttitudeParams {
   Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();
 };
 
+/// What TelltaleAttitudeFilter has learnt of its sensor (the gyro's bias, its common scale
+/// error, the accelerometer's skew) with their covariance, in the filter's units: kept across a
+/// restart, so that a node started again on the water does not begin from the datasheet's
+/// spread (TelltaleAttitudeFilter::calibration, warm_start).
+struct TelltaleCalibration {
+  Eigen::Vector3d bias_rad_s = Eigen::Vector3d::Zero();
+  double gyro_scale = 0.0;
+  double acc_skew_s = 0.0;
+  /// (bias x, y, z, scale, skew): the filter's State::cov.
+  Eigen::Matrix<double, 5, 5> cov = Eigen::Matrix<double, 5, 5>::Zero();
+};
+
 class TelltaleAttitudeFilter final : public AttitudeFilter {
  public:
   using Params = TelltaleAttitudeParams;
@@ -258,6 +272,17 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
   [[nodiscard]] AttitudeOutput output() const override;
   [[nodiscard]] const State& state() const { return state_; }
   void set_state(const State& s) { state_ = s; }
+  /// The bias, scale and skew as learnt so far, and their covariance.
+  [[nodiscard]] TelltaleCalibration calibration() const;
+  /// Begin (at the next first sample: call it before the first update, or the filter takes it
+  /// at its next start) from a calibration saved age_s ago instead of the priors. The sensor has
+  /// drifted since by the filter's own random walks (the bias at (bias_sigma_motion)^2 per
+  /// bias_forgetting_s, the scale and the skew likewise), so each variance grows by that over
+  /// age_s; one that reaches its prior is the prior again (uncorrelated: nothing is left of
+  /// what was learnt). Refused (false; the priors stay) when the calibration is not one this
+  /// filter could have learnt: a value not finite or beyond its clamp, a variance negative, or
+  /// age_s negative or not finite.
+  bool warm_start(const TelltaleCalibration& c, double age_s);
   [[nodiscard]] const Diagnostics& diagnostics() const { return diag_; }
   [[nodiscard]] const Params& params() const { return params_; }
 
@@ -291,6 +316,10 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
   double inv_sqrt2_tau_rest_ = 0.0;
   State state_;
   Diagnostics diag_;
+  /// warm_start's calibration, its covariance already grown by its age: what initialise()
+  /// starts from when have_warm_.
+  TelltaleCalibration warm_;
+  bool have_warm_ = false;
 };
 
 }  // namespace telltale::fusion
