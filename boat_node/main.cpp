@@ -27,6 +27,7 @@
 #include "backfill.hpp"
 #include "boat_dds.hpp"
 #include "boat_wire.hpp"
+#include "calibration_store.hpp"
 #include "console.hpp"
 #include "course_sim.hpp"
 #include "csv.hpp"
@@ -66,6 +67,9 @@ struct Options {
   double log_max_mb = 1024;
   std::string axis_remap = "x=x,y=y,z=z";
   std::string mount_file;
+  /// Where the attitude filter's learnt sensor calibration is kept across restarts (empty:
+  /// LOG_DIR/BOAT_ID.imu-calibration.json; "none": not kept).
+  std::string calibration_file;
   /// The sensor's position from the boat's centre, boat axes (m): the filter's lever_arm_m.
   std::vector<double> sensor_offset_m{0.0, 0.0, 0.0};
   double calibrate_s = 0;
@@ -159,6 +163,51 @@ void save_offsets(const std::string& path, const telltale::fusion::Mounting& m) 
   out.close();
   if (!out || std::rename((path + ".tmp").c_str(), path.c_str()) != 0)
     throw std::runtime_error("cannot write mount file " + path);
+}
+
+double unix_now_s() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+/// What a calibration is the calibration of: the IMU source, the simulator's seed (each seed is
+/// another simulated sensor), the axis remap (the filter's body axes) and the ranges.
+std::string sensor_identity(const Options& o, const std::string& source, std::uint64_t seed) {
+  std::string id = source;
+  if (source.rfind("sim", 0) == 0) id += " seed=" + std::to_string(seed);
+  char ranges[96];
+  std::snprintf(ranges, sizeof ranges, " gyro=%gdps acc=%gg", o.gyro_range_dps, o.acc_range_g);
+  return id + " remap=" + o.axis_remap + ranges;
+}
+
+/// Begins the filter from the calibration kept at `path` when it is this sensor's; says on
+/// stdout what it did. Nothing there, another sensor's or an unreadable file: the datasheet's
+/// priors (a cold start), never a refusal to run.
+void warm_start(telltale::fusion::TelltaleAttitudeFilter& filter, const std::string& path,
+                const std::string& sensor) {
+  std::string why;
+  const auto saved = telltale::boat::load_calibration(path, why);
+  if (!saved) {
+    std::printf("boat_node calibration: %s: %s; cold start\n", path.c_str(), why.c_str());
+  } else if (saved->sensor != sensor) {
+    std::printf("boat_node calibration: %s is of another sensor (%s, this one %s); cold start\n",
+                path.c_str(), saved->sensor.c_str(), sensor.c_str());
+  } else {
+    const double age_s = unix_now_s() - saved->saved_unix_s;
+    if (filter.warm_start(saved->calibration, age_s)) {
+      const auto& c = saved->calibration;
+      std::printf(
+          "boat_node calibration: %s: warm start, saved %.0f s ago, gyro bias %.3f %.3f %.3f "
+          "deg/s\n",
+          path.c_str(), age_s, c.bias_rad_s.x() * kRadToDeg, c.bias_rad_s.y() * kRadToDeg,
+          c.bias_rad_s.z() * kRadToDeg);
+    } else {
+      std::printf(
+          "boat_node calibration: %s: refused (saved %.0f s ago: a clock set back, or values no "
+          "filter learns); cold start\n",
+          path.c_str(), age_s);
+    }
+  }
+  std::fflush(stdout);
 }
 
 void run(const Options& o, telltale::ShutdownSignal& shutdown) {
@@ -298,6 +347,28 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   filter_params.acc_range_m_s2 = o.acc_range_g * telltale::fusion::kStandardGravity_m_s2;
   filter_params.lever_arm_m = {o.sensor_offset_m[0], o.sensor_offset_m[1], o.sensor_offset_m[2]};
   telltale::fusion::TelltaleAttitudeFilter filter(filter_params);
+  // The calibration the filter learnt in an earlier run of this sensor (calibration_store.hpp).
+  const std::string calibration_path =
+      o.calibration_file == "none"
+          ? std::string()
+          : (o.calibration_file.empty() ? o.log_dir + "/" + o.boat_id + ".imu-calibration.json"
+                                        : o.calibration_file);
+  const std::string sensor = sensor_identity(o, source->describe(), seed);
+  if (!calibration_path.empty()) warm_start(filter, calibration_path, sensor);
+  bool calibration_write_failed = false;
+  const auto keep_calibration = [&] {
+    if (calibration_path.empty() || !filter.state().initialised) return;
+    try {
+      telltale::boat::save_calibration(calibration_path,
+                                       {filter.calibration(), sensor, unix_now_s()});
+      calibration_write_failed = false;
+    } catch (const std::exception& e) {
+      // Said once per failing spell: the node goes on; the last good file stays.
+      if (!calibration_write_failed)
+        std::fprintf(stderr, "boat_node: calibration not kept: %s\n", e.what());
+      calibration_write_failed = true;
+    }
+  };
   const telltale::fusion::LedPanelParams led_params{o.led_step_deg,
                                                     static_cast<std::uint8_t>(o.leds_per_bar)};
 
@@ -327,6 +398,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   auto next_status = start;
   auto next_console = start;
   auto next_flush = start + std::chrono::seconds(1);
+  auto next_calibration = start + std::chrono::seconds(60);
   std::string addresses = local_addresses();
   telltale::msg::BoatFix fix_msg;
   std::uint64_t fix_seq = 0;
@@ -499,6 +571,10 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
       log.flush();
       fix_log.flush();
     }
+    if (now >= next_calibration) {
+      next_calibration = now + std::chrono::seconds(60);
+      keep_calibration();
+    }
     if (now >= next_status) {
       next_status = now + std::chrono::seconds(1);
       if (std::string current = local_addresses(); current != addresses) {
@@ -574,6 +650,7 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   };
   flush_or_say(log, "records");
   flush_or_say(fix_log, "fixes");
+  keep_calibration();
   if (o.console && tty) std::printf("\n");
   // Hand the shore what it is missing before going: 3 s if the shore is not heard, up to 10 s
   // while it is (the service manager's stop timeout is longer).
@@ -684,6 +761,11 @@ int main(int argc, char** argv) {
           "")
       ->check(CLI::Range(-50.0, 50.0))
       ->capture_default_str()
+      ->group(mounting);
+  app.add_option("--calibration-file", o.calibration_file,
+                 "the IMU calibration the attitude filter learns (gyro bias, scale, skew), kept "
+                 "across restarts: read at start when it is this sensor's, written every minute "
+                 "and at exit (default LOG_DIR/BOAT_ID.imu-calibration.json; none: not kept)")
       ->group(mounting);
   app.add_option("--calibrate-s", o.calibrate_s,
                  "with the boat level at the dock: average this long and store the offsets")

@@ -15,6 +15,7 @@
 #include <fstream>
 
 #include "backfill.hpp"
+#include "small_tmpfs.hpp"
 
 namespace telltale::boat {
 namespace {
@@ -81,15 +82,7 @@ TEST_F(SessionLogRuns, EarlierRunsOfThisBoatOnlyUntilDelivered) {
             (std::vector<std::uint64_t>{0x22}));
 }
 
-/// A private mount namespace for this test process (root only), so tmpfs mounts with a size limit
-/// or read-only ones stay invisible to everything else. False where that is not allowed.
-bool private_mounts() {
-  static const bool ok = [] {
-    if (::geteuid() != 0 || ::unshare(CLONE_NEWNS) != 0) return false;
-    return ::mount(nullptr, "/", nullptr, MS_REC | MS_PRIVATE, nullptr) == 0;
-  }();
-  return ok;
-}
+using test::private_mounts;
 
 class SessionLogFaults : public SessionLogRuns {
  protected:

@@ -15,6 +15,7 @@
 #include <map>
 #include <thread>
 
+#include "small_tmpfs.hpp"
 #include "tier_check.hpp"
 
 namespace telltale::shore {
@@ -436,42 +437,8 @@ TEST_F(StoreTest, TwoNodesUnderOneIdAreKeptApart) {
   EXPECT_EQ(reopened.count("tw"), before);
 }
 
-/// A private mount namespace for this test process (root only): tmpfs mounts with a size limit
-/// stay invisible to everything else. False where that is not allowed.
-bool private_mounts() {
-  static const bool ok = [] {
-    if (::geteuid() != 0 || ::unshare(CLONE_NEWNS) != 0) return false;
-    return ::mount(nullptr, "/", nullptr, MS_REC | MS_PRIVATE, nullptr) == 0;
-  }();
-  return ok;
-}
-
-/// Fills the filesystem of `path` with one file until a write fails.
-void fill_disk(const std::filesystem::path& path) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  ASSERT_GE(fd, 0);
-  std::vector<char> block(4096, 'x');
-  while (::write(fd, block.data(), block.size()) > 0) {
-  }
-  ::close(fd);
-}
-
-/// A 1 MB tmpfs at `dir` in this process's private mount namespace, unmounted at scope exit: a
-/// disk that really fills up.
-struct SmallTmpfs {
-  explicit SmallTmpfs(const std::filesystem::path& dir) : path(dir) {
-    std::filesystem::create_directories(dir);
-    mounted =
-        private_mounts() && ::mount("tmpfs", dir.c_str(), "tmpfs", 0, "size=1m,mode=0755") == 0;
-  }
-  ~SmallTmpfs() {
-    if (mounted) ::umount2(path.c_str(), MNT_DETACH);
-  }
-  SmallTmpfs(const SmallTmpfs&) = delete;
-  SmallTmpfs& operator=(const SmallTmpfs&) = delete;
-  std::filesystem::path path;
-  bool mounted = false;
-};
+using test::fill_disk;
+using test::SmallTmpfs;
 
 // Given a shore whose disk fills up (a real small tmpfs), then commits back off exponentially
 // instead of retrying the whole backlog every commit interval, the backlog stays bounded (later
