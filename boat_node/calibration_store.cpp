@@ -38,7 +38,11 @@ std::optional<SavedCalibration> load_calibration(const std::string& path, std::s
     why = "not JSON";
     return std::nullopt;
   }
-  if (j.value("format", std::string()) != kFormat || j.value("version", 0) != kVersion) {
+  // (Types checked first: json::value throws on a field of another type.)
+  const auto format = j.find("format");
+  const auto version = j.find("version");
+  if (format == j.end() || !format->is_string() || format->get<std::string>() != kFormat ||
+      version == j.end() || !version->is_number_integer() || version->get<int>() != kVersion) {
     why = std::string("not a ") + kFormat + " file of version " + std::to_string(kVersion);
     return std::nullopt;
   }

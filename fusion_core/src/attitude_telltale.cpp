@@ -2,6 +2,7 @@
 // why each step is done the way it is.
 #include "telltale/fusion/attitude_telltale.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <algorithm>
 #include <array>
@@ -396,6 +397,13 @@ bool TelltaleAttitudeFilter::warm_start(const TelltaleCalibration& c, double age
       std::abs(c.gyro_scale) <= p.max_gyro_scale && std::abs(c.acc_skew_s) <= p.max_acc_skew_s &&
       (c.cov.diagonal().array() >= 0.0).all();
   if (!plausible) return false;
+  // A covariance: symmetric, and no combination of the states with a negative variance (its
+  // smallest eigenvalue not below the rounding of its largest). Once per start.
+  const Eigen::Matrix<double, 5, 5> sym = 0.5 * (c.cov + c.cov.transpose());
+  const double scale = sym.cwiseAbs().maxCoeff();
+  if ((sym - c.cov).cwiseAbs().maxCoeff() > 1e-9 * scale) return false;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 5, 5>> eig(sym, Eigen::EigenvaluesOnly);
+  if (eig.info() != Eigen::Success || eig.eigenvalues().minCoeff() < -1e-12 * scale) return false;
   // The same walks as the prediction in update(), over the time the node was off: a variance
   // below its prior grows by its rate times age_s; one that reaches the prior is the prior,
   // and its correlations go (what was learnt of it is forgotten).
@@ -408,7 +416,7 @@ bool TelltaleAttitudeFilter::warm_start(const TelltaleCalibration& c, double age
                                    sm2 / p.bias_forgetting_s, k0 / p.gyro_scale_forgetting_s,
                                    s0 / p.acc_skew_forgetting_s};
   TelltaleCalibration w = c;
-  w.cov = 0.5 * (c.cov + c.cov.transpose());
+  w.cov = sym;
   for (int i = 0; i < 5; ++i) {
     const auto k = static_cast<std::size_t>(i);
     const double v = w.cov(i, i) + rate[k] * age_s;

@@ -347,7 +347,8 @@ TEST(TelltaleAttitudeFilter, StateRoundTripsExactly) {
 // variances grown by the filter's own walks over the time the node was off; a variance that
 // reaches its prior is the prior again, uncorrelated. A calibration this filter could not have
 // learnt is refused and the priors stay. Seen failing with the age ignored (the variance stays
-// at 1e-8) and with a bias beyond the clamp taken.
+// at 1e-8), with a bias beyond the clamp taken, and with the eigenvalue test left out (the
+// over-correlated covariance taken).
 TEST(TelltaleAttitudeFilter, WarmStartGrowsTheCalibrationByItsAgeAndRefusesTheImpossible) {
   const TelltaleAttitudeParams p;
   TelltaleCalibration c;
@@ -400,6 +401,12 @@ TEST(TelltaleAttitudeFilter, WarmStartGrowsTheCalibrationByItsAgeAndRefusesTheIm
   EXPECT_TRUE(refused(bad, 0.0));
   bad = c;
   bad.cov(2, 2) = -1e-9;
+  EXPECT_TRUE(refused(bad, 0.0));
+  bad = c;  // every variance positive, but bias x and the scale more correlated than perfectly
+  bad.cov(0, 3) = bad.cov(3, 0) = 1e-6;
+  EXPECT_TRUE(refused(bad, 0.0));
+  bad = c;  // not symmetric
+  bad.cov(0, 3) = 1e-7;
   EXPECT_TRUE(refused(bad, 0.0));
   EXPECT_TRUE(refused(c, -1.0));
   EXPECT_TRUE(refused(c, std::numeric_limits<double>::infinity()));

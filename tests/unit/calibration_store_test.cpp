@@ -59,7 +59,8 @@ TEST_F(CalibrationStore, RoundTripsBitForBit) {
   EXPECT_FALSE(std::filesystem::exists(file() + ".tmp"));
 }
 
-// Seen failing with the parser allowed to throw (the node stopped on a garbled file).
+// Seen failing with the parser allowed to throw (the node stopped on a garbled file), and with
+// the format read by json::value (a format of another type threw out of load_calibration).
 TEST_F(CalibrationStore, AnythingElseIsNoCalibrationWithItsReason) {
   std::string why;
   EXPECT_FALSE(load_calibration(file(), why));
@@ -71,6 +72,13 @@ TEST_F(CalibrationStore, AnythingElseIsNoCalibrationWithItsReason) {
   EXPECT_FALSE(load_calibration(file(), why));
   EXPECT_EQ(why, "not JSON");
   write("{\"format\": \"something-else\", \"version\": 1}");
+  EXPECT_FALSE(load_calibration(file(), why));
+  EXPECT_NE(why.find("not a telltale-imu-calibration file"), std::string::npos) << why;
+  // The format and version of another type (json::value would throw on them).
+  write("{\"format\": 3, \"version\": \"1\"}");
+  EXPECT_FALSE(load_calibration(file(), why));
+  EXPECT_NE(why.find("not a telltale-imu-calibration file"), std::string::npos) << why;
+  write("{\"format\": \"telltale-imu-calibration\", \"version\": [1]}");
   EXPECT_FALSE(load_calibration(file(), why));
   EXPECT_NE(why.find("not a telltale-imu-calibration file"), std::string::npos) << why;
   // Each field missing or of the wrong type in turn, from a good file.

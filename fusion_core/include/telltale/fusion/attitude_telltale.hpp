@@ -280,8 +280,9 @@ class TelltaleAttitudeFilter final : public AttitudeFilter {
   /// bias_forgetting_s, the scale and the skew likewise), so each variance grows by that over
   /// age_s; one that reaches its prior is the prior again (uncorrelated: nothing is left of
   /// what was learnt). Refused (false; the priors stay) when the calibration is not one this
-  /// filter could have learnt: a value not finite or beyond its clamp, a variance negative, or
-  /// age_s negative or not finite.
+  /// filter could have learnt: a value not finite or beyond its clamp, a covariance not
+  /// symmetric or with a negative variance in any combination of the states, or age_s negative
+  /// or not finite.
   bool warm_start(const TelltaleCalibration& c, double age_s);
   [[nodiscard]] const Diagnostics& diagnostics() const { return diag_; }
   [[nodiscard]] const Params& params() const { return params_; }
