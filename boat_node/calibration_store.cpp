@@ -116,4 +116,27 @@ void save_calibration(const std::string& path, const SavedCalibration& c) {
   }
 }
 
+std::string restore_calibration(fusion::TelltaleAttitudeFilter& filter, const std::string& path,
+                                const std::string& sensor, double now_unix_s) {
+  std::string why;
+  const auto saved = load_calibration(path, why);
+  if (!saved) return path + ": " + why + "; cold start";
+  if (saved->sensor != sensor)
+    return path + " is of another sensor (" + saved->sensor + ", this one " + sensor +
+           "); cold start";
+  const double age_s = now_unix_s - saved->saved_unix_s;
+  char text[160];
+  if (!filter.warm_start(saved->calibration, age_s)) {
+    std::snprintf(text, sizeof text,
+                  ": refused (saved %.0f s ago: a clock set back, or values no filter learns); "
+                  "cold start",
+                  age_s);
+    return path + text;
+  }
+  const Eigen::Vector3d b = saved->calibration.bias_rad_s * (180.0 / M_PI);
+  std::snprintf(text, sizeof text, ": warm start, saved %.0f s ago, gyro bias %.3f %.3f %.3f deg/s",
+                age_s, b.x(), b.y(), b.z());
+  return path + text;
+}
+
 }  // namespace telltale::boat

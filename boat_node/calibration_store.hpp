@@ -10,7 +10,9 @@
 /// The file says which sensor it describes (the IMU source, its axis remap and ranges, the
 /// simulator's seed): a calibration is the sensor's, and another sensor's bias read as this one's
 /// would be believed to 0.03 deg/s. It is written whole to a temporary file and renamed over the
-/// old one, so a power cut mid-write leaves the previous calibration, never half of one.
+/// old one, so a crash or a full disk mid-write leaves the previous calibration, never half of
+/// one. Not synced to the medium: after a power cut the file may be the one before; it is only a
+/// better start, and a file that does not parse is a cold start.
 
 #include <optional>
 #include <string>
@@ -35,5 +37,14 @@ struct SavedCalibration {
 /// and the reason when it cannot (a full disk, a read-only directory); the old file is then
 /// left as it was.
 void save_calibration(const std::string& path, const SavedCalibration& c);
+
+/// Begins `filter` (before its first sample) from the calibration kept at `path` when it is
+/// `sensor`'s, its age counted to `now_unix_s`; returns what it did, for the node to say: "PATH:
+/// warm start, saved N s ago, gyro bias X Y Z deg/s", or why it is a cold start (nothing there,
+/// unreadable, another sensor's, refused by the filter: a clock set back or values no filter
+/// learns). Never a refusal to run.
+[[nodiscard]] std::string restore_calibration(fusion::TelltaleAttitudeFilter& filter,
+                                              const std::string& path, const std::string& sensor,
+                                              double now_unix_s);
 
 }  // namespace telltale::boat

@@ -179,37 +179,6 @@ std::string sensor_identity(const Options& o, const std::string& source, std::ui
   return id + " remap=" + o.axis_remap + ranges;
 }
 
-/// Begins the filter from the calibration kept at `path` when it is this sensor's; says on
-/// stdout what it did. Nothing there, another sensor's or an unreadable file: the datasheet's
-/// priors (a cold start), never a refusal to run.
-void warm_start(telltale::fusion::TelltaleAttitudeFilter& filter, const std::string& path,
-                const std::string& sensor) {
-  std::string why;
-  const auto saved = telltale::boat::load_calibration(path, why);
-  if (!saved) {
-    std::printf("boat_node calibration: %s: %s; cold start\n", path.c_str(), why.c_str());
-  } else if (saved->sensor != sensor) {
-    std::printf("boat_node calibration: %s is of another sensor (%s, this one %s); cold start\n",
-                path.c_str(), saved->sensor.c_str(), sensor.c_str());
-  } else {
-    const double age_s = unix_now_s() - saved->saved_unix_s;
-    if (filter.warm_start(saved->calibration, age_s)) {
-      const auto& c = saved->calibration;
-      std::printf(
-          "boat_node calibration: %s: warm start, saved %.0f s ago, gyro bias %.3f %.3f %.3f "
-          "deg/s\n",
-          path.c_str(), age_s, c.bias_rad_s.x() * kRadToDeg, c.bias_rad_s.y() * kRadToDeg,
-          c.bias_rad_s.z() * kRadToDeg);
-    } else {
-      std::printf(
-          "boat_node calibration: %s: refused (saved %.0f s ago: a clock set back, or values no "
-          "filter learns); cold start\n",
-          path.c_str(), age_s);
-    }
-  }
-  std::fflush(stdout);
-}
-
 void run(const Options& o, telltale::ShutdownSignal& shutdown) {
   if (!std::regex_match(o.boat_id, kId))
     throw std::invalid_argument("boat id must be 1-32 of [A-Za-z0-9_-], got '" + o.boat_id + "'");
@@ -354,7 +323,12 @@ void run(const Options& o, telltale::ShutdownSignal& shutdown) {
           : (o.calibration_file.empty() ? o.log_dir + "/" + o.boat_id + ".imu-calibration.json"
                                         : o.calibration_file);
   const std::string sensor = sensor_identity(o, source->describe(), seed);
-  if (!calibration_path.empty()) warm_start(filter, calibration_path, sensor);
+  if (!calibration_path.empty()) {
+    std::printf("boat_node calibration: %s\n",
+                telltale::boat::restore_calibration(filter, calibration_path, sensor, unix_now_s())
+                    .c_str());
+    std::fflush(stdout);
+  }
   bool calibration_write_failed = false;
   const auto keep_calibration = [&] {
     if (calibration_path.empty() || !filter.state().initialised) return;

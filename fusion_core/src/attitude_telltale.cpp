@@ -247,18 +247,15 @@ void TelltaleAttitudeFilter::start_wait(bool at_rest, bool gap, double dt) {
   // start_fit_s of sea (two periods of the slowest wave) whenever the receiver's first fix
   // comes, and a fix a few seconds late (a receiver's cold start) would otherwise leave it one
   // wave's half swing. The cost is the start ending that much later, at most start_fit_s.
-  // (A restart's calibration is worth what it was when the filter began: warm_'s covariance.)
+  // (After a restart the bias is known as the calibration it began from says: warm_'s
+  // covariance.)
   const double a0 = params_.start_acc_sigma_m_s2 / params_.g_m_s2;
   const double var0 = params_.bias_sigma_init_rad_s * params_.bias_sigma_init_rad_s;
   st.start_pending = false;
   st.start_fit = true;
   st.start_elapsed_s = 0.0;
-  if (have_warm_) {
-    st.bias_rad_s = warm_.bias_rad_s;
-    st.cov.topLeftCorner<3, 3>() = warm_.cov.topLeftCorner<3, 3>();
-  } else {
-    st.cov.topLeftCorner<3, 3>() = var0 * Eigen::Matrix3d::Identity();
-  }
+  st.cov.topLeftCorner<3, 3>() = have_warm_ ? Eigen::Matrix3d(warm_.cov.topLeftCorner<3, 3>())
+                                            : Eigen::Matrix3d(var0 * Eigen::Matrix3d::Identity());
   // The start's filter has no scale or skew: nothing ties them to the bias.
   st.cov.topRightCorner<3, 2>().setZero();
   st.cov.bottomLeftCorner<2, 3>().setZero();

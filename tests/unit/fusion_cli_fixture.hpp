@@ -13,17 +13,13 @@
 #include <iterator>
 #include <string>
 
+#include "temp_dir_test.hpp"
+
 namespace telltale::testing {
 
-class FusionCliTest : public ::testing::Test {
+class FusionCliTest : public test::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("telltale_cli_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
+  FusionCliTest() : TempDirTest("telltale_cli_") {}
   [[nodiscard]] std::string path(const std::string& name) const { return (dir_ / name).string(); }
   /// Exit status of `fusion_cli args` (-1 if it did not exit), stdout in out.txt, stderr in
   /// err.txt.
@@ -40,9 +36,6 @@ class FusionCliTest : public ::testing::Test {
   void write(const std::string& name, const std::string& text) const {
     std::ofstream(path(name)) << text;
   }
-
- private:
-  std::filesystem::path dir_;
 };
 
 }  // namespace telltale::testing

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "temp_dir_test.hpp"
 #include "tier_check.hpp"
 
 namespace telltale::shore::import {
@@ -41,15 +42,9 @@ std::string atlas_csv(double start_s, std::size_t n, double hz) {
   return out;
 }
 
-class ImportStoreTest : public ::testing::Test {
+class ImportStoreTest : public test::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("telltale_import_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
+  ImportStoreTest() : TempDirTest("telltale_import_") {}
   StoreConfig config() const {
     StoreConfig c;
     c.path = (dir_ / "s.db").string();
@@ -81,7 +76,6 @@ class ImportStoreTest : public ::testing::Test {
     sqlite3_close(db);
     return n;
   }
-  std::filesystem::path dir_;
 };
 
 TEST_F(ImportStoreTest, AtlasCsvBecomesASessionWithSamplesAndFixes) {

@@ -16,6 +16,7 @@
 
 #include "json_views.hpp"
 #include "openapi_json.hpp"
+#include "temp_dir_test.hpp"
 
 namespace telltale::shore {
 namespace {
@@ -24,22 +25,15 @@ using ordered_json = nlohmann::ordered_json;
 
 constexpr std::uint64_t kT0 = 1795300000ULL * 1000000000ULL;
 
-class SampleFieldsTest : public ::testing::Test {
+class SampleFieldsTest : public test::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("telltale_fields_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
+  SampleFieldsTest() : TempDirTest("telltale_fields_") {}
   [[nodiscard]] StoreConfig config() const {
     StoreConfig c;
     c.path = (dir_ / "s.db").string();
     c.commit_interval = std::chrono::milliseconds(20);
     return c;
   }
-  std::filesystem::path dir_;
 };
 
 /// A value of its own for every field: the k-th field gets k in its type (a kind of fix for

@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "small_tmpfs.hpp"
+#include "temp_dir_test.hpp"
 #include "tier_check.hpp"
 
 namespace telltale::shore {
@@ -24,15 +25,9 @@ namespace {
 constexpr std::uint64_t kSecond = 1000000000ULL;
 constexpr std::uint64_t kT0 = 1795300000ULL * kSecond;
 
-class StoreTest : public ::testing::Test {
+class StoreTest : public test::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("telltale_store_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
+  StoreTest() : TempDirTest("telltale_store_") {}
   StoreConfig config() const {
     StoreConfig c;
     c.path = (dir_ / "s.db").string();
@@ -52,7 +47,6 @@ class StoreTest : public ::testing::Test {
     s.heading_deg = std::nan("");
     return s;
   }
-  std::filesystem::path dir_;
 };
 
 // Given a database written before boot_id existed, when a new shore opens it, then the old
