@@ -4,13 +4,14 @@ namespace telltale::fusion {
 
 void WalkingHeading::update(double t_s, const Eigen::Vector3d& gyro_unbiased,
                             const Eigen::Vector3d& bias, const Eigen::Vector3d& up) {
-  if (started_) {
-    const double dt = t_s - last_t_s_;
-    if (dt > 0.0 && dt < 1.0) {
-      yaw_rad_ += gyro_unbiased.dot(up) * dt;
-      bias_yaw_rad_ += bias.dot(up) * dt;
-      up_s_ += up * dt;
-    }
+  const double dt = started_ ? t_s - last_t_s_ : 0.0;
+  if (dt > 0.0 && dt < 1.0) {
+    yaw_rad_ += forward_.update(gyro_unbiased, dt, up);
+    bias_yaw_rad_ += bias.dot(up) * dt;
+    up_s_ += up * dt;
+  } else {
+    forward_.restart();  // the start or a gap: level again, nothing turned
+    forward_.update(gyro_unbiased, 0.0, up);
   }
   started_ = true;
   last_t_s_ = t_s;

@@ -12,8 +12,9 @@
 ///      so handling the phone, standing and pausing make no steps and no distance;
 ///   4. step length from height and cadence by the walk ratio (walk_ratio_step_length_m,
 ///      handheld/walk_ratio.hpp);
-///   5. WalkingHeading (handheld/walking_yaw.hpp): the phone's yaw about the vertical, the
-///      bias-corrected gyro integrated about the up direction. A phone held in front keeps a
+///   5. WalkingHeading (handheld/walking_yaw.hpp): the direction of the phone's forward axis
+///      about the vertical, carried by the bias-corrected gyro and held level by the up
+///      direction (ForwardAxisYaw, forward_axis_yaw.hpp). A phone held in front keeps a
 ///      fixed yaw to the walking direction, so turns of the phone are turns of the walk; the
 ///      magnetometer (unreliable indoors) only orients the track once, at the start, and never
 ///      steers it;

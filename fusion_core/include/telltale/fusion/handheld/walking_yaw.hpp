@@ -11,10 +11,15 @@
 #include <array>
 #include <cstddef>
 
+#include "telltale/fusion/forward_axis_yaw.hpp"
+#include "telltale/fusion/handheld/stand_bias.hpp"
+
 namespace telltale::fusion {
 
-/// The phone's yaw about the vertical: d(yaw)/dt = (w - bias) . up (counter-clockwise seen from
-/// above), heading = start - yaw. A short history lets a step confirmed late take the heading
+/// The phone's yaw about the vertical: the turn of its forward axis (kHandheldForward, the axis
+/// the magnetometer orients the track by) about the vertical, counter-clockwise seen from above,
+/// from the gyro less the bias (ForwardAxisYaw says why not the rate about the vertical);
+/// heading = start - yaw. A short history lets a step confirmed late take the heading
 /// it had when it was walked. Beside the yaw it integrates what relay_track needs to lay the
 /// walk again with another bias: the yaw the bias in use took off, integral of bias . up dt,
 /// and the integral of up dt (the yaw any constant bias b takes off is b . that integral).
@@ -43,6 +48,7 @@ class WalkingHeading {
   double bias_yaw_rad_ = 0.0;
   Eigen::Vector3d up_s_ = Eigen::Vector3d::Zero();
   bool started_ = false;
+  ForwardAxisYaw forward_{kHandheldForward};
   std::array<double, kHistory> hist_yaw_{};
   std::array<double, kHistory> hist_bias_yaw_{};
   std::array<Eigen::Vector3d, kHistory> hist_up_s_{};
