@@ -680,7 +680,7 @@ void phone_sim_table(int walks, int first_seed) {
 /// landmark polyline's length, (b) loop closure (the track's positions at the first and last
 /// landmark times apart) in % of that length, goal <= 2 % on >= 90 % of walks. The position at
 /// a time is that of the last step at or before it. Beside it, the closure of the live track
-/// (every step as laid while walking, before the re-lay: what `wearable_node` publishes).
+/// (every step as laid while walking, with the stands before it: what `wearable_node` publishes).
 void ipin_table(const EvalOptions& o) {
   namespace fs = std::filesystem;
   const std::string dir = data_dir(o) + "/ipin_pdr";

@@ -44,9 +44,10 @@ struct ImuRecord {
                                                       double rate_hz);
 
 /// A phone walk through HandheldPdr, as `fusion_cli pdr --mount phone` writes it and steps-eval
-/// scores it: every step laid as walked (`live`, the track `wearable_node` publishes), then the
-/// whole track re-laid with the gyro bias the walk ended with (`steps`; fusion::relay_track says
-/// why). `ns_per_sample`: the updates' time only.
+/// scores it: every step laid as walked, with the stands before it (`live`, the track
+/// `wearable_node` publishes; fusion::TrackRelay), then the whole track re-laid with the gyro
+/// bias the recording ended with (`steps`; fusion::relay_track). `ns_per_sample`: the updates' time
+/// only.
 struct HandheldWalk {
   std::vector<fusion::HandheldStep> steps;
   std::vector<fusion::HandheldStep> live;

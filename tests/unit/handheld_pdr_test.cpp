@@ -417,6 +417,7 @@ std::vector<HandheldStep> drifting_walk() {
     s.x_m = x;
     s.y_m = y;
     s.heading_deg = heading * 180.0 / M_PI;
+    s.gyro_heading_deg = s.heading_deg;
     s.bias_yaw_rad = bias_yaw;
     s.up_s = Eigen::Vector3d(0.0, 0.0, t);
     steps.push_back(s);
@@ -447,6 +448,53 @@ TEST(RelayTrack, TheBiasInUseAllAlongLeavesTheTrackAsItWas) {
     EXPECT_NEAR(steps[k].x_m, before[k].x_m, 1e-9);
     EXPECT_NEAR(steps[k].y_m, before[k].y_m, 1e-9);
   }
+}
+
+// The live track (TrackRelay) on the same walk, its bias known wrong (0.01 rad/s) until a stand at
+// 50 s measures it (0): up to the stand each step lies where the gyro laid it, from the first
+// step after it on the track is the one relay_track lays with the true bias: the position jumps
+// back onto the line and stays there. Seen failing with lay() adding each step with the bias
+// known at it and leaving the steps before it where they were (9.1 m east after the stand).
+TEST(TrackRelay, AStandsBiasLaysTheStepsBeforeItAgain) {
+  const auto walked = drifting_walk();
+  telltale::fusion::TrackRelay relay;
+  const Eigen::Vector3d wrong(0.0, 0.0, 0.01);
+  for (const auto& s : walked) {
+    const Eigen::Vector3d known = s.t_s <= 50.0 ? wrong : Eigen::Vector3d::Zero();
+    const auto laid = relay.lay(
+        {s.t_s, s.length_m, s.gyro_heading_deg * M_PI / 180.0, s.bias_yaw_rad, s.up_s}, known);
+    if (s.t_s <= 50.0) {
+      EXPECT_NEAR(laid.x_m, s.x_m, 1e-9) << s.t_s;  // the bias in use all along: as laid
+      EXPECT_NEAR(laid.y_m, s.y_m, 1e-9) << s.t_s;
+    } else {
+      EXPECT_NEAR(laid.x_m, 0.0, 1e-9) << s.t_s;
+      EXPECT_NEAR(laid.y_m, 0.7 * (s.t_s + 1.0), 1e-9) << s.t_s;
+      EXPECT_NEAR(laid.heading_rad, 0.0, 1e-9) << s.t_s;
+    }
+  }
+}
+
+// Steps older than the window keep where they were laid (the bias they were walked with has
+// drifted since): with a 20 s window the stand at 50 s mends only the 20 steps before it, and
+// the first 30 keep the 0.3 rad their live heading had drifted to. Seen failing with the window
+// ignored (the walk back on the line, x 0).
+TEST(TrackRelay, StepsOlderThanTheWindowKeepWhereTheyWereLaid) {
+  const auto walked = drifting_walk();
+  telltale::fusion::TrackRelay relay(20.0);
+  const Eigen::Vector3d wrong(0.0, 0.0, 0.01);
+  telltale::fusion::TrackRelay::Laid last;
+  for (const auto& s : walked) {
+    const Eigen::Vector3d known = s.t_s <= 50.0 ? wrong : Eigen::Vector3d::Zero();
+    last = relay.lay({s.t_s, s.length_m, s.gyro_heading_deg * M_PI / 180.0, s.bias_yaw_rad, s.up_s},
+                     known);
+  }
+  // Steps 0-30 (more than 20 s before the stand's first step, at 51 s) where the gyro laid them
+  // with the wrong bias, the later ones on the line.
+  double x = 0.0;
+  for (const auto& s : walked)
+    if (s.t_s < 31.0) x += s.length_m * std::sin(s.gyro_heading_deg * M_PI / 180.0);
+  EXPECT_GT(x, 2.0);
+  EXPECT_NEAR(last.x_m, x, 1e-9);
 }
 
 namespace {

@@ -18,8 +18,9 @@
 ///      fixed yaw to the walking direction, so turns of the phone are turns of the walk; the
 ///      magnetometer (unreliable indoors) only orients the track once, at the start, and never
 ///      steers it;
-///   6. the track (here: HandheldPdr, relay_track): each step laid at the heading the phone had
-///      at that step.
+///   6. the track (TrackRelay, handheld/track_relay.hpp): each step laid at the heading the
+///      phone had at that step, with the best gyro bias known then, the steps before it laid
+///      again with it (relay_track: the whole walk with its last, once it is over).
 ///
 /// Steps are reported with the time of the step itself (they are confirmed up to a few steps
 /// later): HandheldPdr::update returns the steps it confirmed at this sample.
@@ -35,6 +36,7 @@
 
 #include "telltale/fusion/attitude_telltale.hpp"
 #include "telltale/fusion/handheld/stand_bias.hpp"
+#include "telltale/fusion/handheld/track_relay.hpp"
 #include "telltale/fusion/handheld/walk_ratio.hpp"
 #include "telltale/fusion/handheld/walk_steps.hpp"
 #include "telltale/fusion/handheld/walking_yaw.hpp"
@@ -69,26 +71,24 @@ struct HandheldPdrParams {
 
 struct HandheldStep {
   double t_s = 0.0;
+  /// Laid with the bias known at the step (TrackRelay; relay_track: with the walk's last).
   double x_m = 0.0, y_m = 0.0, heading_deg = 0.0, length_m = 0.0, step_hz = 0.0;
   double distance_m = 0.0;
   std::size_t steps = 0;
-  /// At the step, for relay_track: the yaw the gyro bias in use had taken off since the start
-  /// (rad) and the integral of the up direction (phone frame, s).
+  /// As the gyro laid it, for laying it again (track_relay.hpp): the heading with the biases in
+  /// use, the yaw they had taken off since the start (rad) and the integral of the up direction
+  /// (phone frame, s).
+  double gyro_heading_deg = 0.0;
   double bias_yaw_rad = 0.0;
   Eigen::Vector3d up_s = Eigen::Vector3d::Zero();
 };
 
 /// A walk's steps (in order, every step since the start) laid again with one gyro bias for the
-/// whole walk: the one the walk ended with. The bias is a constant of the gyro over a walk
-/// (it drifts with temperature over tens of minutes), and each stand measures it; live, a step
-/// can only be laid with the stands before it, so a walk whose first stand measured it badly
-/// (a walker turning slowly on the spot, a magnetic estimate refused) walks its first legs with
-/// that error, and the later, better stands only mend the legs after them. The estimate every
-/// stand has made is the best for every step, the first ones included. Each step's heading moves
-/// by the yaw the two biases part by up to it, (bias in use - bias) integrated about the up
-/// direction; the first step keeps its heading (the track's orientation, from the
-/// magnetometer), the lengths are kept. For a walk reviewed after it ends (fusion_cli pdr,
-/// steps-eval); the live track (the wearable node) cannot know the stands ahead of it.
+/// whole walk: the one the walk ended with (track_relay.hpp says why). Each step's heading moves
+/// by the yaw the biases it was laid with and this one part by up to it; the first step keeps
+/// its heading (the track's orientation, from the magnetometer), the lengths are kept. For a walk
+/// reviewed after it ends (fusion_cli pdr, steps-eval): live, a step can only be laid with the
+/// stands before it (TrackRelay, the wearable node's track).
 void relay_track(std::span<HandheldStep> steps, const Eigen::Vector3d& bias_rad_s);
 
 class HandheldPdr {
@@ -121,6 +121,7 @@ class HandheldPdr {
   StandBiasLearner bias_;
   WalkStepDetector detector_;
   WalkingHeading heading_;
+  TrackRelay relay_;
   std::array<HandheldStep, WalkStepDetector::kMaxHeld> laid_{};
   HandheldStep last_;
   Eigen::Vector2d mag_offset_sum_ = Eigen::Vector2d::Zero();  ///< unit vectors of the offset
