@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -472,6 +473,21 @@ TEST(TrackRelay, AStandsBiasLaysTheStepsBeforeItAgain) {
       EXPECT_NEAR(laid.heading_rad, 0.0, 1e-9) << s.t_s;
     }
   }
+}
+
+// A bias that is not finite is no measurement: the track goes on with the last one (NaN would
+// make every position NaN from then on). Seen failing without the check: x NaN.
+TEST(TrackRelay, ANonFiniteBiasKeepsTheLastOne) {
+  const auto walked = drifting_walk();
+  telltale::fusion::TrackRelay relay;
+  const Eigen::Vector3d nan = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  telltale::fusion::TrackRelay::Laid last;
+  for (const auto& s : walked) {
+    const Eigen::Vector3d known = s.t_s <= 50.0 ? Eigen::Vector3d(0.0, 0.0, 0.01) : nan;
+    last = relay.lay({s.t_s, s.length_m, s.gyro_heading_deg * M_PI / 180.0, s.bias_yaw_rad, s.up_s},
+                     known);
+  }
+  EXPECT_TRUE(std::isfinite(last.x_m) && std::isfinite(last.y_m));
 }
 
 // Steps older than the window keep where they were laid (the bias they were walked with has

@@ -20,7 +20,8 @@ Eigen::Vector2d TrackRelay::displacement(const GyroLaidStep& s) const {
   return s.length_m * Eigen::Vector2d(std::sin(h), std::cos(h));
 }
 
-TrackRelay::Laid TrackRelay::lay(const GyroLaidStep& step, const Eigen::Vector3d& bias_rad_s) {
+TrackRelay::Laid TrackRelay::lay(const GyroLaidStep& step, const Eigen::Vector3d& bias_in) {
+  const Eigen::Vector3d bias_rad_s = bias_in.allFinite() ? bias_in : bias_;
   if (!anchored_) {
     anchor_ = step;
     anchored_ = true;

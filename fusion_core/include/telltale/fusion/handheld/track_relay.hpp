@@ -20,7 +20,6 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstddef>
-#include <span>
 
 namespace telltale::fusion {
 
@@ -51,7 +50,8 @@ class TrackRelay {
     double x_m = 0.0, y_m = 0.0;  ///< east, north of the start
     double heading_rad = 0.0;     ///< the step's, with the bias
   };
-  /// Lays `step` with the bias known now (`bias_rad_s`), the steps in the window with it.
+  /// Lays `step` with the bias known now (`bias_rad_s`), the steps in the window with it. A
+  /// bias that is not finite is no measurement: the last one stays.
   Laid lay(const GyroLaidStep& step, const Eigen::Vector3d& bias_rad_s);
 
  private:
