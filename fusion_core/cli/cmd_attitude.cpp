@@ -16,10 +16,15 @@ struct AttitudeOptions {
   std::string in;
   std::string out;
   std::string filter{fusion::kDefaultAttitudeFilter};
+  double gyro_range_dps = 0.0;  // 0: the production filter's default (the boat instrument's)
+  double acc_range_g = 0.0;
 };
 
 void run_attitude(const AttitudeOptions& o) {
-  auto filter = fusion::make_attitude_filter(o.filter);
+  fusion::SensorRanges ranges;  // what the recording's sensor clips at, where given
+  if (o.gyro_range_dps > 0.0) ranges.gyro_rad_s = o.gyro_range_dps * M_PI / 180.0;
+  if (o.acc_range_g > 0.0) ranges.acc_m_s2 = o.acc_range_g * fusion::kStandardGravity_m_s2;
+  auto filter = fusion::make_attitude_filter(o.filter, Eigen::Vector3d::Zero(), ranges);
   if (!filter)
     throw UsageError("unknown filter '" + o.filter + "' (see fusion_cli attitude --help)");
   io::CsvReader reader(
@@ -70,6 +75,13 @@ void register_attitude(CLI::App& app) {
                   "yaw_rate_deg_s,acc_weight,quality")
       ->required();
   cmd->add_option("--filter", opts->filter, filters);
+  cmd->add_option("--gyro-range-dps", opts->gyro_range_dps,
+                  "the recording's gyro full scale, deg/s (a reading at 98 % of it is taken for "
+                  "clipped; default: the boat instrument's 250)")
+      ->check(CLI::Range(1.0, 100000.0));
+  cmd->add_option("--acc-range-g", opts->acc_range_g,
+                  "the recording's accelerometer full scale, g (default: the boat instrument's 2)")
+      ->check(CLI::Range(0.1, 1000.0));
   cmd->callback([opts] { run_attitude(*opts); });
 }
 

@@ -152,8 +152,9 @@ void run_eval_attitude(const EvalAttitudeOptions& o) {
   // As recorded: every trial begins with the sensor at rest for 27-49 s.
   std::printf("\n## attitude: BROAD (%s%s), inclination RMSE over movement rows, deg\n\n",
               dir.c_str(), rate.c_str());
+  // Every filter told the recording's sensor's full scales (InclinationTrial::sensor).
   broad_table(trials, filters, [&](std::size_t t, const std::string& f) {
-    auto filter = fusion::make_attitude_filter(f);
+    auto filter = fusion::make_attitude_filter(f, Eigen::Vector3d::Zero(), data[t].sensor);
     return fusion::inclination_rmse_deg(*filter, data[t]);
   });
   // Started in motion: each filter's first sample is the trial's first movement row, so
@@ -171,12 +172,13 @@ void run_eval_attitude(const EvalAttitudeOptions& o) {
     const std::size_t from = fusion::first_scored(data[t]);
     const fusion::InclinationTrial moving = fusion::trial_from(data[t], from);
     if (f != "telltale restarted") {
-      auto filter = fusion::make_attitude_filter(f);
+      auto filter = fusion::make_attitude_filter(f, Eigen::Vector3d::Zero(), moving.sensor);
       return fusion::inclination_rmse_deg(*filter, moving);
     }
-    fusion::TelltaleAttitudeFilter before;
+    const fusion::TelltaleAttitudeParams params = fusion::with_ranges({}, moving.sensor);
+    fusion::TelltaleAttitudeFilter before(params);
     for (std::size_t i = 0; i < from; ++i) before.update(data[t].imu[i]);
-    fusion::TelltaleAttitudeFilter after;
+    fusion::TelltaleAttitudeFilter after(params);
     after.warm_start(before.calibration(), 0.0);
     return fusion::inclination_rmse_deg(after, moving);
   });

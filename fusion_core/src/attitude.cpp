@@ -43,9 +43,10 @@ std::string attitude_filter_description(std::string_view name) {
 }
 
 std::unique_ptr<AttitudeFilter> make_attitude_filter(std::string_view name,
-                                                     const Eigen::Vector3d& lever_arm_m) {
+                                                     const Eigen::Vector3d& lever_arm_m,
+                                                     const SensorRanges& ranges) {
   if (name == "telltale") {
-    TelltaleAttitudeParams params;
+    TelltaleAttitudeParams params = with_ranges({}, ranges);
     params.lever_arm_m = lever_arm_m;
     return std::make_unique<TelltaleAttitudeFilter>(params);
   }

@@ -100,6 +100,7 @@ InclinationTrial resample_trial(const InclinationTrial& trial, double rate_hz) {
   std::vector<double> t;
   for (const auto& s : imu) t.push_back(s.t_s);
   InclinationTrial out;
+  out.sensor = trial.sensor;
   for (const ResampleSpan& r : resample_spans(t, rate_hz)) {
     ImuSample s;
     s.t_s = r.t_s;
@@ -123,7 +124,8 @@ InclinationTrial trial_from(const InclinationTrial& trial, std::size_t from) {
     using V = std::decay_t<decltype(v)>;
     return from >= v.size() ? V{} : V(v.begin() + static_cast<std::ptrdiff_t>(from), v.end());
   };
-  return {cut(trial.imu), cut(trial.heel_true_rad), cut(trial.pitch_true_rad), cut(trial.scored)};
+  return {cut(trial.imu), cut(trial.heel_true_rad), cut(trial.pitch_true_rad), cut(trial.scored),
+          trial.sensor};
 }
 
 double inclination_rmse_deg(AttitudeFilter& filter, const InclinationTrial& trial) {

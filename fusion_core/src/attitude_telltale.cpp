@@ -172,6 +172,13 @@ template <int M>
 
 }  // namespace
 
+TelltaleAttitudeParams with_ranges(TelltaleAttitudeParams p, const SensorRanges& ranges) {
+  if (std::isfinite(ranges.gyro_rad_s) && ranges.gyro_rad_s > 0.0)
+    p.gyro_range_rad_s = ranges.gyro_rad_s;
+  if (std::isfinite(ranges.acc_m_s2) && ranges.acc_m_s2 > 0.0) p.acc_range_m_s2 = ranges.acc_m_s2;
+  return p;
+}
+
 TelltaleAttitudeFilter::TelltaleAttitudeFilter(Params params)
     : params_(params),
       gate_{params.gyro_range_rad_s, params.acc_range_m_s2, params.saturation_fraction,

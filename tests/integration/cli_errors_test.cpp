@@ -101,7 +101,10 @@ INSTANTIATE_TEST_SUITE_P(
              "0..232"},
         Case{"fusion_cli_missing_file", "",
              "fusion_cli attitude --in /nonexistent-telltale.csv --out /dev/null",
-             "nonexistent-telltale.csv"}),
+             "nonexistent-telltale.csv"},
+        Case{"fusion_cli_acc_range_not_positive", "",
+             "fusion_cli attitude --in /nonexistent-telltale.csv --out /dev/null --acc-range-g 0",
+             "acc-range-g"}),
     [](const ::testing::TestParamInfo<Case>& p) { return std::string(p.param.name); });
 
 }  // namespace

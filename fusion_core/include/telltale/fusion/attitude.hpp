@@ -17,6 +17,7 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+#include <limits>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -181,10 +182,18 @@ inline void output_from_up(const Eigen::Vector3d& gyro_body_rad_s, const Eigen::
 [[nodiscard]] std::string attitude_filter_description(std::string_view name);
 /// Name of the production filter (the default of fusion_cli attitude and of the boat node).
 inline constexpr std::string_view kDefaultAttitudeFilter = "telltale";
+/// A sensor's full scales (rad/s, m/s^2): a reading near one is clipped, not the motion.
+/// Infinite: not known.
+struct SensorRanges {
+  double gyro_rad_s = std::numeric_limits<double>::infinity();
+  double acc_m_s2 = std::numeric_limits<double>::infinity();
+};
 /// Builds a filter with its default Params; nullptr for an unknown name. `lever_arm_m` is the
 /// installation's sensor offset from the boat's centre (TelltaleAttitudeParams::lever_arm_m);
-/// the baselines have no model of it and ignore it.
+/// `ranges` the sensor's full scales where known (the production filter's defaults are the
+/// boat instrument's, 250 deg/s and 2 g). The baselines model neither and ignore both.
 [[nodiscard]] std::unique_ptr<AttitudeFilter> make_attitude_filter(
-    std::string_view name, const Eigen::Vector3d& lever_arm_m = Eigen::Vector3d::Zero());
+    std::string_view name, const Eigen::Vector3d& lever_arm_m = Eigen::Vector3d::Zero(),
+    const SensorRanges& ranges = {});
 
 }  // namespace telltale::fusion

@@ -45,6 +45,9 @@ struct InclinationTrial {
   std::vector<double> heel_true_rad;
   std::vector<double> pitch_true_rad;
   std::vector<unsigned char> scored;
+  /// The recording's sensor's full scales: a filter judged on it is told them (a reading within
+  /// them is the motion, not a clipped one).
+  SensorRanges sensor;
 };
 
 /// The trial as an IMU averaging to `rate_hz` (below the recording's rate) would have given it

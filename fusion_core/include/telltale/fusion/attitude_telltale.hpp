@@ -162,6 +162,10 @@ struct TelltaleAttitudeParams {
   Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();
 };
 
+/// `p` for a sensor of these full scales (a scale not known keeps p's).
+[[nodiscard]] TelltaleAttitudeParams with_ranges(TelltaleAttitudeParams p,
+                                                 const SensorRanges& ranges);
+
 /// What TelltaleAttitudeFilter has learnt of its sensor (the gyro's bias, its common scale
 /// error, the accelerometer's skew) with their covariance, in the filter's units: kept across a
 /// restart, so that a node started again on the water does not begin from the datasheet's
