@@ -32,6 +32,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstddef>
+#include <limits>
 #include <span>
 
 #include "telltale/fusion/attitude_telltale.hpp"
@@ -55,10 +56,16 @@ struct HandheldPdrParams {
   /// sensors are stamped by its OS (the IPIN files' gyro interpolated onto the accelerometer's
   /// stamps). On the eight IPIN walks the state ran to its 20 ms clamp through the handling on
   /// two walks and to -12.5 ms on a third, and route 21 walk 1 lost two steps (length ratio
-  /// 0.902 -> 0.880, outside 10 %): nothing there says what the skew is.
+  /// 0.902 -> 0.880, outside 10 %): nothing there says what the skew is. Nor the full scales:
+  /// a phone's are its maker's (Android runs its MEMS parts at up to 2000 deg/s and 4-16 g) and
+  /// the PDR is not told them; the IPIN phones read up to 923 deg/s and 2.9 g in their handling,
+  /// which the boat instrument's 250 deg/s and 2 g took for clipped readings (the walks'
+  /// closures within 0.08 points either way). Not known: nothing is taken for clipped.
   TelltaleAttitudeParams attitude = [] {
     TelltaleAttitudeParams p;
     p.acc_skew_sigma_init_s = 0.0;
+    p.gyro_range_rad_s = std::numeric_limits<double>::infinity();
+    p.acc_range_m_s2 = std::numeric_limits<double>::infinity();
     return p;
   }();
   StandBiasParams bias;

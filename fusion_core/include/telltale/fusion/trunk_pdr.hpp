@@ -30,6 +30,7 @@
 /// Memory: fixed-size members, no heap in update().
 
 #include <cstddef>
+#include <limits>
 
 #include "telltale/fusion/attitude_telltale.hpp"
 #include "telltale/fusion/gait_phase_steps.hpp"
@@ -47,7 +48,14 @@ struct TrunkPdrParams {
   double height_m = 1.75;  ///< the walker's: the pendulum's leg is a share of it
   GaitPhaseStepParams steps{.mount = StepMount::kBody};
   TrunkStepParams step;
-  TelltaleAttitudeParams attitude;
+  /// The production filter, its full scales not known (a belt sensor's are its maker's, the PDR
+  /// is not told them; HandheldPdrParams::attitude says why): nothing is taken for clipped.
+  TelltaleAttitudeParams attitude = [] {
+    TelltaleAttitudeParams p;
+    p.gyro_range_rad_s = std::numeric_limits<double>::infinity();
+    p.acc_range_m_s2 = std::numeric_limits<double>::infinity();
+    return p;
+  }();
   /// Heel strikes further apart than this close no step: the walk paused between them (a slow
   /// walk's step takes 0.7 s).
   double max_step_s = 1.2;
