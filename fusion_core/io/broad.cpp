@@ -26,7 +26,7 @@ fusion::InclinationTrial read_broad_trial(const std::string& imu_path,
   // (trial 08) and 9.6 g (16), unclipped; read with the boat instrument's 250 deg/s and 2 g, a
   // third of 08's and 29's samples would be taken for clipped ones.
   tr.sensor.gyro_rad_s = 2000.0 * kDeg;
-  tr.sensor.acc_m_s2 = 16.0 * 9.80665;
+  tr.sensor.acc_m_s2 = 16.0 * fusion::kStandardGravity_m_s2;
   const std::size_t n = imu.rows();
   tr.imu.resize(n);
   tr.heel_true_rad.resize(n);
