@@ -135,19 +135,6 @@ template <int M>
   st.acc_skew_s += dx(4);
 }
 
-/// A unit vector perpendicular to the unit vector u (continuity does not matter: each motion
-/// update is a measurement on its own, the covariance lives in the body frame). Always inlined:
-/// with three callers the compiler makes it a call, 27 instructions per update (callgrind).
-/// The normalisation is Eigen's normalized() written out (the same squared norm, square root and
-/// division, so the same bits): GCC kept that one an out-of-line call.
-[[gnu::always_inline]] inline Eigen::Vector3d perpendicular(const Eigen::Vector3d& u) {
-  const Eigen::Vector3d a =
-      std::abs(u.x()) < 0.8 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-  const Eigen::Vector3d v = a - a.dot(u) * u;
-  const double n2 = v.squaredNorm();
-  return n2 > 0.0 ? Eigen::Vector3d(v / std::sqrt(n2)) : v;
-}
-
 /// The end of the start's Kalman filter: the low-pass in its steady state (b0, a2: its
 /// Butterworth's coefficients for this step) at the start's vertical (|lp| = g: only its
 /// direction is read), the rotation and R * bias as they are now, the rate in I at its mean over
@@ -176,6 +163,12 @@ TelltaleAttitudeParams with_ranges(TelltaleAttitudeParams p, const SensorRanges&
   if (std::isfinite(ranges.gyro_rad_s) && ranges.gyro_rad_s > 0.0)
     p.gyro_range_rad_s = ranges.gyro_rad_s;
   if (std::isfinite(ranges.acc_m_s2) && ranges.acc_m_s2 > 0.0) p.acc_range_m_s2 = ranges.acc_m_s2;
+  return p;
+}
+
+TelltaleAttitudeParams without_ranges(TelltaleAttitudeParams p) {
+  p.gyro_range_rad_s = std::numeric_limits<double>::infinity();
+  p.acc_range_m_s2 = std::numeric_limits<double>::infinity();
   return p;
 }
 

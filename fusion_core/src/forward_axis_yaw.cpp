@@ -5,19 +5,6 @@
 #include "telltale/fusion/attitude.hpp"
 
 namespace telltale::fusion {
-namespace {
-
-/// A horizontal unit vector (perpendicular to the unit vector up): the axis of the body least
-/// aligned with it, its vertical part taken off.
-Eigen::Vector3d any_horizontal(const Eigen::Vector3d& up) {
-  Eigen::Index i = 0;
-  up.cwiseAbs().minCoeff(&i);
-  Eigen::Vector3d v = Eigen::Vector3d::Unit(i);
-  v -= v.dot(up) * up;
-  return v.normalized();
-}
-
-}  // namespace
 
 ForwardAxisYaw::ForwardAxisYaw(const Eigen::Vector3d& forward_body)
     : forward_(forward_body), forward_norm2_(forward_body.squaredNorm()) {}
@@ -31,7 +18,7 @@ void ForwardAxisYaw::horizontal(const Eigen::Vector3d& up, Eigen::Vector2d& h, b
 double ForwardAxisYaw::update(const Eigen::Vector3d& rate_rad_s, double dt_s,
                               const Eigen::Vector3d& up) {
   if (!started_) {
-    ref_ = any_horizontal(up);
+    ref_ = perpendicular(up);
     horizontal(up, h_prev_, usable_prev_);
     started_ = true;
     return 0.0;
@@ -58,7 +45,7 @@ double ForwardAxisYaw::update(const Eigen::Vector3d& rate_rad_s, double dt_s,
   // vertical as the attitude filter has it (it moves the axis's angle only to second order).
   v -= v.dot(up) * up;
   const double n2 = v.squaredNorm();
-  ref_ = n2 > 1e-6 ? Eigen::Vector3d(v / std::sqrt(n2)) : any_horizontal(up);
+  ref_ = n2 > 1e-6 ? Eigen::Vector3d(v / std::sqrt(n2)) : perpendicular(up);
   Eigen::Vector2d h;
   bool usable = false;
   horizontal(up, h, usable);

@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <random>
 #include <vector>
@@ -451,19 +452,34 @@ TEST(RelayTrack, TheBiasInUseAllAlongLeavesTheTrackAsItWas) {
   }
 }
 
+/// drifting_walk() through a TrackRelay, the bias known to it at each step `known(t)`: the last
+/// step as laid, `check(step, laid)` run on every step.
+using Laid = telltale::fusion::TrackRelay::Laid;
+Laid lay_walk(telltale::fusion::TrackRelay& relay,
+              const std::function<Eigen::Vector3d(double)>& known,
+              const std::function<void(const HandheldStep&, const Laid&)>& check = {}) {
+  Laid laid;
+  for (const auto& s : drifting_walk()) {
+    laid = relay.lay({s.t_s, s.length_m, s.gyro_heading_deg * M_PI / 180.0, s.bias_yaw_rad, s.up_s},
+                     known(s.t_s));
+    if (check) check(s, laid);
+  }
+  return laid;
+}
+
+/// The bias a stand at 50 s measures: 0.01 rad/s too large before it, the truth (0) after.
+Eigen::Vector3d stand_at_50_s(double t) {
+  return t <= 50.0 ? Eigen::Vector3d(0.0, 0.0, 0.01) : Eigen::Vector3d::Zero();
+}
+
 // The live track (TrackRelay) on the same walk, its bias known wrong (0.01 rad/s) until a stand at
 // 50 s measures it (0): up to the stand each step lies where the gyro laid it, from the first
 // step after it on the track is the one relay_track lays with the true bias: the position jumps
 // back onto the line and stays there. Seen failing with lay() adding each step with the bias
 // known at it and leaving the steps before it where they were (9.1 m east after the stand).
 TEST(TrackRelay, AStandsBiasLaysTheStepsBeforeItAgain) {
-  const auto walked = drifting_walk();
   telltale::fusion::TrackRelay relay;
-  const Eigen::Vector3d wrong(0.0, 0.0, 0.01);
-  for (const auto& s : walked) {
-    const Eigen::Vector3d known = s.t_s <= 50.0 ? wrong : Eigen::Vector3d::Zero();
-    const auto laid = relay.lay(
-        {s.t_s, s.length_m, s.gyro_heading_deg * M_PI / 180.0, s.bias_yaw_rad, s.up_s}, known);
+  lay_walk(relay, stand_at_50_s, [](const HandheldStep& s, const Laid& laid) {
     if (s.t_s <= 50.0) {
       EXPECT_NEAR(laid.x_m, s.x_m, 1e-9) << s.t_s;  // the bias in use all along: as laid
       EXPECT_NEAR(laid.y_m, s.y_m, 1e-9) << s.t_s;
@@ -472,21 +488,17 @@ TEST(TrackRelay, AStandsBiasLaysTheStepsBeforeItAgain) {
       EXPECT_NEAR(laid.y_m, 0.7 * (s.t_s + 1.0), 1e-9) << s.t_s;
       EXPECT_NEAR(laid.heading_rad, 0.0, 1e-9) << s.t_s;
     }
-  }
+  });
 }
 
 // A bias that is not finite is no measurement: the track goes on with the last one (NaN would
 // make every position NaN from then on). Seen failing without the check: x NaN.
 TEST(TrackRelay, ANonFiniteBiasKeepsTheLastOne) {
-  const auto walked = drifting_walk();
   telltale::fusion::TrackRelay relay;
-  const Eigen::Vector3d nan = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
-  telltale::fusion::TrackRelay::Laid last;
-  for (const auto& s : walked) {
-    const Eigen::Vector3d known = s.t_s <= 50.0 ? Eigen::Vector3d(0.0, 0.0, 0.01) : nan;
-    last = relay.lay({s.t_s, s.length_m, s.gyro_heading_deg * M_PI / 180.0, s.bias_yaw_rad, s.up_s},
-                     known);
-  }
+  const Laid last = lay_walk(relay, [](double t) {
+    return t <= 50.0 ? Eigen::Vector3d(0.0, 0.0, 0.01)
+                     : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  });
   EXPECT_TRUE(std::isfinite(last.x_m) && std::isfinite(last.y_m));
 }
 
@@ -495,19 +507,12 @@ TEST(TrackRelay, ANonFiniteBiasKeepsTheLastOne) {
 // the first 30 keep the 0.3 rad their live heading had drifted to. Seen failing with the window
 // ignored (the walk back on the line, x 0).
 TEST(TrackRelay, StepsOlderThanTheWindowKeepWhereTheyWereLaid) {
-  const auto walked = drifting_walk();
   telltale::fusion::TrackRelay relay(20.0);
-  const Eigen::Vector3d wrong(0.0, 0.0, 0.01);
-  telltale::fusion::TrackRelay::Laid last;
-  for (const auto& s : walked) {
-    const Eigen::Vector3d known = s.t_s <= 50.0 ? wrong : Eigen::Vector3d::Zero();
-    last = relay.lay({s.t_s, s.length_m, s.gyro_heading_deg * M_PI / 180.0, s.bias_yaw_rad, s.up_s},
-                     known);
-  }
+  const Laid last = lay_walk(relay, stand_at_50_s);
   // Steps 0-30 (more than 20 s before the stand's first step, at 51 s) where the gyro laid them
   // with the wrong bias, the later ones on the line.
   double x = 0.0;
-  for (const auto& s : walked)
+  for (const auto& s : drifting_walk())
     if (s.t_s < 31.0) x += s.length_m * std::sin(s.gyro_heading_deg * M_PI / 180.0);
   EXPECT_GT(x, 2.0);
   EXPECT_NEAR(last.x_m, x, 1e-9);

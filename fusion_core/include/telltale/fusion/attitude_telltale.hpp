@@ -165,6 +165,9 @@ struct TelltaleAttitudeParams {
 /// `p` for a sensor of these full scales (a scale not known keeps p's).
 [[nodiscard]] TelltaleAttitudeParams with_ranges(TelltaleAttitudeParams p,
                                                  const SensorRanges& ranges);
+/// `p` for a sensor whose full scales its user is not told (a wearable's part is its maker's):
+/// nothing is taken for clipped.
+[[nodiscard]] TelltaleAttitudeParams without_ranges(TelltaleAttitudeParams p);
 
 /// What TelltaleAttitudeFilter has learnt of its sensor (the gyro's bias, its common scale
 /// error, the accelerometer's skew) with their covariance, in the filter's units: kept across a

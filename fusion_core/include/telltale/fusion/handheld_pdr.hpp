@@ -32,7 +32,6 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstddef>
-#include <limits>
 #include <span>
 
 #include "telltale/fusion/attitude_telltale.hpp"
@@ -62,10 +61,8 @@ struct HandheldPdrParams {
   /// which the boat instrument's 250 deg/s and 2 g took for clipped readings (the walks'
   /// closures within 0.08 points either way). Not known: nothing is taken for clipped.
   TelltaleAttitudeParams attitude = [] {
-    TelltaleAttitudeParams p;
+    TelltaleAttitudeParams p = without_ranges({});
     p.acc_skew_sigma_init_s = 0.0;
-    p.gyro_range_rad_s = std::numeric_limits<double>::infinity();
-    p.acc_range_m_s2 = std::numeric_limits<double>::infinity();
     return p;
   }();
   StandBiasParams bias;

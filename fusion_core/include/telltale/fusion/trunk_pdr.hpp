@@ -30,7 +30,6 @@
 /// Memory: fixed-size members, no heap in update().
 
 #include <cstddef>
-#include <limits>
 
 #include "telltale/fusion/attitude_telltale.hpp"
 #include "telltale/fusion/gait_phase_steps.hpp"
@@ -50,12 +49,7 @@ struct TrunkPdrParams {
   TrunkStepParams step;
   /// The production filter, its full scales not known (a belt sensor's are its maker's, the PDR
   /// is not told them; HandheldPdrParams::attitude says why): nothing is taken for clipped.
-  TelltaleAttitudeParams attitude = [] {
-    TelltaleAttitudeParams p;
-    p.gyro_range_rad_s = std::numeric_limits<double>::infinity();
-    p.acc_range_m_s2 = std::numeric_limits<double>::infinity();
-    return p;
-  }();
+  TelltaleAttitudeParams attitude = without_ranges({});
   /// Heel strikes further apart than this close no step: the walk paused between them (a slow
   /// walk's step takes 0.7 s).
   double max_step_s = 1.2;
