@@ -2,18 +2,31 @@
 # The demo: a shore server, four simulated boats and a wearable on a private DDS domain (loopback
 # only) and the dashboard. Prints the dashboard link with its token; Ctrl-C stops everything cleanly.
 # --secure: the same with DDS Security, a fleet PKI made in a temporary folder.
+# Environment (each optional): TELLTALE_HTTP_PORT (8080), TELLTALE_DOMAIN (10-99 from the PID),
+# TELLTALE_COACH_TOKEN (random), TELLTALE_DB (build/demo.db; the boats' logs go beside it, in
+# demo_boat_log/), TELLTALE_BIN_DIR (run these binaries as they are instead of building build/bin).
 set -euo pipefail
+# Started in the background by a non-interactive shell (`deploy/demo.sh &` in a script, a
+# service), the script inherits SIGINT ignored, and bash can neither trap nor reset a signal
+# ignored at its entry: `kill -INT` would leave the demo running. Start again with SIGINT's
+# default disposition (once: then it is no longer ignored), so that the trap below takes it.
+sig_ignored=$(awk '/^SigIgn:/ {print $2}' /proc/$$/status)
+if (((16#$sig_ignored >> 1) & 1)); then exec env --default-signal=INT "$BASH" "$0" "$@"; fi
 secure=0
 [[ "${1:-}" == --secure ]] && secure=1
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-echo "building (log: $root/build/build.log)..."
-mkdir -p "$root/build"
-"$root/deploy/build.sh" shore_server boat_node wearable_node >"$root/build/build.log" 2>&1 || { tail -n 40 "$root/build/build.log"; exit 1; }
-bin="$root/build/bin"
+bin=${TELLTALE_BIN_DIR:-}
+if [[ -z $bin ]]; then
+  echo "building (log: $root/build/build.log)..."
+  mkdir -p "$root/build"
+  "$root/deploy/build.sh" shore_server boat_node wearable_node >"$root/build/build.log" 2>&1 || { tail -n 40 "$root/build/build.log"; exit 1; }
+  bin="$root/build/bin"
+fi
 export TELLTALE_DOMAIN=${TELLTALE_DOMAIN:-$((10 + $$ % 90))}
 port=${TELLTALE_HTTP_PORT:-8080}
 token=${TELLTALE_COACH_TOKEN:-$(head -c 12 /dev/urandom | base64 | tr '+/' '-_')}
 db=${TELLTALE_DB:-$root/build/demo.db}
+boat_log=$(dirname "$db")/demo_boat_log
 log=$(mktemp -d)
 pids=()
 stop() {
@@ -43,7 +56,7 @@ for boat in ILCA-1 ILCA-2 ILCA-3 ILCA-4; do
   # The simulated dinghy carries its sensor on the bow, 1.5 m ahead of and 0.25 m above its
   # centre: installed as a real one would be (--sensor-offset, docs/attitude.md).
   # shellcheck disable=SC2046
-  "$bin/boat_node" --boat-id "$boat" --group ILCA7 --log-dir "$root/build/demo_boat_log" \
+  "$bin/boat_node" --boat-id "$boat" --group ILCA7 --log-dir "$boat_log" \
     --sensor-offset 1.5,0,0.25 $(sec "$boat") >"$log/$boat" 2>&1 &
   pids+=($!)
 done
