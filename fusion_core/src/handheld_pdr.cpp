@@ -9,14 +9,10 @@ namespace telltale::fusion {
 
 void relay_track(std::span<HandheldStep> steps, const Eigen::Vector3d& bias_rad_s) {
   if (steps.empty()) return;
-  const auto gyro_laid = [](const HandheldStep& s) {
-    return GyroLaidStep{s.t_s, s.length_m, s.gyro_heading_deg * (M_PI / 180.0), s.bias_yaw_rad,
-                        s.up_s};
-  };
-  const GyroLaidStep anchor = gyro_laid(steps.front());
+  const GyroLaidStep anchor = steps.front().gyro;
   double x = 0.0, y = 0.0;
   for (auto& s : steps) {
-    const double heading = relaid_heading_rad(gyro_laid(s), anchor, bias_rad_s);
+    const double heading = relaid_heading_rad(s.gyro, anchor, bias_rad_s);
     x += s.length_m * std::sin(heading);
     y += s.length_m * std::cos(heading);
     s.x_m = x;
@@ -79,17 +75,15 @@ int HandheldPdr::update(const ImuSample& sample, const Eigen::Vector3d& mag_uT) 
     const double len =
         params_.step_scale * walk_ratio_step_length_m(params_.height_m, hz, params_.length);
     const WalkingHeading::At at = heading_.at(c.t_s);
-    const TrackRelay::Laid laid =
-        relay_.lay({c.t_s, len, at.heading_rad, at.bias_yaw_rad, at.up_s}, bias_.bias_rad_s());
+    const GyroLaidStep gyro{c.t_s, len, at.heading_rad, at.bias_yaw_rad, at.up_s};
+    const TrackRelay::Laid laid = relay_.lay(gyro, bias_.bias_rad_s());
     last_.t_s = clock_.to_caller(c.t_s);
     last_.x_m = laid.x_m;
     last_.y_m = laid.y_m;
     last_.heading_deg = wrap_360_deg(laid.heading_rad * 180.0 / M_PI);
     last_.length_m = len;
     last_.step_hz = hz;
-    last_.gyro_heading_deg = wrap_360_deg(at.heading_rad * 180.0 / M_PI);
-    last_.bias_yaw_rad = at.bias_yaw_rad;
-    last_.up_s = at.up_s;
+    last_.gyro = gyro;
     last_.distance_m += len;
     ++last_.steps;
     laid_[static_cast<std::size_t>(k)] = last_;

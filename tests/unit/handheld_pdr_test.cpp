@@ -419,9 +419,7 @@ std::vector<HandheldStep> drifting_walk() {
     s.x_m = x;
     s.y_m = y;
     s.heading_deg = heading * 180.0 / M_PI;
-    s.gyro_heading_deg = s.heading_deg;
-    s.bias_yaw_rad = bias_yaw;
-    s.up_s = Eigen::Vector3d(0.0, 0.0, t);
+    s.gyro = {t, s.length_m, heading, bias_yaw, Eigen::Vector3d(0.0, 0.0, t)};
     steps.push_back(s);
   }
   return steps;
@@ -443,7 +441,7 @@ TEST(RelayTrack, TheWalksFinalBiasTakesTheFirstStandsErrorOffEveryStep) {
 // Laid again with the bias it was laid with all along, a walk does not move.
 TEST(RelayTrack, TheBiasInUseAllAlongLeavesTheTrackAsItWas) {
   auto steps = drifting_walk();
-  for (auto& s : steps) s.bias_yaw_rad = 0.003 * s.t_s;  // 0.003 rad/s in use from the start
+  for (auto& s : steps) s.gyro.bias_yaw_rad = 0.003 * s.t_s;  // 0.003 rad/s in use from the start
   const auto before = steps;
   telltale::fusion::relay_track(steps, Eigen::Vector3d(0.0, 0.0, 0.003));
   for (std::size_t k = 0; k < steps.size(); ++k) {
@@ -460,8 +458,7 @@ Laid lay_walk(telltale::fusion::TrackRelay& relay,
               const std::function<void(const HandheldStep&, const Laid&)>& check = {}) {
   Laid laid;
   for (const auto& s : drifting_walk()) {
-    laid = relay.lay({s.t_s, s.length_m, s.gyro_heading_deg * M_PI / 180.0, s.bias_yaw_rad, s.up_s},
-                     known(s.t_s));
+    laid = relay.lay(s.gyro, known(s.t_s));
     if (check) check(s, laid);
   }
   return laid;
@@ -513,7 +510,7 @@ TEST(TrackRelay, StepsOlderThanTheWindowKeepWhereTheyWereLaid) {
   // with the wrong bias, the later ones on the line.
   double x = 0.0;
   for (const auto& s : drifting_walk())
-    if (s.t_s < 31.0) x += s.length_m * std::sin(s.gyro_heading_deg * M_PI / 180.0);
+    if (s.t_s < 31.0) x += s.length_m * std::sin(s.gyro.gyro_heading_rad);
   EXPECT_GT(x, 2.0);
   EXPECT_NEAR(last.x_m, x, 1e-9);
 }

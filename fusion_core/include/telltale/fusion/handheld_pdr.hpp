@@ -79,12 +79,9 @@ struct HandheldStep {
   double x_m = 0.0, y_m = 0.0, heading_deg = 0.0, length_m = 0.0, step_hz = 0.0;
   double distance_m = 0.0;
   std::size_t steps = 0;
-  /// As the gyro laid it, for laying it again (track_relay.hpp): the heading with the biases in
-  /// use, the yaw they had taken off since the start (rad) and the integral of the up direction
-  /// (phone frame, s).
-  double gyro_heading_deg = 0.0;
-  double bias_yaw_rad = 0.0;
-  Eigen::Vector3d up_s = Eigen::Vector3d::Zero();
+  /// As the gyro laid it, for laying it again (TrackRelay's record, track_relay.hpp; its time on
+  /// the stages' clock).
+  GyroLaidStep gyro;
 };
 
 /// A walk's steps (in order, every step since the start) laid again with one gyro bias for the
